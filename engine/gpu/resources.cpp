@@ -1,0 +1,209 @@
+#include "gpu/resources.h"
+
+#include "gpu/context.h"
+#include "gpu/error.h"
+
+namespace glint::gpu {
+
+namespace {
+
+VkBufferCreateInfo bufferInfo(const BufferDesc& desc) {
+    VkBufferCreateInfo info{VK_STRUCTURE_TYPE_BUFFER_CREATE_INFO};
+    info.size = desc.size;
+    info.usage = desc.usage | VK_BUFFER_USAGE_SHADER_DEVICE_ADDRESS_BIT;
+    // Exclusive: resources shared by the graphics and async compute queues
+    // are handled by the render graph (see engine/graph).
+    info.sharingMode = VK_SHARING_MODE_EXCLUSIVE;
+    return info;
+}
+
+VkImageCreateInfo imageInfo(const ImageDesc& desc) {
+    VkImageCreateInfo info{VK_STRUCTURE_TYPE_IMAGE_CREATE_INFO};
+    info.imageType = desc.depth > 1 ? VK_IMAGE_TYPE_3D : VK_IMAGE_TYPE_2D;
+    info.format = desc.format;
+    info.extent = {desc.width, desc.height, desc.depth};
+    info.mipLevels = desc.mips;
+    info.arrayLayers = desc.layers;
+    info.samples = VK_SAMPLE_COUNT_1_BIT;
+    info.tiling = VK_IMAGE_TILING_OPTIMAL;
+    info.usage = desc.usage;
+    info.sharingMode = VK_SHARING_MODE_EXCLUSIVE;
+    info.initialLayout = VK_IMAGE_LAYOUT_UNDEFINED;
+    return info;
+}
+
+} // namespace
+
+// ---------------------------------------------------------------- Buffer
+
+Buffer::Buffer(Context& ctx, const BufferDesc& desc) : desc_(desc) { create(ctx, nullptr); }
+
+Buffer::Buffer(Context& ctx, const BufferDesc& desc, const MemoryRange& memory) : desc_(desc) {
+    create(ctx, &memory);
+}
+
+VkMemoryRequirements Buffer::requirements(Context& ctx, const BufferDesc& desc) {
+    const VkBufferCreateInfo info = bufferInfo(desc);
+    VkDeviceBufferMemoryRequirements query{VK_STRUCTURE_TYPE_DEVICE_BUFFER_MEMORY_REQUIREMENTS};
+    query.pCreateInfo = &info;
+    VkMemoryRequirements2 out{VK_STRUCTURE_TYPE_MEMORY_REQUIREMENTS_2};
+    vkGetDeviceBufferMemoryRequirements(ctx.device(), &query, &out);
+    return out.memoryRequirements;
+}
+
+void Buffer::create(Context& ctx, const MemoryRange* placed) {
+    if (desc_.size == 0) {
+        throw GpuError("buffer '" + desc_.name + "': size is zero");
+    }
+    const VkBufferCreateInfo info = bufferInfo(desc_);
+    VkBuffer buffer = VK_NULL_HANDLE;
+    check(vkCreateBuffer(ctx.device(), &info, nullptr, &buffer), "vkCreateBuffer '" + desc_.name + "'");
+    buffer_ = Unique<VkBuffer>(ctx.device(), buffer, vkDestroyBuffer);
+
+    VkMemoryRequirements req;
+    vkGetBufferMemoryRequirements(ctx.device(), buffer, &req);
+    MemoryRange range;
+    if (placed) {
+        if (placed->size < req.size || placed->offset % req.alignment != 0 ||
+            !(req.memoryTypeBits & (1u << placed->memoryTypeIndex))) {
+            throw GpuError("buffer '" + desc_.name + "': the memory range given cannot hold it (needs " +
+                           std::to_string(req.size) + " bytes aligned to " + std::to_string(req.alignment) + ")");
+        }
+        range = *placed;
+    } else {
+        allocation_ = ctx.memory().allocate(req, desc_.memory, /*linear=*/true, desc_.name);
+        range = allocation_.range();
+    }
+    check(vkBindBufferMemory(ctx.device(), buffer, range.memory, range.offset), "vkBindBufferMemory '" + desc_.name + "'");
+    mapped_ = range.mapped;
+    VkBufferDeviceAddressInfo addressInfo{VK_STRUCTURE_TYPE_BUFFER_DEVICE_ADDRESS_INFO};
+    addressInfo.buffer = buffer;
+    address_ = vkGetBufferDeviceAddress(ctx.device(), &addressInfo);
+    ctx.setName(buffer, VK_OBJECT_TYPE_BUFFER, desc_.name);
+}
+
+// ---------------------------------------------------------------- Image
+
+Image::Image(Context& ctx, const ImageDesc& desc) : desc_(desc) { create(ctx, nullptr); }
+
+Image::Image(Context& ctx, const ImageDesc& desc, const MemoryRange& memory) : desc_(desc) { create(ctx, &memory); }
+
+VkMemoryRequirements Image::requirements(Context& ctx, const ImageDesc& desc) {
+    const VkImageCreateInfo info = imageInfo(desc);
+    VkDeviceImageMemoryRequirements query{VK_STRUCTURE_TYPE_DEVICE_IMAGE_MEMORY_REQUIREMENTS};
+    query.pCreateInfo = &info;
+    VkMemoryRequirements2 out{VK_STRUCTURE_TYPE_MEMORY_REQUIREMENTS_2};
+    vkGetDeviceImageMemoryRequirements(ctx.device(), &query, &out);
+    return out.memoryRequirements;
+}
+
+VkImageAspectFlags Image::aspect() const { return aspectOf(desc_.format); }
+
+VkImageSubresourceRange Image::fullRange() const { return {aspect(), 0, desc_.mips, 0, desc_.layers}; }
+
+void Image::create(Context& ctx, const MemoryRange* placed) {
+    if (desc_.width == 0 || desc_.height == 0 || desc_.depth == 0 || desc_.mips == 0 || desc_.layers == 0) {
+        throw GpuError("image '" + desc_.name + "': zero extent, mip count or layer count");
+    }
+    const VkImageCreateInfo info = imageInfo(desc_);
+    VkImageFormatProperties formatProps;
+    if (vkGetPhysicalDeviceImageFormatProperties(ctx.physicalDevice(), info.format, info.imageType, info.tiling,
+                                                 info.usage, 0, &formatProps) != VK_SUCCESS) {
+        throw GpuError("image '" + desc_.name + "': format " + std::to_string(desc_.format) +
+                       " does not support the requested usage on this device");
+    }
+    VkImage image = VK_NULL_HANDLE;
+    check(vkCreateImage(ctx.device(), &info, nullptr, &image), "vkCreateImage '" + desc_.name + "'");
+    image_ = Unique<VkImage>(ctx.device(), image, vkDestroyImage);
+
+    VkMemoryRequirements req;
+    vkGetImageMemoryRequirements(ctx.device(), image, &req);
+    MemoryRange range;
+    if (placed) {
+        if (placed->size < req.size || placed->offset % req.alignment != 0 ||
+            !(req.memoryTypeBits & (1u << placed->memoryTypeIndex))) {
+            throw GpuError("image '" + desc_.name + "': the memory range given cannot hold it");
+        }
+        range = *placed;
+    } else {
+        allocation_ = ctx.memory().allocate(req, MemoryUsage::DeviceLocal, /*linear=*/false, desc_.name);
+        range = allocation_.range();
+    }
+    check(vkBindImageMemory(ctx.device(), image, range.memory, range.offset), "vkBindImageMemory '" + desc_.name + "'");
+    ctx.setName(image, VK_OBJECT_TYPE_IMAGE, desc_.name);
+
+    // Transfer-only images (staging, readback targets) cannot have views.
+    constexpr VkImageUsageFlags kViewUsage = VK_IMAGE_USAGE_SAMPLED_BIT | VK_IMAGE_USAGE_STORAGE_BIT |
+                                             VK_IMAGE_USAGE_COLOR_ATTACHMENT_BIT |
+                                             VK_IMAGE_USAGE_DEPTH_STENCIL_ATTACHMENT_BIT |
+                                             VK_IMAGE_USAGE_INPUT_ATTACHMENT_BIT;
+    if (!(desc_.usage & kViewUsage)) {
+        return;
+    }
+    VkImageViewCreateInfo viewInfo{VK_STRUCTURE_TYPE_IMAGE_VIEW_CREATE_INFO};
+    viewInfo.image = image;
+    viewInfo.viewType = desc_.depth > 1   ? VK_IMAGE_VIEW_TYPE_3D
+                        : desc_.layers > 1 ? VK_IMAGE_VIEW_TYPE_2D_ARRAY
+                                           : VK_IMAGE_VIEW_TYPE_2D;
+    viewInfo.format = desc_.format;
+    viewInfo.subresourceRange = fullRange();
+    VkImageView view = VK_NULL_HANDLE;
+    check(vkCreateImageView(ctx.device(), &viewInfo, nullptr, &view), "vkCreateImageView '" + desc_.name + "'");
+    view_ = Unique<VkImageView>(ctx.device(), view, vkDestroyImageView);
+    ctx.setName(view, VK_OBJECT_TYPE_IMAGE_VIEW, desc_.name);
+}
+
+VkImageAspectFlags aspectOf(VkFormat format) {
+    switch (format) {
+    case VK_FORMAT_D16_UNORM:
+    case VK_FORMAT_D32_SFLOAT:
+    case VK_FORMAT_X8_D24_UNORM_PACK32: return VK_IMAGE_ASPECT_DEPTH_BIT;
+    case VK_FORMAT_D24_UNORM_S8_UINT:
+    case VK_FORMAT_D32_SFLOAT_S8_UINT: return VK_IMAGE_ASPECT_DEPTH_BIT | VK_IMAGE_ASPECT_STENCIL_BIT;
+    default: return VK_IMAGE_ASPECT_COLOR_BIT;
+    }
+}
+
+uint32_t bytesPerTexel(VkFormat format) {
+    switch (format) {
+    case VK_FORMAT_R8_UNORM:
+    case VK_FORMAT_R8_UINT: return 1;
+    case VK_FORMAT_R8G8_UNORM:
+    case VK_FORMAT_R16_SFLOAT:
+    case VK_FORMAT_R16_UINT:
+    case VK_FORMAT_D16_UNORM: return 2;
+    case VK_FORMAT_R8G8B8A8_UNORM:
+    case VK_FORMAT_R8G8B8A8_SRGB:
+    case VK_FORMAT_B8G8R8A8_UNORM:
+    case VK_FORMAT_B8G8R8A8_SRGB:
+    case VK_FORMAT_A2B10G10R10_UNORM_PACK32:
+    case VK_FORMAT_B10G11R11_UFLOAT_PACK32:
+    case VK_FORMAT_R16G16_SFLOAT:
+    case VK_FORMAT_R32_SFLOAT:
+    case VK_FORMAT_R32_UINT:
+    case VK_FORMAT_D32_SFLOAT: return 4;
+    case VK_FORMAT_R16G16B16A16_SFLOAT:
+    case VK_FORMAT_R32G32_SFLOAT:
+    case VK_FORMAT_R32G32_UINT: return 8;
+    case VK_FORMAT_R32G32B32A32_SFLOAT:
+    case VK_FORMAT_R32G32B32A32_UINT: return 16;
+    default: throw GpuError("bytesPerTexel: format " + std::to_string(format) + " is not one Glint reads back");
+    }
+}
+
+// ---------------------------------------------------------------- Sampler
+
+Sampler::Sampler(Context& ctx, const SamplerDesc& desc) {
+    VkSamplerCreateInfo info{VK_STRUCTURE_TYPE_SAMPLER_CREATE_INFO};
+    info.magFilter = desc.filter;
+    info.minFilter = desc.filter;
+    info.mipmapMode = desc.mipmap;
+    info.addressModeU = info.addressModeV = info.addressModeW = desc.address;
+    info.maxLod = desc.maxLod;
+    VkSampler sampler = VK_NULL_HANDLE;
+    check(vkCreateSampler(ctx.device(), &info, nullptr, &sampler), "vkCreateSampler '" + desc.name + "'");
+    sampler_ = Unique<VkSampler>(ctx.device(), sampler, vkDestroySampler);
+    ctx.setName(sampler, VK_OBJECT_TYPE_SAMPLER, desc.name);
+}
+
+} // namespace glint::gpu

@@ -1,0 +1,126 @@
+#include "common/app.h"
+
+#include "gpu/error.h"
+
+#include <spdlog/cfg/helpers.h>
+#include <spdlog/spdlog.h>
+#include <stb_image_write.h>
+
+#include <cstdio>
+#include <filesystem>
+#include <iostream>
+#include <stdexcept>
+
+namespace glint::app {
+
+namespace {
+struct UsageError : std::runtime_error {
+    using std::runtime_error::runtime_error;
+};
+} // namespace
+
+Args::Args(int argc, char** argv, const std::string& usage, const std::vector<std::string>& knownFlags,
+           const std::vector<std::string>& knownSwitches) {
+    auto known = [](const std::vector<std::string>& list, const std::string& s) {
+        return std::find(list.begin(), list.end(), s) != list.end();
+    };
+    for (int i = 1; i < argc; ++i) {
+        const std::string a = argv[i];
+        auto value = [&]() -> std::string {
+            if (i + 1 >= argc) {
+                throw UsageError(a + " needs a value\n" + usage);
+            }
+            return argv[++i];
+        };
+        if (a == "--help" || a == "-h") {
+            std::cout << usage << "\n"
+                      << "common: --validate  --device NAME  --log LEVEL (trace|debug|info|warn|error)  --no-ray-query\n";
+            std::exit(0);
+        } else if (a == "--validate") {
+            common_.validate = true;
+        } else if (a == "--device") {
+            common_.device = value();
+        } else if (a == "--log") {
+            common_.logLevel = value();
+        } else if (a == "--no-ray-query") {
+            common_.pipelineOnly = true;
+        } else if (a.rfind("--", 0) == 0 && known(knownFlags, a.substr(2))) {
+            values_[a.substr(2)] = value();
+        } else if (a.rfind("--", 0) == 0 && known(knownSwitches, a.substr(2))) {
+            values_[a.substr(2)] = "1";
+        } else {
+            throw UsageError("unknown argument '" + a + "'\n" + usage);
+        }
+    }
+    const auto level = spdlog::level::from_str(common_.logLevel);
+    if (level == spdlog::level::off && common_.logLevel != "off") {
+        throw UsageError("--log " + common_.logLevel + ": not a log level (trace, debug, info, warn, error, off)");
+    }
+    spdlog::set_level(level);
+}
+
+std::string Args::get(const std::string& name, const std::string& fallback) const {
+    const auto it = values_.find(name);
+    return it == values_.end() ? fallback : it->second;
+}
+
+uint32_t Args::getUint(const std::string& name, uint32_t fallback) const {
+    const auto it = values_.find(name);
+    if (it == values_.end()) {
+        return fallback;
+    }
+    try {
+        size_t used = 0;
+        const unsigned long v = std::stoul(it->second, &used);
+        if (used != it->second.size() || v > 0xffffffffu) {
+            throw std::invalid_argument("");
+        }
+        return static_cast<uint32_t>(v);
+    } catch (const std::exception&) {
+        throw UsageError("--" + name + " " + it->second + ": not a non-negative integer");
+    }
+}
+
+gpu::ContextOptions Args::contextOptions() const {
+    gpu::ContextOptions o;
+    o.validation = common_.validate;
+    o.deviceFilter = common_.device;
+    o.disableRayQuery = common_.pipelineOnly;
+    return o;
+}
+
+int runMain(const char* program, const std::function<int()>& body) {
+    spdlog::set_pattern("[%H:%M:%S.%e] [%^%l%$] %v");
+    try {
+        return body();
+    } catch (const std::exception& e) {
+        std::fprintf(stderr, "%s: error: %s\n", program, e.what());
+        return 1;
+    }
+}
+
+bool validationClean(gpu::Context& ctx) {
+    if (!ctx.validationEnabled()) {
+        return true;
+    }
+    const size_t n = ctx.validation().count();
+    if (n == 0) {
+        spdlog::info("validation: 0 messages");
+        return true;
+    }
+    spdlog::error("{}", ctx.validation().summary());
+    return false;
+}
+
+void writePng(const std::string& path, uint32_t width, uint32_t height, const std::vector<uint8_t>& rgba) {
+    const auto dir = std::filesystem::path(path).parent_path();
+    if (!dir.empty()) {
+        std::filesystem::create_directories(dir);
+    }
+    if (!stbi_write_png(path.c_str(), int(width), int(height), 4, rgba.data(), int(width * 4))) {
+        throw std::runtime_error("cannot write PNG '" + path + "'");
+    }
+    spdlog::info("wrote {} ({}x{})", path, width, height);
+}
+
+} // namespace glint::app

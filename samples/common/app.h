@@ -1,0 +1,48 @@
+#pragma once
+// What every Glint executable shares: common flags, logging set-up, and a
+// main wrapper that turns any exception into one line on stderr and a
+// non-zero exit.
+
+#include "gpu/context.h"
+
+#include <functional>
+#include <map>
+#include <string>
+#include <vector>
+
+namespace glint::app {
+
+struct CommonOptions {
+    bool validate = false;       // --validate: Khronos validation + sync validation, fail on any message
+    std::string device;          // --device NAME (overrides GLINT_DEVICE)
+    std::string logLevel = "info";
+    bool pipelineOnly = false;   // --no-ray-query: use the ray tracing pipeline even where ray query exists
+};
+
+// Flags after the common ones: "--name value" or "--name" (value "1").
+class Args {
+public:
+    Args(int argc, char** argv, const std::string& usage, const std::vector<std::string>& knownFlags,
+         const std::vector<std::string>& knownSwitches);
+    const CommonOptions& common() const { return common_; }
+    bool has(const std::string& name) const { return values_.count(name) != 0; }
+    std::string get(const std::string& name, const std::string& fallback) const;
+    uint32_t getUint(const std::string& name, uint32_t fallback) const;
+
+    gpu::ContextOptions contextOptions() const;
+
+private:
+    CommonOptions common_;
+    std::map<std::string, std::string> values_;
+};
+
+// Runs `body`, catching everything: prints "<program>: error: <what>" and
+// returns 1; returns 2 when --validate saw validation messages.
+int runMain(const char* program, const std::function<int()>& body);
+
+// Reports validation messages collected by `ctx`; true when there were none.
+bool validationClean(gpu::Context& ctx);
+
+void writePng(const std::string& path, uint32_t width, uint32_t height, const std::vector<uint8_t>& rgba);
+
+} // namespace glint::app

@@ -1,0 +1,13 @@
+#version 460
+#extension GL_EXT_ray_tracing : require
+#extension GL_EXT_scalar_block_layout : require
+#extension GL_GOOGLE_include_directive : require
+
+#include "glint/smoke_shared.h"
+
+layout(location = 0) rayPayloadInEXT SmokeHit payload;
+hitAttributeEXT vec2 bary;
+
+void main() {
+    payload = SmokeHit(1u, gl_InstanceCustomIndexEXT, gl_GeometryIndexEXT, gl_PrimitiveID, gl_HitTEXT, bary.x, bary.y, 0u);
+}
