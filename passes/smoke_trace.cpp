@@ -152,8 +152,10 @@ SmokeTraceResult SmokeTracer::trace(RayBackend backend, uint32_t width, uint32_t
     }
     const gpu::Pipeline& pipeline = pipelineFor(backend);
     const shader::SmokeCamera camera = scene::smokeCamera(scene_, width, height);
-    gpu::Buffer hits(ctx_, {VkDeviceSize(width) * height * sizeof(shader::SmokeHit), VK_BUFFER_USAGE_STORAGE_BUFFER_BIT,
-                            gpu::MemoryUsage::Readback, std::string("smoke.hits.") + backendName(backend)});
+    // Device-local: writing host memory from the shader would time the bus, not the trace.
+    gpu::Buffer hits(ctx_, {VkDeviceSize(width) * height * sizeof(shader::SmokeHit),
+                            VK_BUFFER_USAGE_STORAGE_BUFFER_BIT | VK_BUFFER_USAGE_TRANSFER_SRC_BIT,
+                            gpu::MemoryUsage::DeviceLocal, std::string("smoke.hits.") + backendName(backend)});
     gpu::TimestampQueries timer(ctx_, 1);
     const VkPipelineStageFlags2 stage = backend == RayBackend::RayQuery ? VK_PIPELINE_STAGE_2_COMPUTE_SHADER_BIT
                                                                         : VK_PIPELINE_STAGE_2_RAY_TRACING_SHADER_BIT_KHR;
@@ -172,8 +174,8 @@ SmokeTraceResult SmokeTracer::trace(RayBackend backend, uint32_t width, uint32_t
             sbt_->traceRays(ctx_, cmd, width, height);
         }
         timer.end(cmd, 0);
-        gpu::bufferBarrier(cmd, hits, stage, VK_ACCESS_2_SHADER_STORAGE_WRITE_BIT, VK_PIPELINE_STAGE_2_HOST_BIT,
-                           VK_ACCESS_2_HOST_READ_BIT);
+        gpu::bufferBarrier(cmd, hits, stage, VK_ACCESS_2_SHADER_STORAGE_WRITE_BIT, VK_PIPELINE_STAGE_2_COPY_BIT,
+                           VK_ACCESS_2_TRANSFER_READ_BIT);
     });
     SmokeTraceResult result;
     result.hits = gpu::readbackBufferAs<shader::SmokeHit>(ctx_, hits);

@@ -242,7 +242,12 @@ void Context::createInstance(const ContextOptions& options) {
     info.ppEnabledExtensionNames = extensions.data();
     info.enabledLayerCount = static_cast<uint32_t>(layers.size());
     info.ppEnabledLayerNames = layers.data();
-    check(vkCreateInstance(&info, nullptr, &instance_), "vkCreateInstance");
+    const VkResult created = vkCreateInstance(&info, nullptr, &instance_);
+    if (created == VK_ERROR_INCOMPATIBLE_DRIVER) {
+        throw GpuError("no Vulkan driver could be loaded (VK_ERROR_INCOMPATIBLE_DRIVER): install a GPU driver or "
+                       "lavapipe (scripts/setup), or point VK_DRIVER_FILES at a driver's ICD manifest");
+    }
+    check(created, "vkCreateInstance");
 
     if (validation_) {
         auto create = reinterpret_cast<PFN_vkCreateDebugUtilsMessengerEXT>(
