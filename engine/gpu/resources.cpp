@@ -7,17 +7,34 @@ namespace glint::gpu {
 
 namespace {
 
-VkBufferCreateInfo bufferInfo(const BufferDesc& desc) {
+// The graphics and compute families, for concurrent sharing; empty when the
+// resource stays on one queue family.
+struct Sharing {
+    uint32_t families[2] = {0, 0};
+    uint32_t count = 0;
+};
+
+Sharing sharingFor(const Context& ctx, bool sharedAcrossQueues) {
+    Sharing s;
+    if (sharedAcrossQueues && ctx.caps().computeFamily) {
+        s.families[0] = ctx.caps().graphicsFamily;
+        s.families[1] = *ctx.caps().computeFamily;
+        s.count = 2;
+    }
+    return s;
+}
+
+VkBufferCreateInfo bufferInfo(const BufferDesc& desc, const Sharing& sharing) {
     VkBufferCreateInfo info{VK_STRUCTURE_TYPE_BUFFER_CREATE_INFO};
     info.size = desc.size;
     info.usage = desc.usage | VK_BUFFER_USAGE_SHADER_DEVICE_ADDRESS_BIT;
-    // Exclusive: resources shared by the graphics and async compute queues
-    // are handled by the render graph (see engine/graph).
-    info.sharingMode = VK_SHARING_MODE_EXCLUSIVE;
+    info.sharingMode = sharing.count ? VK_SHARING_MODE_CONCURRENT : VK_SHARING_MODE_EXCLUSIVE;
+    info.queueFamilyIndexCount = sharing.count;
+    info.pQueueFamilyIndices = sharing.count ? sharing.families : nullptr;
     return info;
 }
 
-VkImageCreateInfo imageInfo(const ImageDesc& desc) {
+VkImageCreateInfo imageInfo(const ImageDesc& desc, const Sharing& sharing) {
     VkImageCreateInfo info{VK_STRUCTURE_TYPE_IMAGE_CREATE_INFO};
     info.imageType = desc.depth > 1 ? VK_IMAGE_TYPE_3D : VK_IMAGE_TYPE_2D;
     info.format = desc.format;
@@ -27,7 +44,9 @@ VkImageCreateInfo imageInfo(const ImageDesc& desc) {
     info.samples = VK_SAMPLE_COUNT_1_BIT;
     info.tiling = VK_IMAGE_TILING_OPTIMAL;
     info.usage = desc.usage;
-    info.sharingMode = VK_SHARING_MODE_EXCLUSIVE;
+    info.sharingMode = sharing.count ? VK_SHARING_MODE_CONCURRENT : VK_SHARING_MODE_EXCLUSIVE;
+    info.queueFamilyIndexCount = sharing.count;
+    info.pQueueFamilyIndices = sharing.count ? sharing.families : nullptr;
     info.initialLayout = VK_IMAGE_LAYOUT_UNDEFINED;
     return info;
 }
@@ -43,7 +62,8 @@ Buffer::Buffer(Context& ctx, const BufferDesc& desc, const MemoryRange& memory) 
 }
 
 VkMemoryRequirements Buffer::requirements(Context& ctx, const BufferDesc& desc) {
-    const VkBufferCreateInfo info = bufferInfo(desc);
+    const Sharing sharing = sharingFor(ctx, desc.sharedAcrossQueues);
+    const VkBufferCreateInfo info = bufferInfo(desc, sharing);
     VkDeviceBufferMemoryRequirements query{VK_STRUCTURE_TYPE_DEVICE_BUFFER_MEMORY_REQUIREMENTS};
     query.pCreateInfo = &info;
     VkMemoryRequirements2 out{VK_STRUCTURE_TYPE_MEMORY_REQUIREMENTS_2};
@@ -55,7 +75,8 @@ void Buffer::create(Context& ctx, const MemoryRange* placed) {
     if (desc_.size == 0) {
         throw GpuError("buffer '" + desc_.name + "': size is zero");
     }
-    const VkBufferCreateInfo info = bufferInfo(desc_);
+    const Sharing sharing = sharingFor(ctx, desc_.sharedAcrossQueues);
+    const VkBufferCreateInfo info = bufferInfo(desc_, sharing);
     VkBuffer buffer = VK_NULL_HANDLE;
     check(vkCreateBuffer(ctx.device(), &info, nullptr, &buffer), "vkCreateBuffer '" + desc_.name + "'");
     buffer_ = Unique<VkBuffer>(ctx.device(), buffer, vkDestroyBuffer);
@@ -89,7 +110,8 @@ Image::Image(Context& ctx, const ImageDesc& desc) : desc_(desc) { create(ctx, nu
 Image::Image(Context& ctx, const ImageDesc& desc, const MemoryRange& memory) : desc_(desc) { create(ctx, &memory); }
 
 VkMemoryRequirements Image::requirements(Context& ctx, const ImageDesc& desc) {
-    const VkImageCreateInfo info = imageInfo(desc);
+    const Sharing sharing = sharingFor(ctx, desc.sharedAcrossQueues);
+    const VkImageCreateInfo info = imageInfo(desc, sharing);
     VkDeviceImageMemoryRequirements query{VK_STRUCTURE_TYPE_DEVICE_IMAGE_MEMORY_REQUIREMENTS};
     query.pCreateInfo = &info;
     VkMemoryRequirements2 out{VK_STRUCTURE_TYPE_MEMORY_REQUIREMENTS_2};
@@ -105,7 +127,8 @@ void Image::create(Context& ctx, const MemoryRange* placed) {
     if (desc_.width == 0 || desc_.height == 0 || desc_.depth == 0 || desc_.mips == 0 || desc_.layers == 0) {
         throw GpuError("image '" + desc_.name + "': zero extent, mip count or layer count");
     }
-    const VkImageCreateInfo info = imageInfo(desc_);
+    const Sharing sharing = sharingFor(ctx, desc_.sharedAcrossQueues);
+    const VkImageCreateInfo info = imageInfo(desc_, sharing);
     VkImageFormatProperties formatProps;
     if (vkGetPhysicalDeviceImageFormatProperties(ctx.physicalDevice(), info.format, info.imageType, info.tiling,
                                                  info.usage, 0, &formatProps) != VK_SUCCESS) {

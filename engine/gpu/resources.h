@@ -20,6 +20,10 @@ struct BufferDesc {
     VkBufferUsageFlags usage = 0;  // SHADER_DEVICE_ADDRESS is always added
     MemoryUsage memory = MemoryUsage::DeviceLocal;
     std::string name;
+    // Used by both the graphics and the async compute queue: created with
+    // concurrent sharing over both families (no ownership transfers needed).
+    // No effect on devices without a separate compute family.
+    bool sharedAcrossQueues = false;
 };
 
 class Buffer {
@@ -65,6 +69,7 @@ struct ImageDesc {
     VkFormat format = VK_FORMAT_R8G8B8A8_UNORM;
     VkImageUsageFlags usage = 0;
     std::string name;
+    bool sharedAcrossQueues = false;  // as BufferDesc::sharedAcrossQueues
 };
 
 class Image {
