@@ -1,0 +1,413 @@
+#include "scene/bvh_planner.h"
+
+#include "scene/error.h"
+
+#include "glint/packing.h"
+
+#include <algorithm>
+#include <set>
+#include <sstream>
+
+namespace glint::scene {
+
+std::string_view reasonName(BlasBuildReason reason) {
+    switch (reason) {
+    case BlasBuildReason::FirstInRange: return "first in range";
+    case BlasBuildReason::Deformed: return "deformed";
+    case BlasBuildReason::FirstPerson: return "first person";
+    }
+    return "?";
+}
+
+std::string_view reasonName(BlasDropReason reason) {
+    switch (reason) {
+    case BlasDropReason::ObjectRemoved: return "object removed";
+    case BlasDropReason::Evicted: return "evicted";
+    }
+    return "?";
+}
+
+const BlasDesc* BvhPlan::find(BlasId id) const {
+    const auto it = std::lower_bound(blases.begin(), blases.end(), id,
+                                     [](const BlasDesc& b, BlasId value) { return b.id < value; });
+    return it != blases.end() && it->id == id ? &*it : nullptr;
+}
+
+std::string formatStats(const BvhStats& s) {
+    std::ostringstream out;
+    out << "BLAS built " << s.built << ", rebuilt " << s.rebuilt << " (skinned " << s.rebuiltSkinned
+        << ", first person " << s.rebuiltFirstPerson << "), dropped " << s.dropped << "; skipped: unchanged "
+        << s.skippedUnchanged << ", out of range " << s.skippedOutOfRange << ", over budget " << s.deferredBudget
+        << ", over skinned budget " << s.deferredSkinnedBudget << "; static reused " << s.staticReused
+        << "; instances in range " << s.instancesInRange << ", culled " << s.instancesCulled << " ("
+        << s.instancesWithoutBlas << " without BLAS), moved " << s.instancesMoved << "; TLAS " << s.tlasInstances
+        << ", resident BLAS " << s.residentBlases << ", pool " << s.poolTriangles << " triangles";
+    return out.str();
+}
+
+std::vector<std::vector<uint32_t>> partitionGeometries(const MeshLod& lod, uint32_t maxGeometries) {
+    const uint32_t count = uint32_t(lod.geometries.size());
+    maxGeometries = std::max(maxGeometries, 1u);
+    std::vector<std::vector<uint32_t>> parts;
+    if (count == 0) {
+        return parts;
+    }
+    if (count <= maxGeometries) {
+        parts.emplace_back(count);
+        for (uint32_t g = 0; g < count; ++g) {
+            parts[0][g] = g;
+        }
+        return parts;
+    }
+    // Material groups in order of first appearance.
+    std::vector<std::vector<uint32_t>> groups;
+    std::map<uint32_t, size_t> groupOf;
+    for (uint32_t g = 0; g < count; ++g) {
+        const auto [it, inserted] = groupOf.emplace(lod.geometries[g].material, groups.size());
+        if (inserted) {
+            groups.emplace_back();
+        }
+        groups[it->second].push_back(g);
+    }
+    for (std::vector<uint32_t>& group : groups) {
+        // A material with more geometries than fit one BLAS fills whole BLASes.
+        while (group.size() > maxGeometries) {
+            parts.emplace_back(group.begin(), group.begin() + maxGeometries);
+            group.erase(group.begin(), group.begin() + maxGeometries);
+        }
+        const auto fit = std::find_if(parts.begin(), parts.end(), [&](const std::vector<uint32_t>& p) {
+            return p.size() + group.size() <= maxGeometries;
+        });
+        if (fit != parts.end()) {
+            fit->insert(fit->end(), group.begin(), group.end());
+        } else {
+            parts.push_back(group);
+        }
+    }
+    return parts;
+}
+
+// ---------------------------------------------------------------------------
+// Pool allocator
+// ---------------------------------------------------------------------------
+
+uint32_t PoolAllocator::allocate(uint32_t triangles) {
+    for (auto it = free_.begin(); it != free_.end(); ++it) {
+        if (it->second >= triangles) {
+            const uint32_t offset = it->first;
+            const uint32_t rest = it->second - triangles;
+            free_.erase(it);
+            if (rest > 0) {
+                free_.emplace(offset + triangles, rest);
+            }
+            return offset;
+        }
+    }
+    // Grow; a free range touching the end is extended instead of skipped.
+    if (!free_.empty()) {
+        auto last = std::prev(free_.end());
+        if (last->first + last->second == end_) {
+            const uint32_t offset = last->first;
+            end_ = offset + triangles;
+            free_.erase(last);
+            return offset;
+        }
+    }
+    const uint32_t offset = end_;
+    end_ += triangles;
+    return offset;
+}
+
+void PoolAllocator::insertFree(uint32_t offset, uint32_t triangles) {
+    auto next = free_.lower_bound(offset);
+    if (next != free_.end() && offset + triangles == next->first) {
+        triangles += next->second;
+        next = free_.erase(next);
+    }
+    if (next != free_.begin()) {
+        auto prev = std::prev(next);
+        if (prev->first + prev->second == offset) {
+            prev->second += triangles;
+            return;
+        }
+    }
+    free_.emplace(offset, triangles);
+}
+
+void PoolAllocator::release(uint32_t offset, uint32_t triangles, uint64_t reusableFrom) {
+    if (triangles > 0) {
+        pending_.push_back({offset, triangles, reusableFrom});
+    }
+}
+
+void PoolAllocator::advance(uint64_t frame) {
+    auto due = std::stable_partition(pending_.begin(), pending_.end(),
+                                     [&](const Pending& p) { return p.reusableFrom > frame; });
+    for (auto it = due; it != pending_.end(); ++it) {
+        insertFree(it->offset, it->triangles);
+    }
+    pending_.erase(due, pending_.end());
+}
+
+// ---------------------------------------------------------------------------
+// Planner
+// ---------------------------------------------------------------------------
+
+BvhPlanner::BvhPlanner(const BvhSettings& settings) : settings_(settings) {}
+
+void BvhPlanner::reset() {
+    resident_.clear();
+    roundRobin_.clear();
+    pool_ = PoolAllocator{};
+    nextId_ = 1;
+    havePlanned_ = false;
+}
+
+BvhPlan BvhPlanner::plan(const Scene& scene, const glm::vec3& cameraPosition, uint64_t frame) {
+    if (havePlanned_ && frame <= lastFrame_) {
+        throw SceneError(scene.name, "BVH planner",
+                         "frame " + std::to_string(frame) + " after frame " + std::to_string(lastFrame_) +
+                             " (frames must increase; call reset() to start over)");
+    }
+    havePlanned_ = true;
+    lastFrame_ = frame;
+    pool_.advance(frame);
+
+    BvhPlan plan;
+    plan.frame = frame;
+    BvhStats& stats = plan.stats;
+
+    // --- Objects: each mesh's reflection LOD split into BLAS parts. -------
+    std::vector<uint32_t> lodOf(scene.meshes.size());
+    std::vector<std::vector<std::vector<uint32_t>>> partsOf(scene.meshes.size());
+    for (size_t m = 0; m < scene.meshes.size(); ++m) {
+        const Mesh& mesh = scene.meshes[m];
+        if (mesh.lods.empty()) {
+            continue;
+        }
+        lodOf[m] = reflectionLodIndex(mesh);
+        partsOf[m] = partitionGeometries(mesh.lods[lodOf[m]], settings_.maxGeometriesPerBlas);
+        // A geometry without triangles would be an empty BLAS geometry.
+        for (std::vector<uint32_t>& part : partsOf[m]) {
+            std::erase_if(part, [&](uint32_t g) { return mesh.lods[lodOf[m]].geometries[g].triangleCount() == 0; });
+        }
+        std::erase_if(partsOf[m], [](const std::vector<uint32_t>& part) { return part.empty(); });
+    }
+
+    // --- Which instance is in range, and which BLAS keys exist. -----------
+    struct InstanceView {
+        std::vector<Key> keys;
+        bool inRange = false;
+    };
+    std::vector<InstanceView> views(scene.instances.size());
+    std::map<Key, bool> existing;  // key -> some instance of it is in range
+    for (size_t i = 0; i < scene.instances.size(); ++i) {
+        const Instance& inst = scene.instances[i];
+        if (inst.mesh >= scene.meshes.size()) {
+            throw SceneError(scene.name, "instance " + std::to_string(i),
+                             "mesh " + std::to_string(inst.mesh) + " out of range");
+        }
+        const bool deformable = inst.motion != Motion::Static;
+        const float radius = inst.longRange ? settings_.longRangeRadius : settings_.radius;
+        views[i].inRange = distanceToBounds(instanceBounds(scene, inst), cameraPosition) <= radius;
+        for (uint32_t p = 0; p < partsOf[inst.mesh].size(); ++p) {
+            const Key key{deformable, deformable ? uint32_t(i) : inst.mesh, inst.mesh, lodOf[inst.mesh], p};
+            views[i].keys.push_back(key);
+            existing[key] = existing[key] || views[i].inRange;
+        }
+    }
+    const auto motionOf = [&](const Key& key) {
+        return key.perInstance ? scene.instances[key.owner].motion : Motion::Static;
+    };
+
+    // --- Drops. -------------------------------------------------------------
+    for (auto it = resident_.begin(); it != resident_.end();) {
+        const auto use = existing.find(it->first);
+        const bool removed = use == existing.end() || motionOf(it->first) != it->second.desc.motion;
+        if (use != existing.end() && use->second) {
+            it->second.lastInRange = frame;
+        }
+        const bool evicted = !removed && settings_.evictAfterFramesOutside > 0 &&
+                             frame - it->second.lastInRange >= settings_.evictAfterFramesOutside;
+        if (removed || evicted) {
+            const BlasDesc& desc = it->second.desc;
+            pool_.release(desc.poolOffset, desc.triangleCount, frame + settings_.framesInFlight);
+            plan.drops.push_back({desc.id, removed ? BlasDropReason::ObjectRemoved : BlasDropReason::Evicted});
+            ++stats.dropped;
+            it = resident_.erase(it);
+        } else {
+            ++it;
+        }
+    }
+
+    // --- First builds: objects within their radius that have no BLAS. ------
+    std::set<BlasId> builtThisFrame;
+    for (size_t i = 0; i < scene.instances.size(); ++i) {
+        if (!views[i].inRange) {
+            continue;
+        }
+        const Instance& inst = scene.instances[i];
+        const MeshLod& lod = scene.meshes[inst.mesh].lods[lodOf[inst.mesh]];
+        for (const Key& key : views[i].keys) {
+            if (resident_.count(key)) {
+                continue;
+            }
+            Resident r;
+            BlasDesc& desc = r.desc;
+            desc.id = nextId_++;
+            desc.mesh = inst.mesh;
+            desc.lod = key.lod;
+            desc.part = key.part;
+            desc.instance = key.perInstance ? int32_t(i) : kNone;
+            desc.motion = motionOf(key);
+            for (uint32_t g : partsOf[inst.mesh][key.part]) {
+                desc.geometries.push_back({g, lod.geometries[g].material, lod.geometries[g].triangleCount(), 0});
+                desc.triangleCount += lod.geometries[g].triangleCount();
+            }
+            desc.poolOffset = pool_.allocate(desc.triangleCount);
+            uint32_t offset = desc.poolOffset;
+            for (BlasGeometry& g : desc.geometries) {
+                g.poolOffset = offset;
+                offset += g.triangleCount;
+            }
+            r.builtVersion = key.perInstance ? inst.deformVersion : 0;
+            r.lastInRange = frame;
+            r.lastBuilt = frame;
+            plan.builds.push_back({desc.id, BlasBuildReason::FirstInRange});
+            stats.builtTriangles += desc.triangleCount;
+            builtThisFrame.insert(desc.id);
+            ++stats.built;
+            resident_.emplace(key, std::move(r));
+        }
+    }
+
+    // --- Rebuilds: first person, then the round-robin loop, in budget. -----
+    // The loop holds every deformable, non-first-person BLAS; new ones join
+    // at the back, rebuilt ones move to the back.
+    {
+        std::set<Key> queued(roundRobin_.begin(), roundRobin_.end());
+        std::erase_if(roundRobin_,
+                      [&](const Key& k) { return !resident_.count(k) || scene.instances[k.owner].firstPerson; });
+        for (const auto& [key, r] : resident_) {
+            if (key.perInstance && !scene.instances[key.owner].firstPerson && !queued.count(key)) {
+                roundRobin_.push_back(key);
+            }
+        }
+    }
+    uint32_t rebuilds = 0;
+    uint32_t skinnedRebuilds = 0;
+    // Returns true when rebuilt; counts why not otherwise.
+    const auto consider = [&](const Key& key, Resident& r, BlasBuildReason reason) {
+        if (builtThisFrame.count(r.desc.id)) {
+            return false;
+        }
+        const Instance& inst = scene.instances[key.owner];
+        if (inst.deformVersion == r.builtVersion) {
+            ++stats.skippedUnchanged;
+            return false;
+        }
+        if (!views[key.owner].inRange) {
+            ++stats.skippedOutOfRange;
+            return false;
+        }
+        const bool skinned = r.desc.motion == Motion::Skinned;
+        if (rebuilds >= settings_.maxRebuildsPerFrame) {
+            ++stats.deferredBudget;
+            return false;
+        }
+        if (skinned && skinnedRebuilds >= settings_.maxSkinnedRebuildsPerFrame) {
+            ++stats.deferredSkinnedBudget;
+            return false;
+        }
+        ++rebuilds;
+        ++stats.rebuilt;
+        if (skinned) {
+            ++skinnedRebuilds;
+            ++stats.rebuiltSkinned;
+        }
+        if (reason == BlasBuildReason::FirstPerson) {
+            ++stats.rebuiltFirstPerson;
+        }
+        r.builtVersion = inst.deformVersion;
+        r.lastBuilt = frame;
+        plan.builds.push_back({r.desc.id, reason});
+        stats.builtTriangles += r.desc.triangleCount;
+        builtThisFrame.insert(r.desc.id);
+        return true;
+    };
+    for (size_t i = 0; i < scene.instances.size(); ++i) {
+        if (!scene.instances[i].firstPerson || scene.instances[i].motion == Motion::Static) {
+            continue;
+        }
+        for (const Key& key : views[i].keys) {
+            if (const auto it = resident_.find(key); it != resident_.end()) {
+                consider(key, it->second, BlasBuildReason::FirstPerson);
+            }
+        }
+    }
+    {
+        std::vector<Key> waiting, rebuilt;
+        for (const Key& key : roundRobin_) {
+            (consider(key, resident_.at(key), BlasBuildReason::Deformed) ? rebuilt : waiting).push_back(key);
+        }
+        roundRobin_ = std::move(waiting);
+        roundRobin_.insert(roundRobin_.end(), rebuilt.begin(), rebuilt.end());
+    }
+
+    // --- The TLAS and the primitive offset table. ---------------------------
+    std::set<BlasId> staticInTlas;
+    for (size_t i = 0; i < scene.instances.size(); ++i) {
+        const Instance& inst = scene.instances[i];
+        if (!views[i].inRange) {
+            ++stats.instancesCulled;
+            const bool hasBlas = std::any_of(views[i].keys.begin(), views[i].keys.end(),
+                                             [&](const Key& k) { return resident_.count(k) > 0; });
+            stats.instancesWithoutBlas += hasBlas ? 0 : 1;
+            continue;
+        }
+        ++stats.instancesInRange;
+        if (inst.transform != inst.previousTransform) {
+            ++stats.instancesMoved;
+        }
+        const uint8_t mask = uint8_t(inst.firstPerson ? shader::kInstanceMaskFirstPerson
+                                     : inst.longRange ? shader::kInstanceMaskLongRange
+                                                      : shader::kInstanceMaskWorld);
+        for (const Key& key : views[i].keys) {
+            const BlasDesc& desc = resident_.at(key).desc;
+            if (desc.motion == Motion::Static && !builtThisFrame.count(desc.id)) {
+                staticInTlas.insert(desc.id);
+            }
+            TlasInstance t;
+            t.sceneInstance = uint32_t(i);
+            t.blas = desc.id;
+            t.transform = inst.transform;
+            t.customIndex = uint32_t(plan.primitiveOffsets.size());
+            t.sbtOffset = shader::kSbtOffsetPackedPrimitives;
+            t.mask = mask;
+            if (t.customIndex + desc.geometries.size() > (1u << 24)) {
+                throw SceneError(scene.name, "BVH planner", "primitive offset table exceeds the 24-bit custom index");
+            }
+            for (const BlasGeometry& g : desc.geometries) {
+                plan.primitiveOffsets.push_back(g.poolOffset);
+            }
+            plan.tlas.push_back(t);
+        }
+    }
+    stats.staticReused = uint32_t(staticInTlas.size());
+    stats.tlasInstances = uint32_t(plan.tlas.size());
+
+    plan.particleCount = uint32_t(scene.particles.size());
+    plan.particleTlas = plan.particleCount > 0;
+
+    plan.blases.reserve(resident_.size());
+    for (const auto& [key, r] : resident_) {
+        plan.blases.push_back(r.desc);
+    }
+    std::sort(plan.blases.begin(), plan.blases.end(), [](const BlasDesc& a, const BlasDesc& b) { return a.id < b.id; });
+    plan.poolTriangles = pool_.size();
+    stats.residentBlases = uint32_t(plan.blases.size());
+    stats.poolTriangles = plan.poolTriangles;
+    return plan;
+}
+
+} // namespace glint::scene

@@ -1,0 +1,46 @@
+#pragma once
+// glTF 2.0 (.gltf with embedded or external buffers and images, and .glb)
+// into the scene model, through tinygltf.
+//
+// Every index, offset, count, stride and type is checked before any data is
+// read, and every size before memory is allocated: a broken file gives a
+// SceneError naming the file and the element ("accessor 3 (mesh 'Body'
+// primitive 0 POSITION): ..."), never a crash, an out-of-bounds read or an
+// unbounded allocation. A missing or undecodable texture is not an error:
+// the material keeps its flat factors and the loader warns once per image.
+//
+// Supported extensions: KHR_materials_emissive_strength,
+// KHR_lights_punctual (the first directional light becomes the sun),
+// KHR_materials_ior (as reflectance), KHR_mesh_quantization. Others are
+// ignored with one log line each, unless the file requires them.
+
+#include "scene/scene.h"
+
+#include <cstdint>
+#include <filesystem>
+
+namespace glint::scene {
+
+struct GltfLoadOptions {
+    // The .gltf/.glb file and each external buffer or image. tinygltf takes
+    // GLB sizes as 32-bit, so this must stay below 4 GiB.
+    uint64_t maxFileBytes = 1ull << 30;
+    // Geometry and textures after decoding, all together. Accessors may be
+    // shared by many meshes, so this is not bounded by the file size alone.
+    uint64_t maxDecodedBytes = 2ull << 30;
+    uint32_t maxImageDimension = 16384;
+    // Deeper JSON is refused before parsing (parsers recurse on nesting).
+    uint32_t maxJsonDepth = 64;
+    // false: skip image decoding; materials keep their factors only.
+    bool loadTextures = true;
+};
+
+// Loads `path` (.gltf or .glb, recognised by content), prepares the scene
+// (prepareScene) and gives it a camera that frames it, or the file's first
+// perspective camera. Throws SceneError.
+Scene loadGltf(const std::filesystem::path& path, const GltfLoadOptions& options = {});
+
+// The extensions loadGltf understands.
+bool isSupportedGltfExtension(std::string_view name);
+
+} // namespace glint::scene

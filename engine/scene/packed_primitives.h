@@ -1,0 +1,41 @@
+#pragma once
+// CPU reference of the compute pass that fills the primitive pool: per
+// triangle the unwrapped (optionally skinned) positions the BLAS is built
+// from, and the packed surface (glint/packing.h) sampled from the material
+// at each vertex. Tests compare the GPU pass against it; tools can use it
+// to fill a pool without a GPU.
+
+#include "scene/bvh_planner.h"
+#include "scene/scene.h"
+
+#include "glint/packing.h"
+
+#include <span>
+#include <vector>
+
+namespace glint::scene {
+
+// The surface at `vertex` of `geometry`: base colour factor x vertex colour
+// x base colour texture (sRGB decoded), roughness and metallic factors x the
+// metallic-roughness texture (G, B), the vertex normal, the material's
+// reflectance. Textures are sampled bilinearly from their base level at the
+// vertex's texture coordinates; normal maps do not apply at vertex rate.
+shader::SurfaceVertex surfaceAtVertex(const Scene& scene, const Geometry& geometry, uint32_t vertex);
+
+struct UnwrappedGeometry {
+    std::vector<glm::vec3> positions;                 // three per triangle, object space
+    std::vector<shader::PackedPrimitive> primitives;  // one per triangle
+};
+
+// Unwraps `geometry`. With `jointMatrices` (the instance's slice of
+// Scene::jointMatrices) a skinned geometry's positions and normals are
+// skinned first (linear blend skinning), as the GPU pass does.
+UnwrappedGeometry unwrapGeometry(const Scene& scene, const Geometry& geometry,
+                                 std::span<const glm::mat4> jointMatrices = {});
+
+// The whole pool of `plan` (poolTriangles entries), every BLAS at its
+// range; deformable BLASes use their instance's current joint matrices.
+// Ranges no BLAS owns stay zero.
+std::vector<shader::PackedPrimitive> buildPrimitivePool(const Scene& scene, const BvhPlan& plan);
+
+} // namespace glint::scene
