@@ -320,6 +320,7 @@ void Context::createDevice(const ContextOptions& options) {
     caps_.apiVersion = props.apiVersion;
     caps_.driverVersion = props.driverVersion;
     caps_.timestampPeriodNs = props.limits.timestampPeriod;
+    caps_.bufferImageGranularity = props.limits.bufferImageGranularity;
 
     VkPhysicalDeviceAccelerationStructureFeaturesKHR asFeatures{
         VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_ACCELERATION_STRUCTURE_FEATURES_KHR};

@@ -1,0 +1,940 @@
+// ---- Barriers ---------------------------------------------------------------
+// One walk over the schedule keeps, per subresource ("cell"), what a later
+// use has to synchronise with:
+//   - the last write (or layout transition): queue, stages, access, the
+//     batch it ran in, and, stage by stage on each queue, the accesses it is
+//     already visible to;
+//   - the reads since that write, per queue.
+// Each use then needs:
+//   read-after-write   the write made visible to its stage and access;
+//   write-after-read   an execution dependency on the reads;
+//   write-after-write  the earlier write made available (when no read came
+//                      between; a read in between already saw it);
+//   a layout change    a transition, itself a write: ordered after every
+//                      earlier use of the cell.
+// Read after read needs nothing unless the layout changes. Same-queue needs
+// become one barrier per (use, subresource range), all of a pass's in one
+// dependency; other-queue needs become a timeline wait at the start of the
+// pass's batch in the pass's own stages, or, when an earlier wait already
+// reaches the producer, a barrier chained to that wait's stages.
+//
+// The frame repeats, so its start is the previous frame's end: transients
+// begin with the last uses of their bytes (their own and their aliases')
+// as prior accesses and discarded contents, history halves with what the
+// other half ended in, imports with their declared initial state. Prior
+// accesses on the other queue are waited for on the previous frame's last
+// batch of that queue. After the last pass, imports move to their final
+// state.
+
+#include <algorithm>
+#include <bit>
+#include <string>
+
+#include <spdlog/spdlog.h>
+
+#include "graph/batches.h"
+#include "graph/compile_state.h"
+#include "graph/error.h"
+
+namespace glint::rg::detail {
+namespace {
+
+constexpr TimelinePoint kPreviousFrame{-1, TimelinePoint::kLastBatch};
+
+bool within(VkFlags64 inner, VkFlags64 outer) { return (inner & ~outer) == 0; }
+
+// Visibility is tracked per stage: the stages uses can name (the access
+// table's, transfers as one) each keep the access bits made visible there,
+// packed into 16 bits (the access bits the table uses; any other bit is
+// the last one, which only a semaphore wait makes visible).
+constexpr VkPipelineStageFlags2 kTrackedStages[] = {
+    VK_PIPELINE_STAGE_2_DRAW_INDIRECT_BIT,
+    VK_PIPELINE_STAGE_2_VERTEX_SHADER_BIT,
+    VK_PIPELINE_STAGE_2_FRAGMENT_SHADER_BIT,
+    VK_PIPELINE_STAGE_2_EARLY_FRAGMENT_TESTS_BIT,
+    VK_PIPELINE_STAGE_2_LATE_FRAGMENT_TESTS_BIT,
+    VK_PIPELINE_STAGE_2_COLOR_ATTACHMENT_OUTPUT_BIT,
+    VK_PIPELINE_STAGE_2_COMPUTE_SHADER_BIT,
+    VK_PIPELINE_STAGE_2_ALL_TRANSFER_BIT,
+    VK_PIPELINE_STAGE_2_ACCELERATION_STRUCTURE_BUILD_BIT_KHR,
+    VK_PIPELINE_STAGE_2_RAY_TRACING_SHADER_BIT_KHR,
+};
+constexpr uint32_t kStageSlots = std::size(kTrackedStages);
+
+constexpr VkAccessFlags2 kPackedAccess[] = {
+    VK_ACCESS_2_INDIRECT_COMMAND_READ_BIT,
+    VK_ACCESS_2_UNIFORM_READ_BIT,
+    VK_ACCESS_2_SHADER_READ_BIT,
+    VK_ACCESS_2_COLOR_ATTACHMENT_READ_BIT,
+    VK_ACCESS_2_COLOR_ATTACHMENT_WRITE_BIT,
+    VK_ACCESS_2_DEPTH_STENCIL_ATTACHMENT_READ_BIT,
+    VK_ACCESS_2_DEPTH_STENCIL_ATTACHMENT_WRITE_BIT,
+    VK_ACCESS_2_TRANSFER_READ_BIT,
+    VK_ACCESS_2_TRANSFER_WRITE_BIT,
+    VK_ACCESS_2_ACCELERATION_STRUCTURE_READ_BIT_KHR,
+    VK_ACCESS_2_ACCELERATION_STRUCTURE_WRITE_BIT_KHR,
+    VK_ACCESS_2_SHADER_SAMPLED_READ_BIT,
+    VK_ACCESS_2_SHADER_STORAGE_READ_BIT,
+    VK_ACCESS_2_SHADER_STORAGE_WRITE_BIT,
+};
+constexpr uint16_t kOtherAccess = 1u << 15;
+constexpr uint16_t kAnyPacked = 0xFFFF;
+
+struct PackTable {
+    uint16_t bit[64] = {};
+    constexpr PackTable() {
+        for (uint32_t b = 0; b < 64; ++b) bit[b] = kOtherAccess;
+        for (uint32_t i = 0; i < std::size(kPackedAccess); ++i)
+            bit[std::countr_zero(kPackedAccess[i])] = uint16_t(1u << i);
+    }
+};
+constexpr PackTable kPack;
+
+uint16_t pack(VkAccessFlags2 a) {
+    uint16_t out = 0;
+    for (VkAccessFlags2 rest = a; rest; rest &= rest - 1) out |= kPack.bit[std::countr_zero(rest)];
+    return out;
+}
+
+// The tracked-stage slots of a stage mask, and whether it has stages
+// outside them.
+struct Slots {
+    uint16_t mask = 0;
+    bool untracked = false;
+};
+
+Slots slotsOf(VkPipelineStageFlags2 s) {
+    Slots out;
+    if (s & VK_PIPELINE_STAGE_2_ALL_COMMANDS_BIT) return {uint16_t((1u << kStageSlots) - 1), true};
+    VkPipelineStageFlags2 rest = s;
+    for (uint32_t i = 0; i < kStageSlots; ++i) {
+        if (!(s & kTrackedStages[i])) continue;
+        out.mask |= uint16_t(1u << i);
+        rest &= ~kTrackedStages[i];
+    }
+    out.untracked = rest != 0;
+    return out;
+}
+
+// One declared use, looked up in the access table once per compile.
+struct UseInfo {
+    SyncScope scope;
+    VkAccessFlags2 reads = 0; // the read bits of scope.access
+    Slots slots;
+    uint16_t packedAccess = 0;
+    uint16_t packedReads = 0;
+};
+
+UseInfo makeUseInfo(const SyncScope& scope) {
+    UseInfo info;
+    info.scope = scope;
+    info.reads = scope.access & ~writeAccessBits(scope.access);
+    info.slots = slotsOf(scope.stages);
+    info.packedAccess = pack(scope.access);
+    info.packedReads = pack(info.reads);
+    return info;
+}
+
+// makeUseInfo() of every single access kind, once per process.
+struct UseInfoTable {
+    UseInfo info[kAccessCount][3][3];
+    UseInfoTable() {
+        for (uint32_t a = 0; a < kAccessCount; ++a)
+            for (uint32_t k = 0; k < 3; ++k)
+                for (uint32_t p = 0; p < 3; ++p)
+                    info[a][k][p] = makeUseInfo(
+                        scopeOf(static_cast<Access>(a), static_cast<ResourceKind>(k), static_cast<Pipeline>(p)));
+    }
+};
+
+const UseInfo& useInfoOf(Access a, ResourceKind k, Pipeline p) {
+    static const UseInfoTable table;
+    return table.info[static_cast<uint32_t>(a)][static_cast<uint32_t>(k)][static_cast<uint32_t>(p)];
+}
+
+struct Visibility {
+    uint16_t access[kQueueCount][kStageSlots] = {};
+
+    bool covers(uint32_t q, Slots s, uint16_t a) const {
+        if (s.untracked) return false;
+        for (uint32_t rest = s.mask; rest; rest &= rest - 1)
+            if ((a & ~access[q][std::countr_zero(rest)]) != 0) return false;
+        return true;
+    }
+    void add(uint32_t q, Slots s, uint16_t a) {
+        for (uint32_t rest = s.mask; rest; rest &= rest - 1) access[q][std::countr_zero(rest)] |= a;
+    }
+
+    // Stages outside the tracked set (raw boundary states) never count as
+    // visible: a barrier too many, never one too few.
+    bool covers(uint32_t q, VkPipelineStageFlags2 s, uint16_t a) const {
+        VkPipelineStageFlags2 untracked = s;
+        for (uint32_t i = 0; i < kStageSlots; ++i) {
+            if (!(s & kTrackedStages[i])) continue;
+            if ((a & ~access[q][i]) != 0) return false;
+            untracked &= ~kTrackedStages[i];
+        }
+        return untracked == 0;
+    }
+    void add(uint32_t q, VkPipelineStageFlags2 s, uint16_t a) {
+        const bool all = (s & VK_PIPELINE_STAGE_2_ALL_COMMANDS_BIT) != 0;
+        for (uint32_t i = 0; i < kStageSlots; ++i)
+            if (all || (s & kTrackedStages[i])) access[q][i] |= a;
+    }
+    void clear() { *this = Visibility{}; }
+};
+
+struct Cell {
+    VkImageLayout layout = VK_IMAGE_LAYOUT_UNDEFINED;
+    bool contents = false;
+    bool aliased = false;  // prior accesses include another resource on these bytes
+    bool wPending = false; // a later write must still be ordered after the write (no read came between)
+    int8_t wQueue = -1;    // -1: no write to synchronise with
+    TimelinePoint wPoint;
+    VkPipelineStageFlags2 wStages = 0;
+    VkAccessFlags2 wAccess = 0;
+    Visibility vis; // what the write is visible to, stage by stage
+    VkPipelineStageFlags2 rStages[kQueueCount] = {0, 0};
+    TimelinePoint rPoint[kQueueCount];
+    // Stages of each queue that the other queue's reads are already ordered
+    // before (a barrier on that queue chained from a wait that reached them).
+    VkPipelineStageFlags2 rOrdered[kQueueCount] = {0, 0};
+
+    bool visible(uint32_t q, VkPipelineStageFlags2 s, VkAccessFlags2 a) const { return vis.covers(q, s, pack(a)); }
+    void addVisible(uint32_t q, VkPipelineStageFlags2 s, VkAccessFlags2 a) { vis.add(q, s, pack(a)); }
+    void addVisibleToAll(uint32_t q, VkPipelineStageFlags2 s) { vis.add(q, s, kAnyPacked); }
+    void clearVisible() { vis.clear(); }
+};
+
+// What one frame leaves in a cell: enough to start the next one. It
+// follows the walk's bookkeeping without placing anything: after a use,
+// the last write is visible to that use whatever synchronised it.
+struct EndState {
+    bool touched = false;
+    VkImageLayout layout = VK_IMAGE_LAYOUT_UNDEFINED;
+    int8_t wQueue = -1;
+    bool wPending = false;
+    VkPipelineStageFlags2 wStages = 0;
+    VkAccessFlags2 wAccess = 0;
+    VkPipelineStageFlags2 rStages[kQueueCount] = {0, 0};
+
+    // `seen` (may be null) follows what the last write is visible to.
+    void apply(uint32_t q, const UseInfo& use, bool writes, bool texture, Visibility* seen) {
+        const SyncScope& s = use.scope;
+        if (texture && (!touched || layout != s.layout) && s.layout != VK_IMAGE_LAYOUT_UNDEFINED) {
+            // Transition: a write of no data at the use's stages.
+            wQueue = static_cast<int8_t>(q);
+            wPending = true;
+            wStages = s.stages;
+            wAccess = 0;
+            rStages[0] = rStages[1] = 0;
+            layout = s.layout;
+            if (seen) {
+                seen->clear();
+                seen->add(q, use.slots, use.packedAccess);
+            }
+        }
+        touched = true;
+        if (writes) {
+            wQueue = static_cast<int8_t>(q);
+            wPending = true;
+            wStages = s.stages;
+            wAccess = writeAccessBits(s.access);
+            rStages[0] = rStages[1] = 0;
+            if (seen) seen->clear();
+        } else {
+            rStages[q] |= s.stages;
+            wPending = false;
+            if (seen) seen->add(q, use.slots, use.packedAccess);
+        }
+    }
+};
+
+// Adds `e` as the previous frame's accesses to `c`.
+void addPrior(Cell& c, const EndState& e) {
+    for (uint32_t q = 0; q < kQueueCount; ++q) {
+        if (!e.rStages[q]) continue;
+        c.rStages[q] |= e.rStages[q];
+        c.rPoint[q] = kPreviousFrame;
+    }
+    if (e.wQueue >= 0 && e.wStages && (c.wQueue < 0 || c.wQueue == e.wQueue)) {
+        c.wQueue = e.wQueue;
+        c.wStages |= e.wStages;
+        c.wAccess |= e.wAccess;
+        c.wPoint = kPreviousFrame;
+        c.wPending = c.wPending || e.wPending;
+    }
+}
+
+// What one use of one cell needs.
+struct Need {
+    uint32_t cell;
+    VkPipelineStageFlags2 srcStages;
+    VkAccessFlags2 srcAccess;
+    VkImageLayout oldLayout;
+    VkPipelineStageFlags2 visibleByWait; // a new or placed wait already makes the write visible here
+    bool transition;
+    bool barrier;
+    bool rawByBarrier;
+    bool aliased;
+};
+
+struct Final {
+    uint32_t resource;
+    uint32_t firstNeed;
+};
+
+// compile() runs every frame: the walk keeps its working memory per thread
+// so a frame's compile reuses last frame's allocations instead of asking
+// the allocator (and the kernel, for fresh pages) again.
+struct Scratch {
+    std::vector<Cell> cells;
+    std::vector<EndState> ends;
+    std::vector<Visibility> endSeen;
+    std::vector<const UseInfo*> useInfo;
+    std::vector<UseInfo> mergedInfo;
+    std::vector<Need> needs;
+    std::vector<uint32_t> useNeed;
+    std::vector<Final> finals;
+    std::vector<uint32_t> deferred;
+    std::vector<uint32_t> imports;
+    std::vector<uint64_t> cuts;
+    std::vector<EndState> tree;
+    std::vector<std::vector<uint32_t>> heapMembers;
+};
+
+Scratch& scratch() {
+    thread_local Scratch s;
+    return s;
+}
+
+class Walk {
+public:
+    explicit Walk(CompileState& st) : st_(st), d_(st.decl), batches_(st), scratch_(scratch()) {}
+
+    void run() {
+        st_.plan.barriers.reserve(d_.uses.size() + d_.resources.size());
+        initialiseCells();
+        st_.barrierFirst.assign(st_.order.size(), 0);
+        st_.barrierCount.assign(st_.order.size(), 0);
+        needs_.reserve(64);
+        for (uint32_t pos = 0; pos < st_.order.size(); ++pos) walkPass(pos);
+        finalStates();
+        batches_.finish();
+    }
+
+private:
+    // ---- Frame start ----------------------------------------------------------
+
+    void initialiseCells() {
+        const uint32_t cellCount = d_.cellCount;
+        cells_.assign(cellCount, Cell{});
+        ends_.assign(cellCount, EndState{});
+        const bool history = std::any_of(d_.resources.begin(), d_.resources.end(),
+                                         [](const ir::Resource& r) { return r.partner != kNoIndex; });
+        endSeen_.assign(history ? cellCount : 0, Visibility{});
+        useInfo_.resize(d_.uses.size());
+        // Merged read kinds get their own entry; the reserve keeps pointers
+        // into it valid.
+        mergedInfo_.clear();
+        mergedInfo_.reserve(d_.uses.size());
+
+        // What the frame leaves behind, use by use. Imports restart from their
+        // declared state, so only transients and history halves need it; a
+        // `previous` half starts from what its partner ended in, so it goes
+        // second.
+        std::vector<uint32_t>& deferred = scratch_.deferred;
+        deferred.clear();
+        for (uint32_t pos = 0; pos < st_.order.size(); ++pos) {
+            const uint32_t p = st_.order[pos];
+            const ir::Pass& pass = d_.passes[p];
+            const uint32_t q = queueIndex(st_.queueOf[p]);
+            for (uint32_t u = pass.firstUse; u < pass.firstUse + pass.useCount; ++u) {
+                const ir::Use& use = d_.uses[u];
+                const ir::Resource& r = d_.resources[use.resource];
+                if ((use.kinds & (use.kinds - 1)) == 0) {
+                    useInfo_[u] = &useInfoOf(static_cast<Access>(std::countr_zero(use.kinds)), r.kind, pass.pipeline);
+                } else {
+                    mergedInfo_.push_back(makeUseInfo(accessScope(use.kinds, r.kind, pass.pipeline)));
+                    useInfo_[u] = &mergedInfo_.back();
+                }
+                if (r.origin == ir::Origin::Imported) continue;
+                if (r.origin == ir::Origin::HistoryPrevious) {
+                    deferred.push_back(u);
+                    deferred.push_back(pos);
+                    continue;
+                }
+                applyEnd(u, q);
+            }
+        }
+        for (uint32_t r = 0; r < d_.resources.size(); ++r)
+            if (d_.resources[r].origin == ir::Origin::HistoryCurrent) seedHistoryPrevious(r);
+        for (size_t i = 0; i < deferred.size(); i += 2)
+            applyEnd(deferred[i], queueIndex(st_.queueOf[st_.order[deferred[i + 1]]]));
+
+        imports_.clear();
+        for (uint32_t r = 0; r < d_.resources.size(); ++r) {
+            switch (d_.resources[r].origin) {
+                case ir::Origin::Imported:
+                    imports_.push_back(r);
+                    startImport(r);
+                    break;
+                case ir::Origin::HistoryPrevious:
+                case ir::Origin::HistoryCurrent:
+                    startHistory(r);
+                    break;
+                case ir::Origin::Transient:
+                    // Its own bytes: last used by itself in the previous frame.
+                    // Shared bytes: see startAliased.
+                    if (st_.lifetimes[r].used() && !st_.aliased[r]) {
+                        const ir::Resource& res = d_.resources[r];
+                        for (uint32_t c = res.cellBase; c < res.cellBase + res.cellCount; ++c)
+                            addPrior(cells_[c], ends_[c]);
+                    }
+                    break;
+            }
+        }
+        startAliased();
+    }
+
+    void applyEnd(uint32_t u, uint32_t q) {
+        const ir::Use& use = d_.uses[u];
+        const ir::Resource& r = d_.resources[use.resource];
+        const UseInfo& info = *useInfo_[u];
+        const bool texture = r.kind == ResourceKind::Texture;
+        // Visibility carries over only for history images (imports restart
+        // from their declared state, transients from discarded contents).
+        const bool history = r.partner != kNoIndex;
+        forCells(r, use.range,
+                 [&](uint32_t c) { ends_[c].apply(q, info, use.writes, texture, history ? &endSeen_[c] : nullptr); });
+    }
+
+    // `previous` this frame is what `current` was at the end of the last one.
+    void seedHistoryPrevious(uint32_t current) {
+        const ir::Resource& cur = d_.resources[current];
+        const ir::Resource& prev = d_.resources[cur.partner];
+        for (uint32_t i = 0; i < cur.cellCount; ++i) {
+            const EndState& from = ends_[cur.cellBase + i];
+            if (!from.touched) continue;
+            ends_[prev.cellBase + i] = from;
+            endSeen_[prev.cellBase + i] = endSeen_[cur.cellBase + i];
+        }
+    }
+
+    void startImport(uint32_t r) {
+        const ir::Resource& res = d_.resources[r];
+        if (!res.hasInitial) return;
+        const SyncScope s = boundaryScope(res.initial, res.kind);
+        const uint32_t q = queueIndex(st_.boundaryQueue(res.initial.queue));
+        for (uint32_t c = res.cellBase; c < res.cellBase + res.cellCount; ++c) {
+            Cell& cell = cells_[c];
+            cell.layout = s.layout;
+            cell.contents = res.contentsAtStart;
+            if (!s.stages) continue; // nothing in flight: ordered outside the plan
+            cell.wQueue = static_cast<int8_t>(q);
+            cell.wStages = s.stages;
+            cell.wPoint = kPreviousFrame;
+            if (hasWriteAccess(s.access)) {
+                cell.wAccess = writeAccessBits(s.access);
+                cell.wPending = true;
+            } else {
+                // A read state: whatever wrote the contents is visible to that
+                // read, and only to it; other readers chain from its stages.
+                cell.rStages[q] = s.stages;
+                cell.rPoint[q] = kPreviousFrame;
+                if (cell.contents)
+                    cell.addVisible(q, s.stages, s.access);
+                else
+                    cell.wQueue = -1;
+            }
+        }
+    }
+
+    // A history half's image was its partner's last frame. `current` starts
+    // where `previous` ended (ends_ of `previous` already includes the
+    // partner's end it started from); `previous` starts where `current` ended,
+    // or, for a subresource `current` never touched, where it left it itself
+    // two frames ago.
+    void startHistory(uint32_t r) {
+        const ir::Resource& res = d_.resources[r];
+        const ir::Resource& partner = d_.resources[res.partner];
+        VkImageLayout entry = VK_IMAGE_LAYOUT_UNDEFINED;
+        bool first = true;
+        for (uint32_t i = 0; i < res.cellCount; ++i) {
+            const EndState& partnerEnd = ends_[partner.cellBase + i];
+            const bool fromPartner = res.origin == ir::Origin::HistoryCurrent || partnerEnd.touched;
+            const uint32_t fromCell = fromPartner ? partner.cellBase + i : res.cellBase + i;
+            const EndState& from = ends_[fromCell];
+            Cell& cell = cells_[res.cellBase + i];
+            cell.contents = true;
+            if (!from.touched) continue;
+            cell.layout = from.layout;
+            addPrior(cell, from);
+            // The image keeps what last frame made visible; re-establishing it
+            // would be a barrier that orders nothing.
+            cell.vis = endSeen_[fromCell];
+            if (res.kind != ResourceKind::Texture) continue;
+            if (first) entry = from.layout;
+            first = false;
+            if (from.layout != entry)
+                throw GraphError(ErrorKind::ConflictingAccess, lastUserName(res.partner), res.name,
+                                 "a history texture must end the frame with every subresource in one layout (the "
+                                 "executor prepares both images in one layout before the first frame)");
+        }
+        st_.plan.resources[r].entryLayout = entry;
+    }
+
+    const std::string& lastUserName(uint32_t r) const {
+        static const std::string kNone = "(none)";
+        const Lifetime& life = st_.lifetimes[r];
+        return life.used() ? d_.passes[st_.order[life.last]].name : kNone;
+    }
+
+    // A transient sharing bytes starts after the last uses of every resource
+    // on any of its bytes, itself included (one queue per heap, so stages
+    // are all that matter). Per heap: cut the bytes at every placement
+    // boundary, OR each resource's last uses into the pieces it covers, then
+    // OR back over each resource's pieces -- two segment trees, O(n log n)
+    // however many placements overlap.
+    void startAliased() {
+        std::vector<std::vector<uint32_t>>& members = scratch_.heapMembers;
+        members.resize(st_.plan.heaps.size());
+        for (auto& list : members) list.clear();
+        for (uint32_t r = 0; r < d_.resources.size(); ++r)
+            if (st_.aliased[r]) members[st_.plan.resources[r].heap].push_back(r);
+        std::vector<uint64_t>& cuts = scratch_.cuts;
+        std::vector<EndState>& tree = scratch_.tree;
+        for (const std::vector<uint32_t>& list : members) {
+            if (list.empty()) continue;
+            cuts.clear();
+            for (uint32_t r : list) {
+                cuts.push_back(st_.plan.resources[r].offset);
+                cuts.push_back(st_.plan.resources[r].offset + st_.plan.resources[r].size);
+            }
+            std::sort(cuts.begin(), cuts.end());
+            cuts.erase(std::unique(cuts.begin(), cuts.end()), cuts.end());
+            const size_t pieces = cuts.size() - 1;
+            size_t width = 1;
+            while (width < pieces) width *= 2;
+            auto pieceRange = [&](uint32_t r) {
+                const uint64_t begin = st_.plan.resources[r].offset, end = begin + st_.plan.resources[r].size;
+                return std::pair{static_cast<size_t>(std::lower_bound(cuts.begin(), cuts.end(), begin) - cuts.begin()),
+                                 static_cast<size_t>(std::lower_bound(cuts.begin(), cuts.end(), end) - cuts.begin())};
+            };
+            // Range-OR updates, pushed down to the pieces.
+            tree.assign(2 * width, EndState{});
+            for (uint32_t r : list) {
+                const EndState last = summary(r);
+                auto [lo, hi] = pieceRange(r);
+                for (size_t l = lo + width, h = hi + width; l < h; l /= 2, h /= 2) {
+                    if (l & 1) merge(tree[l++], last);
+                    if (h & 1) merge(tree[--h], last);
+                }
+            }
+            for (size_t n = 1; n < width; ++n) {
+                merge(tree[2 * n], tree[n]);
+                merge(tree[2 * n + 1], tree[n]);
+            }
+            // Range-OR queries over the pieces.
+            for (size_t n = width - 1; n >= 1; --n) {
+                tree[n] = tree[2 * n];
+                merge(tree[n], tree[2 * n + 1]);
+            }
+            for (uint32_t r : list) {
+                EndState priors;
+                auto [lo, hi] = pieceRange(r);
+                for (size_t l = lo + width, h = hi + width; l < h; l /= 2, h /= 2) {
+                    if (l & 1) merge(priors, tree[l++]);
+                    if (h & 1) merge(priors, tree[--h]);
+                }
+                const ir::Resource& res = d_.resources[r];
+                for (uint32_t c = res.cellBase; c < res.cellBase + res.cellCount; ++c) {
+                    addPrior(cells_[c], priors);
+                    cells_[c].aliased = true;
+                }
+            }
+        }
+    }
+
+    // The last uses of any subresource of `r`.
+    EndState summary(uint32_t r) const {
+        const ir::Resource& res = d_.resources[r];
+        EndState out;
+        for (uint32_t c = res.cellBase; c < res.cellBase + res.cellCount; ++c) {
+            const EndState& e = ends_[c];
+            if (!e.touched) continue;
+            out.touched = true;
+            for (uint32_t q = 0; q < kQueueCount; ++q) out.rStages[q] |= e.rStages[q];
+            if (e.wPending && e.wQueue >= 0) {
+                out.wQueue = e.wQueue;
+                out.wPending = true;
+                out.wStages |= e.wStages;
+                out.wAccess |= e.wAccess;
+            }
+        }
+        return out;
+    }
+
+    static void merge(EndState& into, const EndState& from) {
+        if (!from.touched) return;
+        into.touched = true;
+        for (uint32_t q = 0; q < kQueueCount; ++q) into.rStages[q] |= from.rStages[q];
+        if (from.wPending) {
+            into.wQueue = from.wQueue;
+            into.wPending = true;
+            into.wStages |= from.wStages;
+            into.wAccess |= from.wAccess;
+        }
+    }
+
+    template <class F>
+    static void forCells(const ir::Resource& r, const Subresource& range, F&& f) {
+        if (r.kind != ResourceKind::Texture) {
+            f(r.cellBase);
+            return;
+        }
+        for (uint32_t m = range.baseMip; m < range.baseMip + range.mipCount; ++m)
+            for (uint32_t l = range.baseLayer; l < range.baseLayer + range.layerCount; ++l) f(ir::cellOf(r, m, l));
+    }
+
+    // ---- Hazards --------------------------------------------------------------
+
+    // A dependency on a prior access on the other queue: reuse a placed wait
+    // that reaches it, else request one (merged per signalling queue) in the
+    // use's own stages. Returns the wait stages the use can chain from.
+    // The pass's own new wait, once it has one, serves every need it reaches
+    // in the pass's stages; an older wait in other stages serves by a chained
+    // barrier only when no new wait is placed (walkPass re-analyses a pass
+    // that creates one, so the order of its uses does not matter).
+    VkPipelineStageFlags2 crossQueue(uint32_t q, uint32_t from, TimelinePoint point, VkPipelineStageFlags2 stages) {
+        const VkPipelineStageFlags2 wanted = stages ? stages : VK_PIPELINE_STAGE_2_ALL_COMMANDS_BIT;
+        const VkPipelineStageFlags2 placed =
+            batches_.reachingStages(static_cast<Queue>(q), static_cast<Queue>(from), point);
+        if (placed && within(wanted, placed)) return placed;
+        WaitRequest& req = pending_[from];
+        if (req.active && reaches(req.point, point)) {
+            req.stages |= wanted;
+            return req.stages;
+        }
+        if (placed) return placed;
+        if (!req.active) {
+            req = {true, point, wanted};
+        } else {
+            req.point = point;
+            req.stages |= wanted;
+        }
+        return req.stages;
+    }
+
+    void analyse(Need& n, uint32_t c, uint32_t q, const UseInfo& use, bool writes, bool texture) {
+        const Cell& cell = cells_[c];
+        const SyncScope& s = use.scope;
+        n = Need{};
+        n.cell = c;
+        n.transition = texture && cell.layout != s.layout;
+        n.oldLayout = n.transition && !cell.contents ? VK_IMAGE_LAYOUT_UNDEFINED : cell.layout;
+        n.aliased = cell.aliased;
+        const bool writeOp = writes || n.transition;
+        const VkPipelineStageFlags2 own = s.stages ? s.stages : VK_PIPELINE_STAGE_2_ALL_COMMANDS_BIT;
+
+        auto viaOtherQueue = [&](uint32_t from, TimelinePoint point, bool makesVisible) {
+            const VkPipelineStageFlags2 waited = crossQueue(q, from, point, s.stages);
+            if (n.transition || !within(own, waited)) {
+                n.srcStages |= waited; // chain through the wait
+                n.rawByBarrier = n.rawByBarrier || makesVisible;
+            } else if (makesVisible) {
+                n.visibleByWait |= waited;
+            }
+        };
+
+        // Read after write.
+        if (use.reads && cell.wQueue >= 0 && cell.wStages && !cell.vis.covers(q, use.slots, use.packedReads)) {
+            if (cell.wQueue == static_cast<int8_t>(q)) {
+                n.srcStages |= cell.wStages;
+                n.srcAccess |= cell.wAccess;
+                n.rawByBarrier = true;
+            } else {
+                viaOtherQueue(static_cast<uint32_t>(cell.wQueue), cell.wPoint, true);
+            }
+        }
+        if (writeOp) {
+            // Write after read.
+            for (uint32_t rq = 0; rq < kQueueCount; ++rq) {
+                if (!cell.rStages[rq]) continue;
+                if (rq == q)
+                    n.srcStages |= cell.rStages[rq];
+                else if (n.transition || !within(own, cell.rOrdered[q]))
+                    viaOtherQueue(rq, cell.rPoint[rq], false);
+            }
+            // Write after write.
+            if (cell.wPending && cell.wQueue >= 0 && cell.wStages &&
+                (n.transition || !cell.vis.covers(q, use.slots, use.packedAccess))) {
+                if (cell.wQueue == static_cast<int8_t>(q)) {
+                    n.srcStages |= cell.wStages;
+                    n.srcAccess |= cell.wAccess;
+                } else {
+                    viaOtherQueue(static_cast<uint32_t>(cell.wQueue), cell.wPoint, false);
+                }
+            }
+        }
+        n.barrier = n.transition || n.srcStages != 0;
+    }
+
+    // The frame's last word on an import: it ends in `s` on queue q, as if a
+    // use of that kind came next. Priors that `s` already describes (same
+    // queue, its stages, its write access) stay as they are: whoever comes
+    // next synchronises with them through `s`. Others are made to happen
+    // before `s`.
+    void analyseFinal(Need& n, uint32_t c, uint32_t q, const SyncScope& s, bool texture) {
+        const Cell& cell = cells_[c];
+        n = Need{};
+        n.cell = c;
+        n.transition = texture && s.layout != VK_IMAGE_LAYOUT_UNDEFINED && cell.layout != s.layout;
+        n.oldLayout = n.transition && !cell.contents ? VK_IMAGE_LAYOUT_UNDEFINED : cell.layout;
+        if (!n.transition && !s.stages) return; // handed over by a semaphore signal: nothing to order
+        const VkAccessFlags2 reads = s.access & ~writeAccessBits(s.access);
+
+        auto order = [&](uint32_t from, TimelinePoint point, VkPipelineStageFlags2 stages, VkAccessFlags2 access,
+                         bool makesVisible) {
+            if (from == q) {
+                n.srcStages |= stages;
+                n.srcAccess |= access;
+                n.rawByBarrier = n.rawByBarrier || makesVisible;
+                return;
+            }
+            const VkPipelineStageFlags2 waited = crossQueue(q, from, point, s.stages);
+            if (n.transition || !within(s.stages ? s.stages : VK_PIPELINE_STAGE_2_ALL_COMMANDS_BIT, waited))
+                n.srcStages |= waited;
+        };
+
+        for (uint32_t rq = 0; rq < kQueueCount; ++rq) {
+            if (!cell.rStages[rq]) continue;
+            if (!n.transition && rq == q && within(cell.rStages[rq], s.stages)) continue;
+            if (!n.transition && rq != q && within(s.stages, cell.rOrdered[q])) continue;
+            order(rq, cell.rPoint[rq], cell.rStages[rq], 0, false);
+        }
+        if (cell.wQueue >= 0 && cell.wStages) {
+            const bool described = cell.wQueue == static_cast<int8_t>(q) && within(cell.wStages, s.stages) &&
+                                   within(cell.wAccess, s.access);
+            const bool unseen = reads && !cell.visible(q, s.stages, reads);
+            if ((n.transition && cell.wPending) || (!described && (cell.wPending || unseen)))
+                order(static_cast<uint32_t>(cell.wQueue), cell.wPoint, cell.wStages, cell.wAccess, unseen);
+        }
+        n.barrier = n.transition || n.srcStages != 0;
+    }
+
+    void update(const Need& n, uint32_t q, const UseInfo& use, bool writes, TimelinePoint now) {
+        Cell& cell = cells_[n.cell];
+        const SyncScope& s = use.scope;
+        // A barrier chained from a wait orders every read of the other queue
+        // that wait reached, not only the hazard it was placed for.
+        const uint32_t other = queueIndex(otherQueue(static_cast<Queue>(q)));
+        if (n.barrier && cell.rStages[other] &&
+            (batches_.reachingStages(static_cast<Queue>(q), static_cast<Queue>(other), cell.rPoint[other]) &
+             n.srcStages))
+            cell.rOrdered[q] |= s.stages;
+        if (n.transition) {
+            cell.layout = s.layout;
+            cell.wQueue = static_cast<int8_t>(q);
+            cell.wPoint = now;
+            cell.wStages = s.stages;
+            cell.wAccess = 0;
+            cell.wPending = true;
+            cell.rStages[0] = cell.rStages[1] = 0;
+            cell.rOrdered[0] = cell.rOrdered[1] = 0;
+            cell.clearVisible();
+            cell.vis.add(q, use.slots, use.packedAccess);
+            cell.aliased = false;
+        } else if (n.rawByBarrier) {
+            cell.vis.add(q, use.slots, use.packedReads);
+        }
+        if (n.visibleByWait) cell.addVisibleToAll(q, n.visibleByWait);
+        if (writes) {
+            cell.wQueue = static_cast<int8_t>(q);
+            cell.wPoint = now;
+            cell.wStages = s.stages;
+            cell.wAccess = writeAccessBits(s.access);
+            cell.wPending = true;
+            cell.rStages[0] = cell.rStages[1] = 0;
+            cell.rOrdered[0] = cell.rOrdered[1] = 0;
+            cell.clearVisible();
+            cell.contents = true;
+            cell.aliased = false;
+        } else {
+            cell.rStages[q] |= s.stages;
+            cell.rPoint[q] = now;
+            cell.rOrdered[other] = 0; // the new read is not ordered on the other queue yet
+            cell.wPending = false;
+        }
+    }
+
+    // ---- Emission -------------------------------------------------------------
+
+    // Turns needs_[first, last) -- one use's cells in mip-major order -- into
+    // barriers: runs of layers per mip, merged across mips when runs line up.
+    void emit(uint32_t resource, const Subresource& range, const SyncScope& s, size_t first, size_t last) {
+        const ir::Resource& r = d_.resources[resource];
+        const bool texture = r.kind == ResourceKind::Texture;
+        std::vector<Barrier>& out = st_.plan.barriers;
+        const size_t firstBarrier = out.size();
+        const uint32_t layers = texture ? range.layerCount : 1;
+        size_t i = first;
+        while (i < last) {
+            const Need& n = needs_[i];
+            if (!n.barrier) {
+                ++i;
+                continue;
+            }
+            const auto offset = static_cast<uint32_t>(i - first);
+            const uint32_t mip = texture ? range.baseMip + offset / layers : 0;
+            const uint32_t layer = texture ? range.baseLayer + offset % layers : 0;
+            VkPipelineStageFlags2 srcStages = n.srcStages;
+            VkAccessFlags2 srcAccess = n.srcAccess;
+            bool aliasing = n.aliased;
+            uint32_t layerCount = 1;
+            size_t j = i + 1;
+            while (j < last && (j - first) / layers == offset / layers && needs_[j].barrier &&
+                   needs_[j].oldLayout == n.oldLayout) {
+                srcStages |= needs_[j].srcStages;
+                srcAccess |= needs_[j].srcAccess;
+                aliasing = aliasing || needs_[j].aliased;
+                ++layerCount;
+                ++j;
+            }
+            const VkImageLayout oldLayout = texture ? n.oldLayout : VK_IMAGE_LAYOUT_UNDEFINED;
+            // Barriers are built in place: assembling one on the stack and
+            // copying it costs store-forwarding stalls on this hot path.
+            if (out.size() > firstBarrier) {
+                Barrier& prev = out.back();
+                if (prev.oldLayout == oldLayout && prev.range.baseLayer == layer &&
+                    prev.range.layerCount == layerCount && prev.range.baseMip + prev.range.mipCount == mip) {
+                    ++prev.range.mipCount;
+                    prev.srcStages |= srcStages;
+                    prev.srcAccess |= srcAccess;
+                    prev.aliasing = prev.aliasing || aliasing;
+                    i = j;
+                    continue;
+                }
+            }
+            Barrier& b = out.emplace_back();
+            b.resource = resource;
+            b.range = {mip, 1, layer, layerCount};
+            b.aspect = texture ? st_.plan.resources[resource].aspect : 0;
+            b.srcStages = srcStages;
+            b.srcAccess = srcAccess;
+            b.dstStages = s.stages;
+            b.dstAccess = s.access;
+            b.oldLayout = oldLayout;
+            b.newLayout = texture ? s.layout : VK_IMAGE_LAYOUT_UNDEFINED;
+            b.aliasing = aliasing;
+            i = j;
+        }
+        if (st_.log)
+            for (size_t k = firstBarrier; k < out.size(); ++k)
+                spdlog::debug("rg barriers: {}", describeBarrier(r.name, out[k], r.kind));
+    }
+
+    void walkPass(uint32_t pos) {
+        const uint32_t p = st_.order[pos];
+        const ir::Pass& pass = d_.passes[p];
+        const uint32_t q = queueIndex(st_.queueOf[p]);
+        pending_[0] = pending_[1] = WaitRequest{};
+        auto analysePass = [&] {
+            needs_.clear();
+            useNeed_.clear();
+            for (uint32_t u = pass.firstUse; u < pass.firstUse + pass.useCount; ++u) {
+                const ir::Use& use = d_.uses[u];
+                const ir::Resource& r = d_.resources[use.resource];
+                const UseInfo& info = *useInfo_[u];
+                const bool texture = r.kind == ResourceKind::Texture;
+                useNeed_.push_back(static_cast<uint32_t>(needs_.size()));
+                forCells(r, use.range,
+                         [&](uint32_t c) { analyse(needs_.emplace_back(), c, q, info, use.writes, texture); });
+            }
+        };
+        analysePass();
+        if (pending_[0].active || pending_[1].active) analysePass();
+        const uint32_t ordinal = batches_.placePass(static_cast<Queue>(q), pos, pending_);
+        const TimelinePoint now{0, ordinal};
+
+        st_.barrierFirst[pos] = static_cast<uint32_t>(st_.plan.barriers.size());
+        for (uint32_t i = 0; i < pass.useCount; ++i) {
+            const ir::Use& use = d_.uses[pass.firstUse + i];
+            const UseInfo& info = *useInfo_[pass.firstUse + i];
+            const SyncScope& s = info.scope;
+            const size_t first = useNeed_[i];
+            const size_t last = i + 1 < pass.useCount ? useNeed_[i + 1] : needs_.size();
+            emit(use.resource, use.range, s, first, last);
+            for (size_t k = first; k < last; ++k) update(needs_[k], q, info, use.writes, now);
+        }
+        st_.barrierCount[pos] = static_cast<uint32_t>(st_.plan.barriers.size()) - st_.barrierFirst[pos];
+    }
+
+    // ---- Frame end --------------------------------------------------------------
+
+    void finalStates() {
+        for (uint32_t qi = 0; qi < kQueueCount; ++qi) {
+            const auto q = static_cast<Queue>(qi);
+            pending_[0] = pending_[1] = WaitRequest{};
+            auto analyseFinals = [&] {
+                finals_.clear();
+                needs_.clear();
+                for (uint32_t r : imports_) {
+                    const ir::Resource& res = d_.resources[r];
+                    if (!res.hasFinal) continue;
+                    if (!res.final.isRaw && res.final.access == Access::None) continue; // the caller does not care
+                    if (!st_.lifetimes[r].used() && res.hasInitial && res.initial == res.final) continue;
+                    if (st_.boundaryQueue(res.final.queue) != q) continue;
+                    const SyncScope s = boundaryScope(res.final, res.kind);
+                    const bool texture = res.kind == ResourceKind::Texture;
+                    const auto first = static_cast<uint32_t>(needs_.size());
+                    forCells(res, wholeOf(res),
+                             [&](uint32_t c) { analyseFinal(needs_.emplace_back(), c, qi, s, texture); });
+                    if (std::any_of(needs_.begin() + first, needs_.end(), [](const Need& n) { return n.barrier; }))
+                        finals_.push_back({r, first});
+                    else
+                        needs_.resize(first);
+                }
+            };
+            analyseFinals();
+            if (pending_[0].active || pending_[1].active) analyseFinals();
+            // A final state can need only a wait: the import must be visible on
+            // its final queue after the other queue's last use.
+            if (finals_.empty() && !pending_[0].active && !pending_[1].active) continue;
+            batches_.placeEnd(q, pending_);
+            const auto firstBarrier = static_cast<uint32_t>(st_.plan.barriers.size());
+            for (size_t i = 0; i < finals_.size(); ++i) {
+                const ir::Resource& res = d_.resources[finals_[i].resource];
+                const size_t end = i + 1 < finals_.size() ? finals_[i + 1].firstNeed : needs_.size();
+                emit(finals_[i].resource, wholeOf(res), boundaryScope(res.final, res.kind), finals_[i].firstNeed, end);
+            }
+            batches_.setEndBarriers(q, firstBarrier, static_cast<uint32_t>(st_.plan.barriers.size()) - firstBarrier);
+        }
+    }
+
+    static Subresource wholeOf(const ir::Resource& r) {
+        return r.kind == ResourceKind::Texture ? Subresource{0, r.texture.mips, 0, r.texture.layers}
+                                               : Subresource{0, 1, 0, 1};
+    }
+
+    CompileState& st_;
+    const ir::Declaration& d_;
+    BatchBuilder batches_;
+    Scratch& scratch_;
+    std::vector<Cell>& cells_ = scratch_.cells;
+    std::vector<EndState>& ends_ = scratch_.ends;
+    std::vector<Visibility>& endSeen_ = scratch_.endSeen;     // history cells: visibility at the frame's end
+    std::vector<const UseInfo*>& useInfo_ = scratch_.useInfo; // per declared use, from the access table
+    std::vector<UseInfo>& mergedInfo_ = scratch_.mergedInfo;
+    std::vector<Need>& needs_ = scratch_.needs;
+    std::vector<uint32_t>& useNeed_ = scratch_.useNeed;
+    std::vector<Final>& finals_ = scratch_.finals;
+    std::vector<uint32_t>& imports_ = scratch_.imports;
+    WaitRequest pending_[kQueueCount];
+};
+
+} // namespace
+
+void placeBarriersAndBatches(CompileState& st) { Walk(st).run(); }
+
+} // namespace glint::rg::detail

@@ -1,0 +1,572 @@
+#include "graph/executor.h"
+
+#include "gpu/error.h"
+
+#include <spdlog/spdlog.h>
+
+#include <algorithm>
+#include <tuple>
+
+namespace glint::rg {
+
+namespace {
+
+gpu::ImageDesc imageDescOf(const TextureDesc& t, VkImageUsageFlags usage, std::string name, bool shared) {
+    gpu::ImageDesc d;
+    d.width = t.width;
+    d.height = t.height;
+    d.depth = t.depth;
+    d.mips = t.mips;
+    d.layers = t.layers;
+    d.format = t.format;
+    d.usage = usage;
+    d.name = std::move(name);
+    d.sharedAcrossQueues = shared;
+    return d;
+}
+
+gpu::BufferDesc bufferDescOf(const BufferDesc& b, VkBufferUsageFlags usage, std::string name, bool shared) {
+    gpu::BufferDesc d;
+    d.size = b.size;
+    d.usage = usage;
+    d.memory = gpu::MemoryUsage::DeviceLocal;
+    d.name = std::move(name);
+    d.sharedAcrossQueues = shared;
+    return d;
+}
+
+// The name of a history pair: its halves are "<name>.previous" and "<name>.current".
+std::string historyName(const std::string& halfName) { return halfName.substr(0, halfName.rfind('.')); }
+
+} // namespace
+
+QueueCaps queueCapsOf(const gpu::Capabilities& caps) {
+    QueueCaps q;
+    q.separateComputeFamily = caps.computeFamily.has_value();
+    q.graphicsFamily = caps.graphicsFamily;
+    q.computeFamily = caps.computeFamily.value_or(caps.graphicsFamily);
+    q.rayQuery = caps.rayQuery;
+    q.rayTracingPipeline = caps.rayTracingPipeline;
+    q.bufferImageGranularity = caps.bufferImageGranularity;
+    return q;
+}
+
+// ---------------------------------------------------------------- FrameResources
+
+void FrameResources::bind(Texture handle, const gpu::Image& image) { images_[handle.index] = &image; }
+void FrameResources::bind(Buffer handle, const gpu::Buffer& buffer) { buffers_[handle.index] = &buffer; }
+void FrameResources::bind(AccelStruct handle, const gpu::AccelerationStructure& accel) {
+    accels_[handle.index] = &accel;
+}
+
+// ---------------------------------------------------------------- internal state
+
+// Transient memory and the resources placed in it. `key` is everything that,
+// if changed, means the placement must be redone.
+struct Executor::Transients {
+    using Key = std::vector<std::tuple<uint32_t, std::string, uint32_t, uint32_t, uint32_t, uint32_t, uint32_t,
+                                       uint32_t, uint64_t, uint64_t, uint32_t, uint64_t, bool>>;
+    Key key;
+    std::vector<gpu::Allocation> heaps;
+    std::vector<std::unique_ptr<gpu::Image>> images;
+    std::vector<std::unique_ptr<gpu::Buffer>> buffers;
+    std::map<uint32_t, Physical> byResource;
+    uint64_t bytes = 0;
+};
+
+struct Executor::History {
+    ResourceKind kind = ResourceKind::Texture;
+    std::unique_ptr<gpu::Image> images[2];
+    std::unique_ptr<gpu::Buffer> buffers[2];
+    uint32_t current = 0;  // which of the two is this frame's `current`
+    bool flippedThisFrame = false;
+};
+
+struct Executor::FrameSlot {
+    gpu::CommandPool pools[kQueueCount];
+    gpu::TimestampQueries timer;
+    uint64_t frame = 0;
+    bool used = false;
+    uint64_t endValue[kQueueCount] = {0, 0};  // timeline values that mark this frame done
+    std::vector<PassTiming> passes;            // names and queues, in query-pair order
+};
+
+// ---------------------------------------------------------------- Executor
+
+Executor::Executor(gpu::Context& gpu, uint32_t framesInFlight)
+    : gpu_(gpu), framesInFlight_(std::max(framesInFlight, 1u)) {
+    timelines_[0] = gpu::TimelineSemaphore(gpu_, "rg.timeline.graphics");
+    timelines_[1] = gpu::TimelineSemaphore(gpu_, "rg.timeline.compute");
+    for (uint32_t i = 0; i < framesInFlight_; ++i) {
+        auto slot = std::make_unique<FrameSlot>();
+        slot->pools[0] = gpu::CommandPool(gpu_, gpu_.graphicsQueue().family, "rg.frame" + std::to_string(i) + ".graphics");
+        slot->pools[1] = gpu::CommandPool(gpu_, gpu_.computeQueue().family, "rg.frame" + std::to_string(i) + ".compute");
+        slots_.push_back(std::move(slot));
+    }
+}
+
+Executor::~Executor() {
+    try {
+        waitIdle();
+    } catch (const std::exception& e) {
+        spdlog::error("render graph: waiting for the GPU at shutdown failed: {}", e.what());
+    }
+}
+
+CompileOptions Executor::compileOptions(bool aliasing) const {
+    CompileOptions o;
+    o.aliasing = aliasing;
+    gpu::Context* gpu = &gpu_;
+    o.memoryRequirements = [gpu](const TransientDescription& d) {
+        const VkMemoryRequirements r =
+            d.kind == ResourceKind::Texture
+                ? gpu::Image::requirements(*gpu, imageDescOf(d.texture, d.imageUsage, std::string(d.name), false))
+                : gpu::Buffer::requirements(*gpu, bufferDescOf(d.buffer, d.bufferUsage, std::string(d.name), false));
+        return MemoryRequirements{r.size, r.alignment, r.memoryTypeBits};
+    };
+    return o;
+}
+
+const gpu::Queue& Executor::queueOf(Queue q) const {
+    return q == Queue::AsyncCompute ? gpu_.computeQueue() : gpu_.graphicsQueue();
+}
+
+void Executor::waitIdle() {
+    for (uint32_t q = 0; q < kQueueCount; ++q) {
+        timelines_[q].wait(lastSignal_[q]);
+    }
+}
+
+void Executor::prepareTransients(const Plan& plan) {
+    const auto& decl = *plan.declaration;
+    Transients::Key key;
+    for (uint32_t i = 0; i < plan.resources.size(); ++i) {
+        const PlannedResource& r = plan.resources[i];
+        if (r.origin != ir::Origin::Transient || !r.used) {
+            continue;
+        }
+        const ir::Resource& d = decl.resources[i];
+        const uint32_t usage = r.kind == ResourceKind::Texture ? r.imageUsage : r.bufferUsage;
+        key.emplace_back(i, d.name, uint32_t(r.kind), d.texture.width, d.texture.height,
+                         d.texture.depth * 65536u + d.texture.layers, d.texture.mips * 65536u + uint32_t(d.texture.format),
+                         usage, d.buffer.size, r.offset, r.heap, r.size, r.crossQueue);
+    }
+    for (const MemoryHeap& h : plan.heaps) {
+        key.emplace_back(kNoIndex, "heap", uint32_t(h.queue), h.images, h.crossQueue, h.memoryTypeBits, 0, 0, h.size,
+                         h.alignment, 0, 0, false);
+    }
+    if (transients_ && transients_->key == key) {
+        return;
+    }
+
+    // The GPU may still use the old resources (frames in flight).
+    waitIdle();
+    auto t = std::make_unique<Transients>();
+    t->key = std::move(key);
+    for (uint32_t h = 0; h < plan.heaps.size(); ++h) {
+        const MemoryHeap& heap = plan.heaps[h];
+        // The plan keeps buffers and images inside a heap apart by
+        // bufferImageGranularity; padding the heap to that granularity keeps
+        // its edges apart from the allocator's neighbours too.
+        const uint64_t granularity = std::max<uint64_t>(gpu_.caps().bufferImageGranularity, 1);
+        const uint64_t alignment = std::max<uint64_t>({heap.alignment, granularity, 1});
+        VkMemoryRequirements req{(heap.size + granularity - 1) / granularity * granularity, alignment,
+                                 heap.memoryTypeBits};
+        t->heaps.push_back(gpu_.memory().allocate(req, gpu::MemoryUsage::DeviceLocal, !heap.images,
+                                                  "rg.heap" + std::to_string(h)));
+        t->bytes += heap.size;
+    }
+    for (uint32_t i = 0; i < plan.resources.size(); ++i) {
+        const PlannedResource& r = plan.resources[i];
+        if (r.origin != ir::Origin::Transient || !r.used) {
+            continue;
+        }
+        const ir::Resource& d = decl.resources[i];
+        if (r.heap >= t->heaps.size()) {
+            throw gpu::GpuError("render graph: transient '" + d.name + "' has no heap in the plan");
+        }
+        gpu::MemoryRange range = t->heaps[r.heap].range();
+        range.offset += r.offset;
+        range.size = r.size;
+        range.mapped = nullptr;
+        Physical p;
+        if (r.kind == ResourceKind::Texture) {
+            t->images.push_back(std::make_unique<gpu::Image>(
+                gpu_, imageDescOf(d.texture, r.imageUsage, d.name, r.crossQueue), range));
+            p.image = t->images.back().get();
+        } else {
+            t->buffers.push_back(std::make_unique<gpu::Buffer>(
+                gpu_, bufferDescOf(d.buffer, r.bufferUsage, d.name, r.crossQueue), range));
+            p.buffer = t->buffers.back().get();
+        }
+        t->byResource[i] = p;
+    }
+    spdlog::info("render graph: transient memory {} KiB in {} heap(s), {} KiB without aliasing",
+                 t->bytes >> 10, plan.heaps.size(), plan.stats.transientBytes >> 10);
+    transients_ = std::move(t);
+    ++stats_.transientRebuilds;
+    stats_.transientBytes = transients_->bytes;
+}
+
+void Executor::prepareHistory(const Plan& plan) {
+    const auto& decl = *plan.declaration;
+    for (auto& [name, h] : history_) {
+        h->flippedThisFrame = false;
+    }
+    // Pairs seen for the first time: create both halves, clear them, and put
+    // each in the layout its role starts frame 0 in.
+    for (uint32_t i = 0; i < plan.resources.size(); ++i) {
+        const PlannedResource& r = plan.resources[i];
+        if (r.origin != ir::Origin::HistoryCurrent || !r.used) {
+            continue;
+        }
+        const ir::Resource& current = decl.resources[i];
+        const std::string name = historyName(current.name);
+        auto it = history_.find(name);
+        if (it != history_.end()) {
+            if (!it->second->flippedThisFrame) {
+                it->second->current ^= 1u;
+                it->second->flippedThisFrame = true;
+            }
+            continue;
+        }
+        auto h = std::make_unique<History>();
+        h->kind = r.kind;
+        h->flippedThisFrame = true;
+        const PlannedResource& prevPlan = plan.resources[r.partner];
+        const bool shared = r.crossQueue || prevPlan.crossQueue;
+        for (uint32_t k = 0; k < 2; ++k) {
+            const std::string halfName = name + "[" + std::to_string(k) + "]";
+            if (r.kind == ResourceKind::Texture) {
+                h->images[k] = std::make_unique<gpu::Image>(
+                    gpu_, imageDescOf(current.texture, r.imageUsage | VK_IMAGE_USAGE_TRANSFER_DST_BIT, halfName, shared));
+            } else {
+                h->buffers[k] = std::make_unique<gpu::Buffer>(
+                    gpu_, bufferDescOf(current.buffer, r.bufferUsage | VK_BUFFER_USAGE_TRANSFER_DST_BIT, halfName, shared));
+            }
+        }
+        gpu::submitAndWait(gpu_, gpu_.graphicsQueue(), "rg.history.init " + name, [&](VkCommandBuffer cmd) {
+            for (uint32_t k = 0; k < 2; ++k) {
+                const VkImageLayout entry = k == h->current ? r.entryLayout : prevPlan.entryLayout;
+                if (r.kind == ResourceKind::Texture) {
+                    const gpu::Image& img = *h->images[k];
+                    gpu::imageBarrier(cmd, img, VK_IMAGE_LAYOUT_UNDEFINED, VK_IMAGE_LAYOUT_TRANSFER_DST_OPTIMAL,
+                                      VK_PIPELINE_STAGE_2_NONE, 0, VK_PIPELINE_STAGE_2_CLEAR_BIT,
+                                      VK_ACCESS_2_TRANSFER_WRITE_BIT);
+                    const VkImageSubresourceRange range = img.fullRange();
+                    if (img.aspect() & VK_IMAGE_ASPECT_COLOR_BIT) {
+                        const VkClearColorValue zero{};
+                        vkCmdClearColorImage(cmd, img.handle(), VK_IMAGE_LAYOUT_TRANSFER_DST_OPTIMAL, &zero, 1, &range);
+                    } else {
+                        const VkClearDepthStencilValue zero{};
+                        vkCmdClearDepthStencilImage(cmd, img.handle(), VK_IMAGE_LAYOUT_TRANSFER_DST_OPTIMAL, &zero, 1,
+                                                    &range);
+                    }
+                    gpu::imageBarrier(cmd, img, VK_IMAGE_LAYOUT_TRANSFER_DST_OPTIMAL,
+                                      entry == VK_IMAGE_LAYOUT_UNDEFINED ? VK_IMAGE_LAYOUT_GENERAL : entry,
+                                      VK_PIPELINE_STAGE_2_CLEAR_BIT, VK_ACCESS_2_TRANSFER_WRITE_BIT,
+                                      VK_PIPELINE_STAGE_2_ALL_COMMANDS_BIT,
+                                      VK_ACCESS_2_MEMORY_READ_BIT | VK_ACCESS_2_MEMORY_WRITE_BIT);
+                } else {
+                    vkCmdFillBuffer(cmd, h->buffers[k]->handle(), 0, VK_WHOLE_SIZE, 0);
+                    gpu::bufferBarrier(cmd, *h->buffers[k], VK_PIPELINE_STAGE_2_CLEAR_BIT,
+                                       VK_ACCESS_2_TRANSFER_WRITE_BIT, VK_PIPELINE_STAGE_2_ALL_COMMANDS_BIT,
+                                       VK_ACCESS_2_MEMORY_READ_BIT | VK_ACCESS_2_MEMORY_WRITE_BIT);
+                }
+            }
+        });
+        spdlog::debug("render graph: history '{}' created", name);
+        history_[name] = std::move(h);
+    }
+}
+
+void Executor::bindResources(const Plan& plan, const FrameResources& imports) {
+    const auto& decl = *plan.declaration;
+    physical_.assign(plan.resources.size(), Physical{});
+    resourceNames_.resize(plan.resources.size());
+    for (uint32_t i = 0; i < plan.resources.size(); ++i) {
+        const PlannedResource& r = plan.resources[i];
+        const ir::Resource& d = decl.resources[i];
+        resourceNames_[i] = d.name;
+        if (!r.used) {
+            continue;
+        }
+        Physical& p = physical_[i];
+        switch (r.origin) {
+        case ir::Origin::Transient: p = transients_->byResource.at(i); break;
+        case ir::Origin::HistoryPrevious:
+        case ir::Origin::HistoryCurrent: {
+            const History& h = *history_.at(historyName(d.name));
+            const uint32_t k = r.origin == ir::Origin::HistoryCurrent ? h.current : 1u - h.current;
+            p.image = h.images[k].get();
+            p.buffer = h.buffers[k].get();
+            break;
+        }
+        case ir::Origin::Imported: {
+            bool bound = false;
+            if (r.kind == ResourceKind::Texture) {
+                const auto it = imports.images_.find(i);
+                bound = it != imports.images_.end();
+                if (bound) p.image = it->second;
+            } else if (r.kind == ResourceKind::Buffer) {
+                const auto it = imports.buffers_.find(i);
+                bound = it != imports.buffers_.end();
+                if (bound) p.buffer = it->second;
+            } else {
+                const auto it = imports.accels_.find(i);
+                bound = it != imports.accels_.end();
+                if (bound) p.accel = it->second;
+            }
+            if (!bound) {
+                throw gpu::GpuError("render graph: imported " + std::string(toString(r.kind)) + " '" + d.name +
+                                    "' has no resource bound for this frame (FrameResources::bind)");
+            }
+            if (r.crossQueue && plan.caps.separateComputeFamily &&
+                ((p.image && !p.image->desc().sharedAcrossQueues) || (p.buffer && !p.buffer->desc().sharedAcrossQueues))) {
+                throw gpu::GpuError("render graph: imported '" + d.name +
+                                    "' is used on both queues but was not created with sharedAcrossQueues");
+            }
+            break;
+        }
+        }
+    }
+}
+
+void Executor::recordBarriers(VkCommandBuffer cmd, const Plan& plan, std::span<const Barrier> barriers) const {
+    if (barriers.empty()) {
+        return;
+    }
+    std::vector<VkImageMemoryBarrier2> images;
+    std::vector<VkBufferMemoryBarrier2> buffers;
+    std::vector<VkMemoryBarrier2> memory;
+    for (const Barrier& b : barriers) {
+        const PlannedResource& r = plan.resources[b.resource];
+        const Physical& p = physical_[b.resource];
+        if (b.aliasing || r.kind == ResourceKind::AccelStruct) {
+            // Accesses through an aliased resource, or to an acceleration
+            // structure (no object barrier exists for those), need a global one.
+            VkMemoryBarrier2 m{VK_STRUCTURE_TYPE_MEMORY_BARRIER_2};
+            m.srcStageMask = b.srcStages;
+            m.srcAccessMask = b.srcAccess;
+            m.dstStageMask = b.dstStages;
+            m.dstAccessMask = b.dstAccess;
+            memory.push_back(m);
+        }
+        if (r.kind == ResourceKind::Texture) {
+            VkImageMemoryBarrier2 i{VK_STRUCTURE_TYPE_IMAGE_MEMORY_BARRIER_2};
+            i.srcStageMask = b.srcStages;
+            i.srcAccessMask = b.srcAccess;
+            i.dstStageMask = b.dstStages;
+            i.dstAccessMask = b.dstAccess;
+            i.oldLayout = b.oldLayout;
+            i.newLayout = b.newLayout;
+            i.srcQueueFamilyIndex = i.dstQueueFamilyIndex = VK_QUEUE_FAMILY_IGNORED;
+            i.image = p.image->handle();
+            i.subresourceRange = {b.aspect, b.range.baseMip, b.range.mipCount, b.range.baseLayer, b.range.layerCount};
+            images.push_back(i);
+        } else if (r.kind == ResourceKind::Buffer) {
+            VkBufferMemoryBarrier2 m{VK_STRUCTURE_TYPE_BUFFER_MEMORY_BARRIER_2};
+            m.srcStageMask = b.srcStages;
+            m.srcAccessMask = b.srcAccess;
+            m.dstStageMask = b.dstStages;
+            m.dstAccessMask = b.dstAccess;
+            m.srcQueueFamilyIndex = m.dstQueueFamilyIndex = VK_QUEUE_FAMILY_IGNORED;
+            m.buffer = p.buffer->handle();
+            m.offset = 0;
+            m.size = VK_WHOLE_SIZE;
+            buffers.push_back(m);
+        }
+    }
+    VkDependencyInfo dep{VK_STRUCTURE_TYPE_DEPENDENCY_INFO};
+    dep.memoryBarrierCount = static_cast<uint32_t>(memory.size());
+    dep.pMemoryBarriers = memory.data();
+    dep.bufferMemoryBarrierCount = static_cast<uint32_t>(buffers.size());
+    dep.pBufferMemoryBarriers = buffers.data();
+    dep.imageMemoryBarrierCount = static_cast<uint32_t>(images.size());
+    dep.pImageMemoryBarriers = images.data();
+    vkCmdPipelineBarrier2(cmd, &dep);
+}
+
+void Executor::run(const Plan& plan, const FrameResources& imports) {
+    if (!plan.declaration) {
+        throw gpu::GpuError("render graph: run() got an empty Plan");
+    }
+    const QueueCaps caps = queueCaps();
+    if (plan.caps.separateComputeFamily != caps.separateComputeFamily) {
+        throw gpu::GpuError(std::string("render graph: the plan was compiled for ") +
+                            (plan.caps.separateComputeFamily ? "two queues" : "one queue") + " but device '" +
+                            gpu_.caps().deviceName + "' has " + (caps.separateComputeFamily ? "two" : "one"));
+    }
+
+    // ---- the slot of this frame: wait for the frame that used it last
+    FrameSlot& slot = *slots_[frame_ % framesInFlight_];
+    if (slot.used) {
+        for (uint32_t q = 0; q < kQueueCount; ++q) {
+            timelines_[q].wait(slot.endValue[q]);
+        }
+    }
+    slot.pools[0].reset();
+    slot.pools[1].reset();
+    if (slot.timer.pairCount() < plan.passes.size()) {
+        slot.timer = gpu::TimestampQueries(gpu_, std::max<uint32_t>(static_cast<uint32_t>(plan.passes.size()), 32));
+    }
+    slot.timer.reset();
+    slot.passes.clear();
+    slot.frame = frame_;
+    slot.used = true;
+
+    prepareTransients(plan);
+    prepareHistory(plan);
+    bindResources(plan, imports);
+
+    // ---- timeline values: this frame's batches count up from where the
+    // previous frame ended on each queue (the plan may change between frames,
+    // so values come from what was actually signalled, not from frame * n).
+    uint64_t base[kQueueCount] = {lastSignal_[0], lastSignal_[1]};
+    uint64_t previousEnd[kQueueCount] = {lastSignal_[0], lastSignal_[1]};
+
+    PassContext ctx(*this, gpu_);
+    ctx.frame_ = frame_;
+    for (const Batch& batch : plan.batches) {
+        const uint32_t qi = static_cast<uint32_t>(batch.queue);
+        VkCommandBuffer cmd = slot.pools[qi].allocate();
+        VkCommandBufferBeginInfo begin{VK_STRUCTURE_TYPE_COMMAND_BUFFER_BEGIN_INFO};
+        begin.flags = VK_COMMAND_BUFFER_USAGE_ONE_TIME_SUBMIT_BIT;
+        gpu::check(vkBeginCommandBuffer(cmd, &begin), "vkBeginCommandBuffer (render graph)");
+        ctx.cmd_ = cmd;
+        ctx.queue_ = batch.queue;
+        for (const PlannedPass& p : plan.passesOf(batch)) {
+            recordBarriers(cmd, plan, plan.barriersBefore(p));
+            ctx.name_ = plan.passName(p);
+            gpu::ScopedLabel label(gpu_, cmd, ctx.name_);
+            const uint32_t pair = p.timestampQuery / 2;
+            slot.timer.begin(cmd, pair);
+            if (const ExecuteFn& execute = plan.execute(p)) {
+                execute(ctx);
+            }
+            slot.timer.end(cmd, pair);
+            if (slot.passes.size() <= pair) {
+                slot.passes.resize(pair + 1);
+            }
+            slot.passes[pair] = {ctx.name_, p.queue, std::nullopt};
+        }
+        recordBarriers(cmd, plan, plan.barriersAfter(batch));
+        gpu::check(vkEndCommandBuffer(cmd), "vkEndCommandBuffer (render graph)");
+
+        std::vector<VkSemaphoreSubmitInfo> waits;
+        for (const SemaphoreWait& w : plan.waitsOf(batch)) {
+            const uint32_t wq = static_cast<uint32_t>(w.queue);
+            uint64_t value = 0;
+            if (w.frameOffset == 0) {
+                value = base[wq] + w.batch + 1;
+            } else {
+                if (frame_ == 0) {
+                    continue;  // no previous frame to wait for
+                }
+                // The previous frame's batch `w.batch`, never past its end
+                // (its plan may have had fewer batches).
+                value = std::min(stats_.frames > 0 ? previousBase_[wq] + w.batch + 1 : 0, previousEnd[wq]);
+            }
+            VkSemaphoreSubmitInfo info{VK_STRUCTURE_TYPE_SEMAPHORE_SUBMIT_INFO};
+            info.semaphore = timelines_[wq].handle();
+            info.value = value;
+            info.stageMask = w.stages;
+            waits.push_back(info);
+        }
+        VkSemaphoreSubmitInfo signal{VK_STRUCTURE_TYPE_SEMAPHORE_SUBMIT_INFO};
+        signal.semaphore = timelines_[qi].handle();
+        signal.value = base[qi] + batch.ordinal + 1;
+        signal.stageMask = VK_PIPELINE_STAGE_2_ALL_COMMANDS_BIT;
+        VkCommandBufferSubmitInfo cmdInfo{VK_STRUCTURE_TYPE_COMMAND_BUFFER_SUBMIT_INFO};
+        cmdInfo.commandBuffer = cmd;
+        VkSubmitInfo2 submit{VK_STRUCTURE_TYPE_SUBMIT_INFO_2};
+        submit.waitSemaphoreInfoCount = static_cast<uint32_t>(waits.size());
+        submit.pWaitSemaphoreInfos = waits.data();
+        submit.commandBufferInfoCount = 1;
+        submit.pCommandBufferInfos = &cmdInfo;
+        submit.signalSemaphoreInfoCount = 1;
+        submit.pSignalSemaphoreInfos = &signal;
+        gpu::check(vkQueueSubmit2(queueOf(batch.queue).queue, 1, &submit, VK_NULL_HANDLE),
+                   "vkQueueSubmit2 (render graph, " + std::string(toString(batch.queue)) + " batch " +
+                       std::to_string(batch.ordinal) + ")");
+        lastSignal_[qi] = std::max(lastSignal_[qi], signal.value);
+    }
+    for (uint32_t q = 0; q < kQueueCount; ++q) {
+        previousBase_[q] = base[q];
+        slot.endValue[q] = lastSignal_[q];
+    }
+    ++frame_;
+    ++stats_.frames;
+}
+
+std::vector<PassTiming> Executor::timings() const {
+    // The newest slot whose frame is complete on every queue.
+    const FrameSlot* best = nullptr;
+    for (const auto& s : slots_) {
+        if (!s->used) continue;
+        bool done = true;
+        for (uint32_t q = 0; q < kQueueCount; ++q) {
+            done = done && timelines_[q].value() >= s->endValue[q];
+        }
+        if (done && (!best || s->frame > best->frame)) {
+            best = s.get();
+        }
+    }
+    if (!best) {
+        return {};
+    }
+    std::vector<PassTiming> out = best->passes;
+    const auto ms = best->timer.readMilliseconds();
+    for (size_t i = 0; i < out.size() && i < ms.size(); ++i) {
+        out[i].milliseconds = ms[i];
+    }
+    return out;
+}
+
+// ---------------------------------------------------------------- PassContext
+
+const Executor::Physical& Executor::physical(uint32_t resource, std::string_view pass) const {
+    if (resource >= physical_.size()) {
+        throw gpu::GpuError("render graph: pass '" + std::string(pass) + "' asked for a resource not in this plan");
+    }
+    return physical_[resource];
+}
+
+const gpu::Image& PassContext::image(Texture handle) const {
+    const auto& p = executor_.physical(handle.index, name_);
+    if (!p.image) {
+        throw gpu::GpuError("render graph: pass '" + name_ + "' asked for texture '" +
+                            executor_.resourceNames_[handle.index] + "', which has no image this frame (culled?)");
+    }
+    return *p.image;
+}
+
+const gpu::Buffer& PassContext::buffer(Buffer handle) const {
+    const auto& p = executor_.physical(handle.index, name_);
+    if (!p.buffer) {
+        throw gpu::GpuError("render graph: pass '" + name_ + "' asked for buffer '" +
+                            executor_.resourceNames_[handle.index] + "', which has no buffer this frame (culled?)");
+    }
+    return *p.buffer;
+}
+
+const gpu::AccelerationStructure& PassContext::accel(AccelStruct handle) const {
+    const auto& p = executor_.physical(handle.index, name_);
+    if (!p.accel) {
+        throw gpu::GpuError("render graph: pass '" + name_ + "' asked for acceleration structure '" +
+                            executor_.resourceNames_[handle.index] + "', which is not bound this frame");
+    }
+    return *p.accel;
+}
+
+void PassContext::dispatch(const gpu::Pipeline& pipeline, uint32_t x, uint32_t y, uint32_t z) const {
+    pipeline.bind(cmd_);
+    vkCmdDispatch(cmd_, x, y, z);
+}
+
+void PassContext::dispatchIndirect(const gpu::Pipeline& pipeline, Buffer args, VkDeviceSize offset) const {
+    pipeline.bind(cmd_);
+    vkCmdDispatchIndirect(cmd_, buffer(args).handle(), offset);
+}
+
+} // namespace glint::rg

@@ -1,0 +1,160 @@
+#pragma once
+
+// Executing Plans on Vulkan: the half of the render graph that makes calls.
+//
+//   rg::Executor executor(gpu);                     // once
+//   each frame:
+//     rg::Graph graph(executor.queueCaps());
+//     ... addPass(...) ...
+//     rg::Plan plan = graph.compile(executor.compileOptions());
+//     rg::FrameResources imports;                 // this frame's imports
+//     imports.bind(swapchainHandle, swapchainImage);
+//     executor.run(plan, imports);
+//   executor.waitIdle(); executor.timings();       // per-pass GPU times
+//
+// What it keeps across frames:
+// - transient memory: one allocation per plan heap, with the transients
+//   placed (aliased) as the plan says. Kept while the transient layout
+//   (descriptions, usage, placement) stays the same; rebuilt, after the GPU
+//   is idle, when it changes.
+// - history pairs, by name: two images (or buffers) that swap roles every
+//   frame.
+// - per frame in flight: command pools, timestamp queries; one timeline
+//   semaphore per queue.
+// Frames in flight: run() blocks only until the frame that last used the
+// same slot (framesInFlight frames ago) has finished on the GPU.
+
+#include "graph/compile.h"
+#include "graph/plan.h"
+#include "graph/types.h"
+
+#include "gpu/accel.h"
+#include "gpu/commands.h"
+#include "gpu/context.h"
+#include "gpu/pipeline.h"
+#include "gpu/resources.h"
+#include "gpu/timestamps.h"
+
+#include <map>
+#include <memory>
+#include <optional>
+#include <string>
+#include <vector>
+
+namespace glint::rg {
+
+// The queue description compile() needs, from the device's capabilities.
+QueueCaps queueCapsOf(const gpu::Capabilities& caps);
+
+// The caller's resources for one frame, bound to the handles that imported them.
+class FrameResources {
+public:
+    void bind(Texture handle, const gpu::Image& image);
+    void bind(Buffer handle, const gpu::Buffer& buffer);
+    void bind(AccelStruct handle, const gpu::AccelerationStructure& accel);
+
+private:
+    friend class Executor;
+    std::map<uint32_t, const gpu::Image*> images_;
+    std::map<uint32_t, const gpu::Buffer*> buffers_;
+    std::map<uint32_t, const gpu::AccelerationStructure*> accels_;
+    uint32_t graph_ = 0;
+};
+
+// What a pass's execute callback records with.
+class PassContext {
+public:
+    VkCommandBuffer cmd() const { return cmd_; }
+    gpu::Context& gpu() const { return gpu_; }
+    const std::string& passName() const { return name_; }
+    uint64_t frame() const { return frame_; }
+    Queue queue() const { return queue_; }
+
+    // The Vulkan objects behind this frame's handles (history handles give
+    // this frame's image of the pair). Errors name the pass and resource.
+    const gpu::Image& image(Texture handle) const;
+    VkImageView view(Texture handle) const { return image(handle).view(); }
+    const gpu::Buffer& buffer(Buffer handle) const;
+    const gpu::AccelerationStructure& accel(AccelStruct handle) const;
+
+    // Binds `pipeline` and dispatches; the bindings must have been pushed.
+    void dispatch(const gpu::Pipeline& pipeline, uint32_t x, uint32_t y = 1, uint32_t z = 1) const;
+    void dispatchIndirect(const gpu::Pipeline& pipeline, Buffer args, VkDeviceSize offset = 0) const;
+
+private:
+    friend class Executor;
+    PassContext(class Executor& executor, gpu::Context& gpu) : executor_(executor), gpu_(gpu) {}
+    class Executor& executor_;
+    gpu::Context& gpu_;
+    VkCommandBuffer cmd_ = VK_NULL_HANDLE;
+    std::string name_;
+    uint64_t frame_ = 0;
+    Queue queue_ = Queue::Graphics;
+};
+
+struct PassTiming {
+    std::string name;
+    Queue queue = Queue::Graphics;
+    std::optional<double> milliseconds;  // none where the queue has no timestamps
+};
+
+struct ExecutorStats {
+    uint64_t frames = 0;
+    uint32_t transientRebuilds = 0;  // times the transient memory was (re)created
+    uint64_t transientBytes = 0;     // bytes of the current transient heaps
+};
+
+class Executor {
+public:
+    explicit Executor(gpu::Context& gpu, uint32_t framesInFlight = 2);
+    ~Executor();
+    Executor(const Executor&) = delete;
+    Executor& operator=(const Executor&) = delete;
+
+    QueueCaps queueCaps() const { return queueCapsOf(gpu_.caps()); }
+    // Compile options whose memory sizes are the driver's.
+    CompileOptions compileOptions(bool aliasing = true) const;
+
+    // Records and submits one frame of `plan`.
+    void run(const Plan& plan, const FrameResources& imports = {});
+    // Waits for every submitted frame.
+    void waitIdle();
+    // Per-pass GPU times of the most recent frame that has completed, in
+    // submission order (after waitIdle(): the last frame run).
+    std::vector<PassTiming> timings() const;
+    const ExecutorStats& stats() const { return stats_; }
+
+private:
+    friend class PassContext;
+    struct Physical {
+        const gpu::Image* image = nullptr;
+        const gpu::Buffer* buffer = nullptr;
+        const gpu::AccelerationStructure* accel = nullptr;
+    };
+    struct Transients;
+    struct History;
+    struct FrameSlot;
+
+    void prepareTransients(const Plan& plan);
+    void prepareHistory(const Plan& plan);
+    void bindResources(const Plan& plan, const FrameResources& imports);
+    void recordBarriers(VkCommandBuffer cmd, const Plan& plan, std::span<const Barrier> barriers) const;
+    const gpu::Queue& queueOf(Queue q) const;
+    const Physical& physical(uint32_t resource, std::string_view pass) const;
+
+    gpu::Context& gpu_;
+    uint32_t framesInFlight_;
+    uint64_t frame_ = 0;
+    gpu::TimelineSemaphore timelines_[kQueueCount];
+    uint64_t lastSignal_[kQueueCount] = {0, 0};
+    uint64_t previousBase_[kQueueCount] = {0, 0};  // timeline value before the previous frame's batches
+    std::vector<std::unique_ptr<FrameSlot>> slots_;
+    std::unique_ptr<Transients> transients_;
+    std::map<std::string, std::unique_ptr<History>> history_;
+    // Per declaration resource of the plan being run.
+    std::vector<Physical> physical_;
+    std::vector<std::string> resourceNames_;
+    ExecutorStats stats_;
+};
+
+}  // namespace glint::rg

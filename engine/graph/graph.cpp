@@ -1,0 +1,454 @@
+#include "graph/graph.h"
+
+#include <algorithm>
+#include <atomic>
+#include <bit>
+#include <string>
+
+#include "graph/compile.h"
+#include "graph/plan.h"
+
+namespace glint::rg {
+namespace {
+
+// Handles carry their graph's id; 0 is never used so a default handle is
+// foreign to every graph.
+std::atomic<uint32_t> gNextGraphId{1};
+
+const std::string kNoPass = "(graph)";
+
+void validateTexture(std::string_view name, const TextureDesc& d) {
+    std::string problem;
+    if (d.width == 0 || d.height == 0 || d.depth == 0 || d.layers == 0 || d.mips == 0)
+        problem = "every extent, the layer count and the mip count must be at least 1";
+    else if (d.depth > 1 && d.layers > 1)
+        problem = "a 3D texture has one layer";
+    else if (d.format == VK_FORMAT_UNDEFINED)
+        problem = "format is VK_FORMAT_UNDEFINED";
+    else if (d.mips > static_cast<uint32_t>(std::bit_width(std::max({d.width, d.height, d.depth}))))
+        problem = "more mips than the extent halves to 1";
+    if (!problem.empty()) throw GraphError(ErrorKind::InvalidDescription, kNoPass, std::string(name), problem);
+}
+
+void validateBuffer(std::string_view name, const BufferDesc& d) {
+    if (d.size == 0) throw GraphError(ErrorKind::InvalidDescription, kNoPass, std::string(name), "buffer size is 0");
+}
+
+bool rangesOverlap(const Subresource& a, const Subresource& b) {
+    return a.baseMip < b.baseMip + b.mipCount && b.baseMip < a.baseMip + a.mipCount &&
+           a.baseLayer < b.baseLayer + b.layerCount && b.baseLayer < a.baseLayer + a.layerCount;
+}
+
+VkImageLayout layoutOf(AccessSet kinds) { return accessScope(kinds, ResourceKind::Texture, Pipeline::Compute).layout; }
+
+} // namespace
+
+// ---- Builder -----------------------------------------------------------------
+
+Texture Builder::createTexture(std::string_view name, const TextureDesc& desc) {
+    return graph_.createTexture(name, desc);
+}
+
+Buffer Builder::createBuffer(std::string_view name, const BufferDesc& desc) { return graph_.createBuffer(name, desc); }
+
+Texture Builder::read(Texture t, Access a, Subresource range) {
+    graph_.use(pass_, ResourceKind::Texture, t.index, t.version, t.graph, a, range, false);
+    return t;
+}
+
+Buffer Builder::read(Buffer b, Access a) {
+    graph_.use(pass_, ResourceKind::Buffer, b.index, b.version, b.graph, a, {}, false);
+    return b;
+}
+
+AccelStruct Builder::read(AccelStruct s, Access a) {
+    graph_.use(pass_, ResourceKind::AccelStruct, s.index, s.version, s.graph, a, {}, false);
+    return s;
+}
+
+Texture Builder::write(Texture t, Access a, Subresource range) {
+    t.version = graph_.use(pass_, ResourceKind::Texture, t.index, t.version, t.graph, a, range, true);
+    return t;
+}
+
+Buffer Builder::write(Buffer b, Access a) {
+    b.version = graph_.use(pass_, ResourceKind::Buffer, b.index, b.version, b.graph, a, {}, true);
+    return b;
+}
+
+AccelStruct Builder::write(AccelStruct s, Access a) {
+    s.version = graph_.use(pass_, ResourceKind::AccelStruct, s.index, s.version, s.graph, a, {}, true);
+    return s;
+}
+
+void Builder::setPipeline(Pipeline pipeline) { graph_.mutableDecl().passes[pass_].pipeline = pipeline; }
+
+void Builder::markSideEffects() { graph_.mutableDecl().passes[pass_].sideEffects = true; }
+
+// ---- Graph -------------------------------------------------------------------
+
+Graph::Graph(const QueueCaps& caps) : caps_(caps), decl_(std::make_shared<ir::Declaration>()) {
+    decl_->graphId = gNextGraphId.fetch_add(1, std::memory_order_relaxed);
+}
+
+Graph::Graph(Graph&&) noexcept = default;
+Graph& Graph::operator=(Graph&&) noexcept = default;
+Graph::~Graph() = default;
+
+uint32_t Graph::id() const { return decl_->graphId; }
+
+void Graph::reserve(uint32_t passes, uint32_t resources, uint32_t uses) {
+    ir::Declaration& d = mutableDecl();
+    d.passes.reserve(passes);
+    d.resources.reserve(resources);
+    d.uses.reserve(uses);
+    d.written.reserve(resources);
+}
+
+ir::Declaration& Graph::mutableDecl() {
+    // A compiled Plan shares the declaration; keep its view frozen.
+    if (decl_.use_count() > 1) decl_ = std::make_shared<ir::Declaration>(*decl_);
+    return *decl_;
+}
+
+// Resources are built in place: moving a Resource into the vector costs
+// more than everything else declaring it does.
+uint32_t Graph::newResource(std::string_view name, ResourceKind kind, ir::Origin origin) {
+    ir::Declaration& d = mutableDecl();
+    const auto index = static_cast<uint32_t>(d.resources.size());
+    ir::Resource& r = d.resources.emplace_back();
+    r.name = name;
+    r.kind = kind;
+    r.origin = origin;
+    return index;
+}
+
+// Gives a resource, once described, its cells.
+void Graph::finishResource(uint32_t index) {
+    ir::Declaration& d = *decl_;
+    ir::Resource& r = d.resources[index];
+    r.cellBase = d.cellCount;
+    r.cellCount = r.kind == ResourceKind::Texture ? r.texture.mips * r.texture.layers : 1u;
+    d.cellCount = r.cellBase + r.cellCount;
+    d.written.resize(d.cellCount, r.contentsAtStart ? 1 : 0);
+}
+
+Texture Graph::createTexture(std::string_view name, const TextureDesc& desc) {
+    validateTexture(name, desc);
+    const uint32_t index = newResource(name, ResourceKind::Texture, ir::Origin::Transient);
+    decl_->resources[index].texture = desc;
+    finishResource(index);
+    return Texture{index, 0, id()};
+}
+
+Buffer Graph::createBuffer(std::string_view name, const BufferDesc& desc) {
+    validateBuffer(name, desc);
+    const uint32_t index = newResource(name, ResourceKind::Buffer, ir::Origin::Transient);
+    decl_->resources[index].buffer = desc;
+    finishResource(index);
+    return Buffer{index, 0, id()};
+}
+
+namespace {
+
+void fillImport(ir::Resource& r, std::string_view name, ResourceKind kind, const std::optional<BoundaryState>& initial,
+                const std::optional<BoundaryState>& final) {
+    r.hasInitial = initial.has_value();
+    r.hasFinal = final.has_value();
+    if (initial) r.initial = *initial;
+    if (final) r.final = *final;
+    for (const BoundaryState* state : {&r.initial, &r.final}) {
+        if (state->isRaw || state->access == Access::None) continue;
+        const bool valid =
+            state->access == Access::Present ? kind == ResourceKind::Texture : accessAllowedOn(state->access, kind);
+        if (!valid)
+            throw GraphError(ErrorKind::InvalidAccess, kNoPass, std::string(name),
+                             "boundary state " + std::string(toString(state->access)) + " is not valid for a " +
+                                 std::string(toString(kind)));
+    }
+    // Contents exist at the start when the initial state names a use that
+    // left data behind (raw states: when they name a layout or any access).
+    if (r.hasInitial) {
+        const SyncScope s = boundaryScope(r.initial, kind);
+        r.contentsAtStart = kind == ResourceKind::Texture
+                                ? s.layout != VK_IMAGE_LAYOUT_UNDEFINED
+                                : (r.initial.isRaw ? (s.stages | s.access) != 0 : r.initial.access != Access::None);
+    }
+}
+
+} // namespace
+
+uint32_t Graph::addImport(std::string_view name, ResourceKind kind, const std::optional<BoundaryState>& initial,
+                          const std::optional<BoundaryState>& final) {
+    const uint32_t index = newResource(name, kind, ir::Origin::Imported);
+    try {
+        fillImport(decl_->resources[index], name, kind, initial, final);
+    } catch (...) {
+        decl_->resources.pop_back();
+        throw;
+    }
+    return index;
+}
+
+Texture Graph::importTexture(std::string_view name, const TextureImport& import) {
+    validateTexture(name, import.desc);
+    const uint32_t index = addImport(name, ResourceKind::Texture, import.initial, import.final);
+    decl_->resources[index].texture = import.desc;
+    finishResource(index);
+    return Texture{index, 0, id()};
+}
+
+Buffer Graph::importBuffer(std::string_view name, const BufferImport& import) {
+    validateBuffer(name, import.desc);
+    const uint32_t index = addImport(name, ResourceKind::Buffer, import.initial, import.final);
+    decl_->resources[index].buffer = import.desc;
+    finishResource(index);
+    return Buffer{index, 0, id()};
+}
+
+AccelStruct Graph::importAccelStruct(std::string_view name, const AccelStructImport& import) {
+    const uint32_t index = addImport(name, ResourceKind::AccelStruct, import.initial, import.final);
+    finishResource(index);
+    return AccelStruct{index, 0, id()};
+}
+
+HistoryTexture Graph::createHistoryTexture(std::string_view name, const TextureDesc& desc) {
+    validateTexture(name, desc);
+    const auto [previous, current] = addHistory(name, ResourceKind::Texture);
+    for (uint32_t r : {previous, current}) {
+        decl_->resources[r].texture = desc;
+        finishResource(r);
+    }
+    return {Texture{previous, 0, id()}, Texture{current, 0, id()}};
+}
+
+HistoryBuffer Graph::createHistoryBuffer(std::string_view name, const BufferDesc& desc) {
+    validateBuffer(name, desc);
+    const auto [previous, current] = addHistory(name, ResourceKind::Buffer);
+    for (uint32_t r : {previous, current}) {
+        decl_->resources[r].buffer = desc;
+        finishResource(r);
+    }
+    return {Buffer{previous, 0, id()}, Buffer{current, 0, id()}};
+}
+
+// Both halves of a pair; the description is filled in by the caller.
+std::pair<uint32_t, uint32_t> Graph::addHistory(std::string_view name, ResourceKind kind) {
+    const uint32_t previous = newResource(std::string(name) + ".previous", kind, ir::Origin::HistoryPrevious);
+    decl_->resources[previous].contentsAtStart = true;
+    const uint32_t current = previous + 1;
+    decl_->resources.emplace_back();
+    ir::Resource& c = decl_->resources[current];
+    c.name = std::string(name) + ".current";
+    c.kind = kind;
+    c.origin = ir::Origin::HistoryCurrent;
+    decl_->resources[previous].partner = current;
+    c.partner = previous;
+    return {previous, current};
+}
+
+const ir::Resource& Graph::checkHandle(ResourceKind kind, uint32_t index, uint32_t graph, std::string_view pass) const {
+    const ir::Declaration& d = *decl_;
+    if (graph != d.graphId || index >= d.resources.size()) {
+        const std::string what = graph == 0 ? "an invalid (default-constructed) handle"
+                                            : "a handle from another graph (graph " + std::to_string(graph) +
+                                                  ", this is graph " + std::to_string(d.graphId) + ")";
+        throw GraphError(ErrorKind::ForeignHandle, std::string(pass), "#" + std::to_string(index), "uses " + what);
+    }
+    const ir::Resource& r = d.resources[index];
+    if (r.kind != kind)
+        throw GraphError(ErrorKind::ForeignHandle, std::string(pass), r.name,
+                         "handle kind does not match the resource (a " + std::string(toString(r.kind)) + ")");
+    return r;
+}
+
+void Graph::markOutput(Texture t) { markOutput(ResourceKind::Texture, t.index, t.version, t.graph); }
+void Graph::markOutput(Buffer b) { markOutput(ResourceKind::Buffer, b.index, b.version, b.graph); }
+void Graph::markOutput(AccelStruct s) { markOutput(ResourceKind::AccelStruct, s.index, s.version, s.graph); }
+
+void Graph::markOutput(ResourceKind kind, uint32_t index, uint32_t version, uint32_t graph) {
+    static const std::string kOutput = "(output)";
+    const ir::Resource& r = checkHandle(kind, index, graph, kOutput);
+    if (version != r.version)
+        throw GraphError(ErrorKind::StaleHandle, kOutput, r.name,
+                         "marks version " + std::to_string(version) + " as output, but version " +
+                             std::to_string(r.version) + " is current");
+    if (version == 0 && !r.contentsAtStart)
+        throw GraphError(ErrorKind::ReadBeforeWrite, kOutput, r.name, "is marked as output but no pass writes it");
+    mutableDecl().outputs.push_back({index, version, r.lastWriter});
+}
+
+void Graph::order(PassId before, PassId after) {
+    const ir::Declaration& d = *decl_;
+    for (const PassId p : {before, after})
+        if (p.graph != d.graphId || p.index >= d.passes.size())
+            throw GraphError(ErrorKind::ForeignHandle, "#" + std::to_string(p.index), "",
+                             "order() got a pass id from another graph");
+    mutableDecl().orderings.push_back({before.index, after.index});
+}
+
+Builder Graph::beginPass(std::string_view name, Queue queue, ExecuteFn execute) {
+    ir::Declaration& d = mutableDecl();
+    ir::Pass& p = d.passes.emplace_back();
+    p.name = name;
+    p.queue = queue;
+    p.firstUse = static_cast<uint32_t>(d.uses.size());
+    p.execute = std::move(execute);
+    passFirstResource_ = static_cast<uint32_t>(d.resources.size());
+    passFirstCell_ = d.cellCount;
+    return Builder(*this, static_cast<uint32_t>(d.passes.size() - 1));
+}
+
+void Graph::abortPass(uint32_t pass) {
+    // Setup (or endPass's checks) threw: forget the pass and what it created,
+    // so the graph stays usable. Versions move only once endPass's checks
+    // pass, so nothing else changed.
+    ir::Declaration& d = mutableDecl();
+    d.uses.resize(d.passes[pass].firstUse);
+    d.passes.pop_back();
+    d.resources.resize(passFirstResource_);
+    d.cellCount = passFirstCell_;
+    d.written.resize(passFirstCell_);
+}
+
+PassId Graph::endPass(uint32_t pass) {
+    ir::Declaration& d = mutableDecl();
+    ir::Pass& p = d.passes[pass];
+    const uint32_t end = p.firstUse + p.useCount;
+    // Pipeline-dependent checks wait until setup has had its chance to call
+    // setPipeline().
+    for (uint32_t u = p.firstUse; u < end; ++u) {
+        const ir::Use& use = d.uses[u];
+        const ir::Resource& r = d.resources[use.resource];
+        for (AccessSet rest = use.kinds; rest; rest &= static_cast<AccessSet>(rest - 1)) {
+            const auto a = static_cast<Access>(std::countr_zero(rest));
+            if (accessNeedsRaster(a) && p.pipeline != Pipeline::Raster)
+                throw GraphError(
+                    ErrorKind::InvalidAccess, p.name, r.name,
+                    std::string(toString(a)) + " needs a raster pipeline; call setPipeline(Pipeline::Raster)");
+        }
+    }
+    if (!queueSupports(p.queue, Access::None, p.pipeline))
+        throw GraphError(ErrorKind::QueueCannotAccess, p.name,
+                         end > p.firstUse ? d.resources[d.uses[p.firstUse].resource].name : "",
+                         "the async compute queue has no raster pipeline");
+    // Commit: every resource this pass wrote moves to its next version.
+    for (uint32_t u = p.firstUse; u < end; ++u) {
+        const ir::Use& use = d.uses[u];
+        if (!use.writes) continue;
+        ir::Resource& r = d.resources[use.resource];
+        r.version = use.version + 1;
+        r.lastWriter = pass;
+        for (uint32_t m = use.range.baseMip; m < use.range.baseMip + use.range.mipCount; ++m)
+            for (uint32_t l = use.range.baseLayer; l < use.range.baseLayer + use.range.layerCount; ++l)
+                d.written[ir::cellOf(r, m, l)] = 1;
+    }
+    return PassId{pass, d.graphId};
+}
+
+uint32_t Graph::use(uint32_t pass, ResourceKind kind, uint32_t index, uint32_t version, uint32_t graph, Access access,
+                    Subresource range, bool write) {
+    ir::Declaration& d = mutableDecl();
+    const std::string& passName = d.passes[pass].name;
+    const ir::Resource& r = checkHandle(kind, index, graph, passName);
+    const ir::Pass& p = d.passes[pass];
+
+    auto fail = [&](ErrorKind k, const std::string& detail) { throw GraphError(k, passName, r.name, detail); };
+
+    if (access >= Access::Count || accessIsBoundaryOnly(access))
+        fail(ErrorKind::InvalidAccess, std::string(toString(access)) + " describes a frame boundary, not a pass's use");
+    if (!accessAllowedOn(access, kind))
+        fail(ErrorKind::InvalidAccess,
+             std::string(toString(access)) + " is not an access a " + std::string(toString(kind)) + " can take");
+    if (accessWrites(access) != write)
+        fail(ErrorKind::InvalidAccess, std::string(toString(access)) +
+                                           (write ? " does not write; declare it with read()"
+                                                  : " writes; declare it with write() and use the handle it returns"));
+    if (!queueSupports(p.queue, access, p.pipeline))
+        fail(ErrorKind::QueueCannotAccess,
+             std::string(toString(access)) + " is not available on the " + std::string(toString(p.queue)) + " queue");
+    if (r.origin == ir::Origin::Imported && (!r.hasInitial || !r.hasFinal))
+        fail(ErrorKind::ImportWithoutState, std::string("was imported without ") +
+                                                (!r.hasInitial ? "an initial" : "a final") +
+                                                " state; the graph cannot synchronise against an unknown state");
+
+    if (version != r.version) {
+        if (version > r.version) fail(ErrorKind::ForeignHandle, "names a version this graph never made");
+        const std::string& writer = r.lastWriter != kNoIndex ? d.passes[r.lastWriter].name : std::string("?");
+        if (write)
+            fail(ErrorKind::UnorderedWriters,
+                 "writes from version " + std::to_string(version) + ", which pass '" + writer +
+                     "' already wrote; nothing orders the two writers (write the handle '" + writer + "' returned)");
+        fail(ErrorKind::StaleHandle, "reads version " + std::to_string(version) + ", but pass '" + writer +
+                                         "' has since written version " + std::to_string(r.version));
+    }
+
+    // Resolve the subresource range.
+    if (kind == ResourceKind::Texture) {
+        const TextureDesc& t = r.texture;
+        if (range.mipCount == Subresource::kAll) range.mipCount = range.baseMip < t.mips ? t.mips - range.baseMip : 0;
+        if (range.layerCount == Subresource::kAll)
+            range.layerCount = range.baseLayer < t.layers ? t.layers - range.baseLayer : 0;
+        if (range.mipCount == 0 || range.layerCount == 0 || range.baseMip + range.mipCount > t.mips ||
+            range.baseLayer + range.layerCount > t.layers)
+            fail(ErrorKind::InvalidSubresource,
+                 "mips [" + std::to_string(range.baseMip) + ", +" + std::to_string(range.mipCount) + ") layers [" +
+                     std::to_string(range.baseLayer) + ", +" + std::to_string(range.layerCount) + ") are outside " +
+                     std::to_string(t.mips) + " mips x " + std::to_string(t.layers) + " layers");
+    } else {
+        if (range != Subresource{}) fail(ErrorKind::InvalidSubresource, "only textures have subresources");
+        range = {0, 1, 0, 1};
+    }
+
+    if (accessNeedsContents(access)) {
+        for (uint32_t m = range.baseMip; m < range.baseMip + range.mipCount; ++m)
+            for (uint32_t l = range.baseLayer; l < range.baseLayer + range.layerCount; ++l)
+                if (!d.written[ir::cellOf(r, m, l)]) {
+                    std::string where = kind == ResourceKind::Texture
+                                            ? " (mip " + std::to_string(m) + ", layer " + std::to_string(l) + ")"
+                                            : std::string();
+                    fail(ErrorKind::ReadBeforeWrite,
+                         std::string(toString(access)) + " needs contents, but nothing wrote it" + where +
+                             (r.origin == ir::Origin::Imported ? "; it was imported with undefined contents" : ""));
+                }
+    }
+
+    // One subresource, one use per pass: reads that share a layout merge
+    // (depth test plus sampling); anything else is ambiguous.
+    const AccessSet bit = accessBit(access);
+    for (uint32_t u = p.firstUse; u < p.firstUse + p.useCount; ++u) {
+        ir::Use& other = d.uses[u];
+        if (other.resource != index || !rangesOverlap(other.range, range)) continue;
+        const bool sameLayout = kind != ResourceKind::Texture || layoutOf(other.kinds) == layoutOf(bit);
+        if (!write && !other.writes && other.range == range && sameLayout) {
+            other.kinds |= bit;
+            return version;
+        }
+        fail(ErrorKind::ConflictingAccess,
+             "is used twice on overlapping subresources (" + std::string(toString(access)) +
+                 " and an earlier use); a pass that reads and writes one subresource declares StorageReadWrite");
+    }
+
+    const uint32_t producer = r.lastWriter;
+    // Built in place: assembling it on the stack and copying it stalls on
+    // store forwarding, and this runs for every use of every pass.
+    ir::Use& use = d.uses.emplace_back();
+    use.resource = index;
+    use.version = version;
+    use.producer = producer;
+    use.kinds = bit;
+    use.writes = write;
+    use.range = range;
+    ++d.passes[pass].useCount;
+    return write ? version + 1 : version;
+}
+
+Plan Graph::compile(const CompileOptions& options, Plan&& recycled) const {
+    return rg::compile(*this, caps_, options, std::move(recycled));
+}
+
+Plan Graph::compile(const CompileOptions& options) const { return rg::compile(*this, caps_, options, Plan{}); }
+
+Plan Graph::compile() const { return rg::compile(*this, caps_, CompileOptions{}, Plan{}); }
+
+} // namespace glint::rg

@@ -1,0 +1,90 @@
+#pragma once
+
+// The declared graph as data: what Graph/Builder record and what compile()
+// and the verifier read. Flat vectors indexed by pass, use and resource;
+// a pass's uses are contiguous.
+
+#include <cstdint>
+#include <string>
+#include <vector>
+
+#include "graph/access.h"
+#include "graph/types.h"
+
+namespace glint::rg::ir {
+
+enum class Origin : uint8_t {
+    Transient,       // described here, created (and aliased) by the executor
+    Imported,        // owned by the caller, with boundary states
+    HistoryPrevious, // last frame's image of a ping-pong pair
+    HistoryCurrent,  // this frame's image of the pair
+};
+
+struct Resource {
+    std::string name;
+    ResourceKind kind = ResourceKind::Texture;
+    Origin origin = Origin::Transient;
+    TextureDesc texture;
+    BufferDesc buffer;
+    // Imports only.
+    bool hasInitial = false;
+    bool hasFinal = false;
+    BoundaryState initial;
+    BoundaryState final;
+    uint32_t partner = kNoIndex; // the other half of a history pair
+    // Per-subresource state lives in "cells": mips x layers of a texture, one
+    // for a buffer or acceleration structure. Cell (m, l) is cellBase + m*layers + l.
+    uint32_t cellBase = 0;
+    uint32_t cellCount = 1;
+    // Declaration bookkeeping: the current version and the pass that made it.
+    uint32_t version = 0;
+    uint32_t lastWriter = kNoIndex;
+    bool contentsAtStart = false; // imports with a defined initial state, history previous
+};
+
+struct Use {
+    uint32_t resource = kNoIndex;
+    uint32_t version = 0;         // the version read, or written from
+    uint32_t producer = kNoIndex; // pass that made `version`; kNoIndex: it came from outside the frame
+    AccessSet kinds = 0;          // one kind, or several reads sharing a layout
+    bool writes = false;
+    Subresource range; // resolved, no kAll
+};
+
+struct Pass {
+    std::string name;
+    Queue queue = Queue::Graphics; // as declared; compile() maps it to a family
+    Pipeline pipeline = Pipeline::Compute;
+    bool sideEffects = false;
+    uint32_t firstUse = 0;
+    uint32_t useCount = 0;
+    ExecuteFn execute;
+};
+
+struct Output {
+    uint32_t resource;
+    uint32_t version;
+    uint32_t producer;
+};
+
+struct Ordering {
+    uint32_t before;
+    uint32_t after;
+};
+
+struct Declaration {
+    uint32_t graphId = 0;
+    std::vector<Pass> passes;
+    std::vector<Use> uses;
+    std::vector<Resource> resources;
+    std::vector<Output> outputs;
+    std::vector<Ordering> orderings;
+    std::vector<uint8_t> written; // per cell: holds data some pass (or the frame's start) wrote
+    uint32_t cellCount = 0;
+};
+
+inline uint32_t cellOf(const Resource& r, uint32_t mip, uint32_t layer) {
+    return r.cellBase + mip * (r.kind == ResourceKind::Texture ? r.texture.layers : 1u) + layer;
+}
+
+} // namespace glint::rg::ir

@@ -1,0 +1,72 @@
+// ---- Lifetimes --------------------------------------------------------------
+// First and last use of every resource in schedule order, the queues that
+// touch it and the access kinds it takes, counting surviving passes only:
+// usage flags come from here, after culling, so a culled pass cannot leave
+// a usage bit (or a memory cost) behind. Device-dependent misuse is caught
+// here too, since only compile() knows the device.
+
+#include <string>
+
+#include <spdlog/spdlog.h>
+
+#include "graph/compile_state.h"
+#include "graph/error.h"
+#include "graph/memory.h"
+
+namespace glint::rg::detail {
+
+void computeLifetimes(CompileState& st) {
+    const ir::Declaration& d = st.decl;
+    st.lifetimes.assign(d.resources.size(), Lifetime{});
+
+    for (uint32_t pos = 0; pos < st.order.size(); ++pos) {
+        const uint32_t p = st.order[pos];
+        const ir::Pass& pass = d.passes[p];
+        const uint8_t queueBit = static_cast<uint8_t>(1u << queueIndex(st.queueOf[p]));
+        if (pass.pipeline == Pipeline::RayTracing && !st.caps.rayTracingPipeline)
+            throw GraphError(ErrorKind::UnsupportedFeature, pass.name,
+                             pass.useCount ? d.resources[d.uses[pass.firstUse].resource].name : std::string(),
+                             "uses a ray tracing pipeline, which the device does not support");
+        for (uint32_t u = pass.firstUse; u < pass.firstUse + pass.useCount; ++u) {
+            const ir::Use& use = d.uses[u];
+            if ((use.kinds & accessBit(Access::AccelRead)) && pass.pipeline != Pipeline::RayTracing &&
+                !st.caps.rayQuery)
+                throw GraphError(ErrorKind::UnsupportedFeature, pass.name, d.resources[use.resource].name,
+                                 "reads an acceleration structure with a ray query, which the device does not support");
+            Lifetime& life = st.lifetimes[use.resource];
+            if (life.first == kNoIndex) life.first = pos;
+            life.last = pos;
+            life.queues |= queueBit;
+            life.kinds |= use.kinds;
+        }
+    }
+
+    st.plan.resources.assign(d.resources.size(), PlannedResource{});
+    for (uint32_t r = 0; r < d.resources.size(); ++r) {
+        const ir::Resource& res = d.resources[r];
+        const Lifetime& life = st.lifetimes[r];
+        PlannedResource& out = st.plan.resources[r];
+        out.kind = res.kind;
+        out.origin = res.origin;
+        out.partner = res.partner;
+        out.used = life.used();
+        out.crossQueue = life.crossQueue();
+        out.queue = life.used() ? st.queueOf[st.order[life.first]] : Queue::Graphics;
+        // A history pair's two images trade roles every frame, so each needs
+        // the usage of both roles.
+        AccessSet kinds = life.kinds;
+        if (res.partner != kNoIndex) {
+            kinds |= st.lifetimes[res.partner].kinds;
+            out.crossQueue = out.crossQueue || st.lifetimes[res.partner].crossQueue() ||
+                             (life.queues | st.lifetimes[res.partner].queues) == 3;
+        }
+        if (res.kind == ResourceKind::Texture) {
+            out.imageUsage = imageUsageFor(kinds);
+            out.aspect = aspectOf(res.texture.format);
+        } else if (res.kind == ResourceKind::Buffer) {
+            out.bufferUsage = bufferUsageFor(kinds);
+        }
+    }
+}
+
+} // namespace glint::rg::detail
