@@ -29,8 +29,13 @@ VKAPI_ATTR VkBool32 VKAPI_CALL onValidationMessage(VkDebugUtilsMessageSeverityFl
     const char* id = data->pMessageIdName ? data->pMessageIdName : "";
     const char* text = data->pMessage ? data->pMessage : "";
     if (severity >= VK_DEBUG_UTILS_MESSAGE_SEVERITY_WARNING_BIT_EXT) {
-        spdlog::error("validation: [{}] {}", id, text);
+        const size_t before = log->count();
         log->add({severity, id, text});
+        if (log->count() > before) {
+            spdlog::error("validation: [{}] {}", id, text);
+        } else {
+            spdlog::debug("validation (set aside: layer 1.3.239 cannot see timeline waits): [{}] {}", id, text);
+        }
     } else {
         spdlog::trace("validation: [{}] {}", id, text);
     }

@@ -565,9 +565,9 @@ private:
             if (!e.touched) continue;
             out.touched = true;
             for (uint32_t q = 0; q < kQueueCount; ++q) out.rStages[q] |= e.rStages[q];
-            if (e.wPending && e.wQueue >= 0) {
-                out.wQueue = e.wQueue;
-                out.wPending = true;
+            if (e.wQueue >= 0 && e.wStages) {  // available writes too: see merge()
+                if (out.wQueue < 0 || e.wPending) out.wQueue = e.wQueue;
+                out.wPending = out.wPending || e.wPending;
                 out.wStages |= e.wStages;
                 out.wAccess |= e.wAccess;
             }
@@ -579,9 +579,12 @@ private:
         if (!from.touched) return;
         into.touched = true;
         for (uint32_t q = 0; q < kQueueCount; ++q) into.rStages[q] |= from.rStages[q];
-        if (from.wPending) {
-            into.wQueue = from.wQueue;
-            into.wPending = true;
+        // Writes already made available still matter to the next layout
+        // transition on these bytes (see analyse(): write after write), so
+        // they are carried too; only pending ones set wPending.
+        if (from.wQueue >= 0 && from.wStages) {
+            if (into.wQueue < 0 || from.wPending) into.wQueue = from.wQueue;
+            into.wPending = into.wPending || from.wPending;
             into.wStages |= from.wStages;
             into.wAccess |= from.wAccess;
         }
@@ -666,8 +669,12 @@ private:
                 else if (n.transition || !within(own, cell.rOrdered[q]))
                     viaOtherQueue(rq, cell.rPoint[rq], false);
             }
-            // Write after write.
-            if (cell.wPending && cell.wQueue >= 0 && cell.wStages &&
+            // Write after write. A layout transition names the last write
+            // in its first scope even when an earlier barrier already made
+            // it available: the transition is a write of its own, and
+            // synchronization validation (rightly strict about WAW) only
+            // accepts a prior write the transition's barrier itself covers.
+            if ((cell.wPending || n.transition) && cell.wQueue >= 0 && cell.wStages &&
                 (n.transition || !cell.vis.covers(q, use.slots, use.packedAccess))) {
                 if (cell.wQueue == static_cast<int8_t>(q)) {
                     n.srcStages |= cell.wStages;
