@@ -51,6 +51,23 @@ VkImageCreateInfo imageInfo(const ImageDesc& desc, const Sharing& sharing) {
     return info;
 }
 
+// The memory a new resource binds to: `placed` when given (checked against
+// what the resource needs), else a fresh suballocation kept in `owned`.
+MemoryRange memoryFor(Context& ctx, const VkMemoryRequirements& req, const MemoryRange* placed, MemoryUsage usage,
+                      bool linear, const char* kind, const std::string& name, Allocation& owned) {
+    if (!placed) {
+        owned = ctx.memory().allocate(req, usage, linear, name);
+        return owned.range();
+    }
+    if (placed->size < req.size || placed->offset % req.alignment != 0 ||
+        !(req.memoryTypeBits & (1u << placed->memoryTypeIndex))) {
+        throw GpuError(std::string(kind) + " '" + name + "': the memory range given cannot hold it (needs " +
+                       std::to_string(req.size) + " bytes aligned to " + std::to_string(req.alignment) +
+                       ", memory type mask " + std::to_string(req.memoryTypeBits) + ")");
+    }
+    return *placed;
+}
+
 } // namespace
 
 // ---------------------------------------------------------------- Buffer
@@ -83,18 +100,7 @@ void Buffer::create(Context& ctx, const MemoryRange* placed) {
 
     VkMemoryRequirements req;
     vkGetBufferMemoryRequirements(ctx.device(), buffer, &req);
-    MemoryRange range;
-    if (placed) {
-        if (placed->size < req.size || placed->offset % req.alignment != 0 ||
-            !(req.memoryTypeBits & (1u << placed->memoryTypeIndex))) {
-            throw GpuError("buffer '" + desc_.name + "': the memory range given cannot hold it (needs " +
-                           std::to_string(req.size) + " bytes aligned to " + std::to_string(req.alignment) + ")");
-        }
-        range = *placed;
-    } else {
-        allocation_ = ctx.memory().allocate(req, desc_.memory, /*linear=*/true, desc_.name);
-        range = allocation_.range();
-    }
+    const MemoryRange range = memoryFor(ctx, req, placed, desc_.memory, /*linear=*/true, "buffer", desc_.name, allocation_);
     check(vkBindBufferMemory(ctx.device(), buffer, range.memory, range.offset), "vkBindBufferMemory '" + desc_.name + "'");
     mapped_ = range.mapped;
     VkBufferDeviceAddressInfo addressInfo{VK_STRUCTURE_TYPE_BUFFER_DEVICE_ADDRESS_INFO};
@@ -141,17 +147,8 @@ void Image::create(Context& ctx, const MemoryRange* placed) {
 
     VkMemoryRequirements req;
     vkGetImageMemoryRequirements(ctx.device(), image, &req);
-    MemoryRange range;
-    if (placed) {
-        if (placed->size < req.size || placed->offset % req.alignment != 0 ||
-            !(req.memoryTypeBits & (1u << placed->memoryTypeIndex))) {
-            throw GpuError("image '" + desc_.name + "': the memory range given cannot hold it");
-        }
-        range = *placed;
-    } else {
-        allocation_ = ctx.memory().allocate(req, MemoryUsage::DeviceLocal, /*linear=*/false, desc_.name);
-        range = allocation_.range();
-    }
+    const MemoryRange range =
+        memoryFor(ctx, req, placed, MemoryUsage::DeviceLocal, /*linear=*/false, "image", desc_.name, allocation_);
     check(vkBindImageMemory(ctx.device(), image, range.memory, range.offset), "vkBindImageMemory '" + desc_.name + "'");
     ctx.setName(image, VK_OBJECT_TYPE_IMAGE, desc_.name);
 
