@@ -465,7 +465,7 @@ void Executor::run(const Plan& plan, const FrameResources& imports) {
                 }
                 // The previous frame's batch `w.batch`, never past its end
                 // (its plan may have had fewer batches).
-                value = std::min(stats_.frames > 0 ? previousBase_[wq] + w.batch + 1 : 0, previousEnd[wq]);
+                value = std::min(previousBase_[wq] + w.batch + 1, previousEnd[wq]);
             }
             VkSemaphoreSubmitInfo info{VK_STRUCTURE_TYPE_SEMAPHORE_SUBMIT_INFO};
             info.semaphore = timelines_[wq].handle();
