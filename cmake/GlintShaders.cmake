@@ -5,6 +5,8 @@
 # features are available), tracks #include dependencies through the depfile
 # glslangValidator writes, and validates the result with spirv-val. A shader
 # error fails the build with glslang's "ERROR: <file>:<line>: ..." line.
+# spirv-val checks scalar block layout rules: the device enables
+# scalarBlockLayout and shared structs use it (glint/shared.h).
 function(glint_add_shaders target)
   cmake_parse_arguments(ARG "" "ROOT;OUTPUT_DIR" "SOURCES;INCLUDE_DIRS" ${ARGN})
   set(outputs)
@@ -21,7 +23,7 @@ function(glint_add_shaders target)
       COMMAND ${CMAKE_COMMAND} -E make_directory ${spv_dir}
       COMMAND ${GLSLANG_VALIDATOR} --quiet --target-env vulkan1.2 -g ${include_flags}
               --depfile ${spv}.d -o ${spv} ${src}
-      COMMAND ${SPIRV_VAL} --target-env vulkan1.2 ${spv}
+      COMMAND ${SPIRV_VAL} --target-env vulkan1.2 --scalar-block-layout ${spv}
       DEPENDS ${src}
       DEPFILE ${spv}.d
       COMMENT "GLSL ${rel}"

@@ -79,11 +79,11 @@ void AccelBuild::record(const Context& ctx, VkCommandBuffer cmd, VkAccelerationS
 }
 
 AccelerationStructure::AccelerationStructure(Context& ctx, VkAccelerationStructureTypeKHR type, VkDeviceSize size,
-                                             std::string name)
+                                             std::string name, bool sharedAcrossQueues)
     : name_(std::move(name)) {
     requireAccel(ctx);
     buffer_ = Buffer(ctx, {size, VK_BUFFER_USAGE_ACCELERATION_STRUCTURE_STORAGE_BIT_KHR, MemoryUsage::DeviceLocal,
-                           name_ + ".storage"});
+                           name_ + ".storage", sharedAcrossQueues});
     VkAccelerationStructureCreateInfoKHR info{VK_STRUCTURE_TYPE_ACCELERATION_STRUCTURE_CREATE_INFO_KHR};
     info.buffer = buffer_.handle();
     info.size = size;

@@ -62,7 +62,10 @@ private:
 class AccelerationStructure {
 public:
     AccelerationStructure() = default;
-    AccelerationStructure(Context& ctx, VkAccelerationStructureTypeKHR type, VkDeviceSize size, std::string name);
+    // `sharedAcrossQueues`: the storage buffer is shared by the graphics and
+    // async compute families (built on one queue, traced on the other).
+    AccelerationStructure(Context& ctx, VkAccelerationStructureTypeKHR type, VkDeviceSize size, std::string name,
+                          bool sharedAcrossQueues = false);
     AccelerationStructure(AccelerationStructure&&) noexcept = default;
     AccelerationStructure& operator=(AccelerationStructure&&) noexcept = default;
 

@@ -322,7 +322,8 @@ void Executor::bindResources(const Plan& plan, const FrameResources& imports) {
                                     "' has no resource bound for this frame (FrameResources::bind)");
             }
             if (r.crossQueue && plan.caps.separateComputeFamily &&
-                ((p.image && !p.image->desc().sharedAcrossQueues) || (p.buffer && !p.buffer->desc().sharedAcrossQueues))) {
+                ((p.image && !p.image->desc().sharedAcrossQueues) || (p.buffer && !p.buffer->desc().sharedAcrossQueues) ||
+                 (p.accel && !p.accel->buffer().desc().sharedAcrossQueues))) {
                 throw gpu::GpuError("render graph: imported '" + d.name +
                                     "' is used on both queues but was not created with sharedAcrossQueues");
             }

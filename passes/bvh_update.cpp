@@ -1,0 +1,552 @@
+#include "passes/bvh_update.h"
+
+#include "gpu/commands.h"
+#include "gpu/descriptors.h"
+#include "gpu/error.h"
+#include "scene/packed_primitives.h"
+#include "scene/smoke_scene.h"
+
+#include "glint/bvh_shared.h"
+#include "glint/packing.h"
+
+#include <algorithm>
+#include <bit>
+#include <cstring>
+#include <optional>
+#include <string>
+
+namespace glint::passes {
+
+namespace {
+
+constexpr VkBufferUsageFlags kBuildInput = VK_BUFFER_USAGE_ACCELERATION_STRUCTURE_BUILD_INPUT_READ_ONLY_BIT_KHR;
+
+// Growth policy of every buffer whose size follows the scene: the next power
+// of two, so a slowly growing pool or TLAS reallocates O(log n) times.
+uint64_t grownCapacity(uint64_t needed, uint64_t minimum) {
+    return std::bit_ceil(std::max(needed, minimum));
+}
+
+// The executor keeps transient memory while the plan's transient layout is
+// unchanged and rebuilds it after a device wait otherwise, so the scratch
+// request only ever grows, in powers of two, from this size.
+constexpr uint64_t kMinScratchBytes = 64 * 1024;
+constexpr uint32_t kMinTlasInstances = 64;
+constexpr uint32_t kMinOffsetEntries = 256;
+
+VkPipelineStageFlags2 traceStages(const gpu::Capabilities& caps) {
+    VkPipelineStageFlags2 stages = VK_PIPELINE_STAGE_2_COMPUTE_SHADER_BIT;
+    if (caps.rayTracingPipeline) {
+        stages |= VK_PIPELINE_STAGE_2_RAY_TRACING_SHADER_BIT_KHR;
+    }
+    return stages;
+}
+
+} // namespace
+
+rg::BoundaryState tracedAccelState(const gpu::Capabilities& caps) {
+    return rg::BoundaryState::raw(traceStages(caps), VK_ACCESS_2_ACCELERATION_STRUCTURE_READ_BIT_KHR,
+                                  VK_IMAGE_LAYOUT_UNDEFINED, rg::Queue::Graphics);
+}
+
+rg::BoundaryState tracedBufferState(const gpu::Capabilities& caps) {
+    return rg::BoundaryState::raw(traceStages(caps), VK_ACCESS_2_SHADER_STORAGE_READ_BIT, VK_IMAGE_LAYOUT_UNDEFINED,
+                                  rg::Queue::Graphics);
+}
+
+// ---------------------------------------------------------------------------
+// Per-object state
+// ---------------------------------------------------------------------------
+
+// One geometry of a mesh's reflection LOD on the GPU, uploaded the first time
+// a BLAS uses it.
+struct BvhManager::SourceGeometry {
+    gpu::Buffer vertices;  // BvhSourceVertex per vertex
+    gpu::Buffer indices;   // three per triangle
+    gpu::Buffer skin;      // BvhSkinVertex per vertex; empty when not skinned
+    uint32_t triangleCount = 0;
+};
+
+struct BvhManager::ResidentBlas {
+    scene::BlasDesc desc;
+    // Three vec3 per triangle, the build input. A static BLAS never rebuilds,
+    // so its positions are released once its build has finished.
+    gpu::Buffer positions;
+    uint64_t builtInFrame = 0;
+    std::vector<const SourceGeometry*> sources;  // per BLAS geometry
+    std::optional<gpu::AccelBuild> build;        // geometry addresses into `positions`, reused by rebuilds
+    gpu::AccelerationStructure structure;
+};
+
+struct BvhManager::Retired {
+    uint64_t lastUse = 0;  // the last frame whose commands may touch it
+    std::shared_ptr<void> object;
+};
+
+struct BvhManager::FrameWork {
+    struct Pack {
+        const SourceGeometry* source = nullptr;
+        const gpu::Buffer* positions = nullptr;
+        shader::BvhPackParams params{};
+    };
+    struct Build {
+        ResidentBlas* blas = nullptr;
+        VkDeviceSize scratchOffset = 0;
+    };
+    uint32_t slot = 0;
+    std::vector<Pack> packs;
+    std::vector<Build> builds;
+    std::vector<VkAccelerationStructureInstanceKHR> instances;
+    std::vector<uint32_t> offsets;
+    std::vector<glm::mat4> joints;  // the palette as it was when the frame was declared
+    std::optional<gpu::AccelBuild> tlasBuild;
+    std::shared_ptr<gpu::Buffer> poolCopySource;  // the outgrown pool, copied into the new one first
+    VkDeviceSize poolCopyBytes = 0;
+};
+
+template <class T> void BvhManager::retire(T&& object) {
+    // Frames up to frame_ - 1 may have recorded uses; frame_ itself when the
+    // object is still used by the frame being declared (a pool copy source).
+    retired_.push_back({frame_, std::make_shared<std::decay_t<T>>(std::forward<T>(object))});
+}
+
+void BvhManager::collectRetired() {
+    // Before the executor runs frame N it has waited for frame N - framesInFlight;
+    // prepare() for frame N runs before that wait, so frame N - 1 - framesInFlight
+    // is the newest one known to be finished.
+    std::erase_if(retired_, [&](const Retired& r) { return r.lastUse + framesInFlight_ < frame_; });
+}
+
+BvhManager::BvhManager(gpu::Context& ctx, const scene::Scene& scene, uint32_t framesInFlight,
+                       const BvhUpdateOptions& options)
+    : ctx_(ctx), scene_(scene), framesInFlight_(std::max(framesInFlight, 1u)), options_(options) {
+    const VkShaderStageFlags cs = VK_SHADER_STAGE_COMPUTE_BIT;
+    packPipeline_ = gpu::createComputePipeline(
+        ctx, {"bvh/pack_primitives.comp",
+              {{0, VK_DESCRIPTOR_TYPE_STORAGE_BUFFER, cs},
+               {1, VK_DESCRIPTOR_TYPE_STORAGE_BUFFER, cs},
+               {2, VK_DESCRIPTOR_TYPE_STORAGE_BUFFER, cs},
+               {3, VK_DESCRIPTOR_TYPE_STORAGE_BUFFER, cs},
+               {4, VK_DESCRIPTOR_TYPE_STORAGE_BUFFER, cs},
+               {5, VK_DESCRIPTOR_TYPE_STORAGE_BUFFER, cs}},
+              sizeof(shader::BvhPackParams),
+              "bvh.pack_primitives"});
+    offsetStaging_.resize(framesInFlight_);
+    instanceBuffers_.resize(framesInFlight_);
+    jointPalettes_.resize(framesInFlight_);
+}
+
+BvhManager::~BvhManager() {
+    // Retired objects and resident BLASes may still be referenced by frames
+    // in flight.
+    ctx_.waitIdle();
+}
+
+const gpu::AccelerationStructure* BvhManager::blas(scene::BlasId id) const {
+    const auto it = blases_.find(id);
+    return it == blases_.end() ? nullptr : &it->second->structure;
+}
+
+void BvhManager::bind(rg::FrameResources& resources, const BvhUpdateOutputs& outputs) const {
+    resources.bind(outputs.tlas, *tlas_);
+    resources.bind(outputs.primitivePool, pool_);
+    resources.bind(outputs.primitiveOffsets, offsets_);
+}
+
+// ---------------------------------------------------------------------------
+// Uploads and growth
+// ---------------------------------------------------------------------------
+
+const BvhManager::SourceGeometry& BvhManager::sourceGeometry(uint32_t mesh, uint32_t lod, uint32_t geometry) {
+    auto& slot = geometries_[{mesh, lod, geometry}];
+    if (slot) {
+        return *slot;
+    }
+    const scene::Geometry& g = scene_.meshes.at(mesh).lods.at(lod).geometries.at(geometry);
+    const std::string name = "bvh." + scene_.meshes[mesh].name + ".lod" + std::to_string(lod) + ".geometry" +
+                             std::to_string(geometry);
+    // Material attributes are sampled here, once, with the CPU reference:
+    // texture sampling at the vertices gives the same answer every frame, so
+    // doing it per frame on the GPU would cost texture bindings and fetches
+    // for nothing. The pack pass then only skins the normal and packs it.
+    std::vector<shader::BvhSourceVertex> vertices(g.vertexCount());
+    for (uint32_t v = 0; v < g.vertexCount(); ++v) {
+        const shader::SurfaceVertex s = scene::surfaceAtVertex(scene_, g, v);
+        const shader::PackedVertex packed = shader::packVertex(s);
+        vertices[v] = {g.positions[v], s.normal, packed.albedoSmoothness,
+                       packed.normalMetallicReflectance & 0xFFFF0000u};
+    }
+    auto source = std::make_unique<SourceGeometry>();
+    source->triangleCount = g.triangleCount();
+    const auto upload = [&](const void* data, size_t bytes, const std::string& what) {
+        return gpu::createBufferWithData(ctx_,
+                                         {std::max<VkDeviceSize>(bytes, 4), VK_BUFFER_USAGE_STORAGE_BUFFER_BIT,
+                                          gpu::MemoryUsage::DeviceLocal, name + what, true},
+                                         data);
+    };
+    source->vertices = upload(vertices.data(), vertices.size() * sizeof(vertices[0]), ".vertices");
+    source->indices = upload(g.indices.data(), g.indices.size() * sizeof(uint32_t), ".indices");
+    stats_.geometryBytes += source->vertices.size() + source->indices.size();
+    if (g.skinned()) {
+        std::vector<shader::BvhSkinVertex> skin(g.vertexCount());
+        for (uint32_t v = 0; v < g.vertexCount(); ++v) {
+            const glm::u16vec4 j = g.joints[v];
+            skin[v] = {glm::uvec2(uint32_t(j.x) | uint32_t(j.y) << 16, uint32_t(j.z) | uint32_t(j.w) << 16),
+                       g.weights[v]};
+        }
+        source->skin = upload(skin.data(), skin.size() * sizeof(skin[0]), ".skin");
+        stats_.geometryBytes += source->skin.size();
+    }
+    ++stats_.uploadedGeometries;
+    slot = std::move(source);
+    return *slot;
+}
+
+BvhManager::ResidentBlas& BvhManager::createBlas(const scene::BlasDesc& desc) {
+    auto blas = std::make_unique<ResidentBlas>();
+    blas->desc = desc;
+    const std::string name = "bvh.blas" + std::to_string(desc.id) + "." + scene_.meshes.at(desc.mesh).name;
+    blas->positions = gpu::Buffer(ctx_, {std::max<VkDeviceSize>(VkDeviceSize(desc.triangleCount) * 3 * sizeof(glm::vec3), 12),
+                                         VK_BUFFER_USAGE_STORAGE_BUFFER_BIT | kBuildInput,
+                                         gpu::MemoryUsage::DeviceLocal, name + ".positions", true});
+    std::vector<gpu::TriangleGeometry> triangles;
+    VkDeviceSize first = 0;
+    for (const scene::BlasGeometry& g : desc.geometries) {
+        blas->sources.push_back(&sourceGeometry(desc.mesh, desc.lod, g.meshGeometry));
+        gpu::TriangleGeometry t;
+        t.vertices = blas->positions.address() + first * sizeof(glm::vec3);
+        t.vertexCount = 3 * g.triangleCount;
+        t.triangleCount = g.triangleCount;
+        // Alpha-tested foliage would need any-hit; the packed-primitive path
+        // has no texture to test against, so every reflection triangle is opaque.
+        t.opaque = true;
+        triangles.push_back(t);
+        first += 3 * VkDeviceSize(g.triangleCount);
+    }
+    const bool deformable = desc.motion != scene::Motion::Static;
+    blas->build = gpu::AccelBuild::bottomLevel(ctx_, triangles, deformable ? options_.deformableFlags : options_.staticFlags);
+    blas->structure = gpu::AccelerationStructure(ctx_, VK_ACCELERATION_STRUCTURE_TYPE_BOTTOM_LEVEL_KHR,
+                                                 blas->build->structureSize(), name, true);
+    stats_.blasBytes += blas->structure.buffer().size();
+    stats_.positionBytes += blas->positions.size();
+    auto& slot = blases_[desc.id];
+    slot = std::move(blas);
+    return *slot;
+}
+
+void BvhManager::ensurePool(uint32_t triangles, FrameWork& work) {
+    const VkDeviceSize needed = std::max<VkDeviceSize>(triangles, 1) * sizeof(shader::PackedPrimitive);
+    if (pool_ && pool_.size() >= needed) {
+        return;
+    }
+    const VkDeviceSize capacity = grownCapacity(needed, 1024 * sizeof(shader::PackedPrimitive));
+    gpu::Buffer grown(ctx_, {capacity,
+                             VK_BUFFER_USAGE_STORAGE_BUFFER_BIT | VK_BUFFER_USAGE_TRANSFER_SRC_BIT |
+                                 VK_BUFFER_USAGE_TRANSFER_DST_BIT,
+                             gpu::MemoryUsage::DeviceLocal, "bvh.primitive_pool", true});
+    if (pool_) {
+        // Static BLASes were packed once; their primitives must survive.
+        work.poolCopyBytes = pool_.size();
+        work.poolCopySource = std::make_shared<gpu::Buffer>(std::move(pool_));
+        retired_.push_back({frame_, work.poolCopySource});
+        ++stats_.poolGrowths;
+    }
+    pool_ = std::move(grown);
+    stats_.poolBytes = pool_.size();
+}
+
+void BvhManager::ensureTlas(uint32_t instances) {
+    if (tlas_ && instances <= tlasCapacity_) {
+        return;
+    }
+    tlasCapacity_ = uint32_t(grownCapacity(instances, kMinTlasInstances));
+    for (gpu::Buffer& buffer : instanceBuffers_) {
+        if (buffer) retire(std::move(buffer));
+        buffer = gpu::Buffer(ctx_, {VkDeviceSize(tlasCapacity_) * sizeof(VkAccelerationStructureInstanceKHR), kBuildInput,
+                                    gpu::MemoryUsage::Upload, "bvh.tlas_instances", true});
+    }
+    // Sized for the capacity so instance counts up to it reuse the structure.
+    const gpu::AccelBuild sizing =
+        gpu::AccelBuild::topLevel(ctx_, instanceBuffers_[0].address(), tlasCapacity_, options_.tlasFlags);
+    if (tlas_) retire(std::move(tlas_));
+    tlas_ = std::make_unique<gpu::AccelerationStructure>(ctx_, VK_ACCELERATION_STRUCTURE_TYPE_TOP_LEVEL_KHR,
+                                                         sizing.structureSize(), "bvh.tlas", true);
+    stats_.tlasBytes = tlas_->buffer().size();
+}
+
+void BvhManager::ensureOffsets(size_t entries) {
+    const VkDeviceSize needed = std::max<VkDeviceSize>(entries, 1) * sizeof(uint32_t);
+    if (offsets_ && offsets_.size() >= needed) {
+        return;
+    }
+    const VkDeviceSize capacity = grownCapacity(needed, kMinOffsetEntries * sizeof(uint32_t));
+    if (offsets_) retire(std::move(offsets_));
+    offsets_ = gpu::Buffer(ctx_, {capacity, VK_BUFFER_USAGE_STORAGE_BUFFER_BIT | VK_BUFFER_USAGE_TRANSFER_DST_BIT,
+                                  gpu::MemoryUsage::DeviceLocal, "bvh.primitive_offsets", true});
+    for (gpu::Buffer& staging : offsetStaging_) {
+        if (staging) retire(std::move(staging));
+        staging = gpu::Buffer(ctx_, {capacity, VK_BUFFER_USAGE_TRANSFER_SRC_BIT, gpu::MemoryUsage::Upload,
+                                     "bvh.primitive_offsets.staging", true});
+    }
+}
+
+void BvhManager::ensureJointPalette(size_t matrices) {
+    const VkDeviceSize needed = std::max<VkDeviceSize>(matrices, 1) * sizeof(glm::mat4);
+    for (gpu::Buffer& palette : jointPalettes_) {
+        if (palette && palette.size() >= needed) continue;
+        if (palette) retire(std::move(palette));
+        palette = gpu::Buffer(ctx_, {grownCapacity(needed, 64 * sizeof(glm::mat4)), VK_BUFFER_USAGE_STORAGE_BUFFER_BIT,
+                                     gpu::MemoryUsage::Upload, "bvh.joint_palette", true});
+    }
+}
+
+// ---------------------------------------------------------------------------
+// The frame: CPU decisions, then recording
+// ---------------------------------------------------------------------------
+
+std::shared_ptr<BvhManager::FrameWork> BvhManager::prepare(const scene::BvhPlan& plan) {
+    ++frame_;
+    collectRetired();
+    auto work = std::make_shared<FrameWork>();
+    work->slot = uint32_t(frame_ % framesInFlight_);
+    stats_.frame = frame_;
+    stats_.blasBuilds = stats_.blasRebuilds = stats_.blasReleased = 0;
+    stats_.packedTriangles = stats_.packDispatches = 0;
+
+    for (const scene::BlasDrop& drop : plan.drops) {
+        const auto it = blases_.find(drop.blas);
+        if (it == blases_.end()) continue;  // never built here (the plan dropped it before a build)
+        stats_.blasBytes -= it->second->structure.buffer().size();
+        stats_.positionBytes -= it->second->positions.size();
+        retire(std::move(it->second));
+        blases_.erase(it);
+        ++stats_.blasReleased;
+    }
+
+    // Static BLASes built in an earlier frame need their positions no more
+    // (36 bytes per triangle, half again the pool's 24).
+    for (auto& [id, blas] : blases_) {
+        if (blas->desc.motion == scene::Motion::Static && blas->positions && blas->builtInFrame < frame_) {
+            stats_.positionBytes -= blas->positions.size();
+            retire(std::move(blas->positions));
+            blas->positions = gpu::Buffer();
+        }
+    }
+
+    ensurePool(plan.poolTriangles, *work);
+
+    // Builds: pack dispatches per geometry, BLAS scratch laid out end to end
+    // because the builds run without barriers between them.
+    const bool anySkinned = std::any_of(plan.builds.begin(), plan.builds.end(), [&](const scene::BlasBuild& b) {
+        const scene::BlasDesc* d = plan.find(b.blas);
+        return d && d->motion == scene::Motion::Skinned;
+    });
+    if (anySkinned) {
+        ensureJointPalette(scene_.jointMatrices.size());
+        work->joints = scene_.jointMatrices;
+    } else {
+        ensureJointPalette(0);
+    }
+    VkDeviceSize blasScratch = 0;
+    for (const scene::BlasBuild& build : plan.builds) {
+        const scene::BlasDesc* desc = plan.find(build.blas);
+        if (!desc) {
+            throw gpu::GpuError("BVH update: the plan builds BLAS " + std::to_string(build.blas) +
+                                " but does not describe it");
+        }
+        auto it = blases_.find(build.blas);
+        const bool resident = it != blases_.end();
+        if (resident && !it->second->positions) {
+            // A static BLAS asked to build again (the planner builds them
+            // once): its positions are gone, so it starts over.
+            stats_.blasBytes -= it->second->structure.buffer().size();
+            retire(std::move(it->second));
+            blases_.erase(it);
+            it = blases_.end();
+        }
+        ResidentBlas& blas = it != blases_.end() ? *it->second : createBlas(*desc);
+        blas.builtInFrame = frame_;
+        ++(resident ? stats_.blasRebuilds : stats_.blasBuilds);
+
+        uint32_t jointOffset = 0, jointCount = 0;
+        if (desc->motion == scene::Motion::Skinned && desc->instance != scene::kNone) {
+            const scene::Instance& inst = scene_.instances.at(size_t(desc->instance));
+            jointOffset = inst.jointOffset;
+            jointCount = uint32_t(scene_.skins.at(size_t(inst.skin)).joints.size());
+        }
+        uint32_t first = 0;
+        for (size_t g = 0; g < desc->geometries.size(); ++g) {
+            const scene::BlasGeometry& geometry = desc->geometries[g];
+            const SourceGeometry* source = blas.sources[g];
+            FrameWork::Pack pack{source, &blas.positions, {}};
+            pack.params.triangleCount = geometry.triangleCount;
+            pack.params.poolOffset = geometry.poolOffset;
+            pack.params.positionOffset = 3 * first;
+            // A geometry without skin data stays rigid even in a skinned instance,
+            // as in the CPU reference.
+            pack.params.jointOffset = jointOffset;
+            pack.params.jointCount = source->skin ? jointCount : 0;
+            work->packs.push_back(pack);
+            first += geometry.triangleCount;
+            stats_.packedTriangles += geometry.triangleCount;
+        }
+        work->builds.push_back({&blas, blasScratch});
+        blasScratch += blas.build->scratchSize();
+    }
+    stats_.packDispatches = uint32_t(work->packs.size());
+    stats_.totalBlasBuilds += work->builds.size();
+    stats_.residentBlases = uint32_t(blases_.size());
+
+    // TLAS instances and the offset table, written to host memory when the
+    // pass records (the frame slot is free by then).
+    ensureTlas(uint32_t(plan.tlas.size()));
+    ensureOffsets(plan.primitiveOffsets.size());
+    work->offsets = plan.primitiveOffsets;
+    work->instances.reserve(plan.tlas.size());
+    for (const scene::TlasInstance& ti : plan.tlas) {
+        const auto it = blases_.find(ti.blas);
+        if (it == blases_.end()) {
+            throw gpu::GpuError("BVH update: TLAS instance of scene instance " + std::to_string(ti.sceneInstance) +
+                                " uses BLAS " + std::to_string(ti.blas) + ", which was never built");
+        }
+        const auto transform = scene::rowMajor3x4(ti.transform);
+        work->instances.push_back(gpu::makeInstance(it->second->structure, transform.data(), ti.customIndex, ti.mask,
+                                                    ti.sbtOffset));
+    }
+    stats_.tlasInstances = uint32_t(work->instances.size());
+    work->tlasBuild = gpu::AccelBuild::topLevel(ctx_, instanceBuffers_[work->slot].address(),
+                                                uint32_t(work->instances.size()), options_.tlasFlags);
+
+    // The TLAS build follows a barrier after the BLAS builds, so it reuses
+    // the scratch from offset 0.
+    const VkDeviceSize scratch = std::max(blasScratch, work->tlasBuild->scratchSize());
+    stats_.scratchBytes = scratch;
+    scratchCapacity_ = std::max(scratchCapacity_, grownCapacity(scratch, kMinScratchBytes));
+    return work;
+}
+
+void BvhManager::record(FrameWork& work, rg::PassContext& pc, const BvhUpdateOutputs& handles) {
+    const VkCommandBuffer cmd = pc.cmd();
+    // The objects bound to this frame's handles (the manager's current ones
+    // when the frame was declared).
+    const gpu::Buffer& pool = pc.buffer(handles.primitivePool);
+    const gpu::Buffer& offsets = pc.buffer(handles.primitiveOffsets);
+    const gpu::Buffer& scratch = pc.buffer(handles.scratch);
+    const gpu::AccelerationStructure& tlas = pc.accel(handles.tlas);
+    const uint32_t slot = work.slot;
+
+    // Host writes first: this slot's previous frame has finished (the executor
+    // waited for it before recording), and writes before the submit are
+    // visible to the device without a barrier.
+    if (!work.instances.empty()) {
+        std::memcpy(instanceBuffers_[slot].mapped(), work.instances.data(),
+                    work.instances.size() * sizeof(VkAccelerationStructureInstanceKHR));
+    }
+    if (!work.joints.empty()) {
+        std::memcpy(jointPalettes_[slot].mapped(), work.joints.data(), work.joints.size() * sizeof(glm::mat4));
+    }
+    if (!work.offsets.empty()) {
+        std::memcpy(offsetStaging_[slot].mapped(), work.offsets.data(), work.offsets.size() * sizeof(uint32_t));
+    }
+
+    // Resources the graph does not see (BLASes, their positions, an outgrown
+    // pool) were last touched by this pass in an earlier frame on this same
+    // queue: order those builds, dispatches and copies before this frame's.
+    gpu::memoryBarrier(cmd,
+                       VK_PIPELINE_STAGE_2_ACCELERATION_STRUCTURE_BUILD_BIT_KHR | VK_PIPELINE_STAGE_2_COMPUTE_SHADER_BIT |
+                           VK_PIPELINE_STAGE_2_COPY_BIT,
+                       VK_ACCESS_2_ACCELERATION_STRUCTURE_WRITE_BIT_KHR | VK_ACCESS_2_SHADER_STORAGE_WRITE_BIT |
+                           VK_ACCESS_2_TRANSFER_WRITE_BIT,
+                       VK_PIPELINE_STAGE_2_ACCELERATION_STRUCTURE_BUILD_BIT_KHR | VK_PIPELINE_STAGE_2_COMPUTE_SHADER_BIT |
+                           VK_PIPELINE_STAGE_2_COPY_BIT,
+                       VK_ACCESS_2_ACCELERATION_STRUCTURE_READ_BIT_KHR | VK_ACCESS_2_ACCELERATION_STRUCTURE_WRITE_BIT_KHR |
+                           VK_ACCESS_2_SHADER_STORAGE_READ_BIT | VK_ACCESS_2_SHADER_STORAGE_WRITE_BIT |
+                           VK_ACCESS_2_SHADER_READ_BIT | VK_ACCESS_2_TRANSFER_READ_BIT | VK_ACCESS_2_TRANSFER_WRITE_BIT);
+
+    // Copies: the outgrown pool into the new one, the offset table.
+    if (work.poolCopySource || !work.offsets.empty()) {
+        gpu::ScopedLabel label(ctx_, cmd, "bvh.copies");
+        if (work.poolCopySource) {
+            const VkBufferCopy region{0, 0, work.poolCopyBytes};
+            vkCmdCopyBuffer(cmd, work.poolCopySource->handle(), pool.handle(), 1, &region);
+        }
+        if (!work.offsets.empty()) {
+            const VkBufferCopy region{0, 0, work.offsets.size() * sizeof(uint32_t)};
+            vkCmdCopyBuffer(cmd, offsetStaging_[slot].handle(), offsets.handle(), 1, &region);
+        }
+        // The pack dispatches overwrite parts of the copied pool.
+        gpu::memoryBarrier(cmd, VK_PIPELINE_STAGE_2_COPY_BIT, VK_ACCESS_2_TRANSFER_WRITE_BIT,
+                           VK_PIPELINE_STAGE_2_COMPUTE_SHADER_BIT,
+                           VK_ACCESS_2_SHADER_STORAGE_READ_BIT | VK_ACCESS_2_SHADER_STORAGE_WRITE_BIT);
+    }
+
+    if (!work.packs.empty()) {
+        gpu::ScopedLabel label(ctx_, cmd, "bvh.pack_primitives");
+        packPipeline_.bind(cmd);
+        for (const FrameWork::Pack& pack : work.packs) {
+            const gpu::Buffer& skin = pack.source->skin ? pack.source->skin : pack.source->vertices;
+            gpu::PushDescriptors(packPipeline_)
+                .storageBuffer(0, pack.source->vertices)
+                .storageBuffer(1, pack.source->indices)
+                .storageBuffer(2, skin)  // unread when jointCount is 0; the binding must still be valid
+                .storageBuffer(3, jointPalettes_[slot])
+                .storageBuffer(4, *pack.positions)
+                .storageBuffer(5, pool)
+                .push(ctx_, cmd);
+            packPipeline_.pushConstants(cmd, pack.params);
+            vkCmdDispatch(cmd, (pack.params.triangleCount + shader::kBvhPackGroupSize - 1) / shader::kBvhPackGroupSize,
+                          1, 1);
+        }
+        // Unwrapped positions -> BLAS build input.
+        gpu::memoryBarrier(cmd, VK_PIPELINE_STAGE_2_COMPUTE_SHADER_BIT, VK_ACCESS_2_SHADER_STORAGE_WRITE_BIT,
+                           VK_PIPELINE_STAGE_2_ACCELERATION_STRUCTURE_BUILD_BIT_KHR, VK_ACCESS_2_SHADER_READ_BIT);
+    }
+
+    if (!work.builds.empty()) {
+        gpu::ScopedLabel label(ctx_, cmd, "bvh.blas_builds");
+        for (const FrameWork::Build& build : work.builds) {
+            build.blas->build->record(ctx_, cmd, build.blas->structure.handle(), scratch.address() + build.scratchOffset);
+        }
+        // BLAS writes -> TLAS build reads; the TLAS build also reuses the scratch.
+        gpu::memoryBarrier(cmd, VK_PIPELINE_STAGE_2_ACCELERATION_STRUCTURE_BUILD_BIT_KHR,
+                           VK_ACCESS_2_ACCELERATION_STRUCTURE_WRITE_BIT_KHR,
+                           VK_PIPELINE_STAGE_2_ACCELERATION_STRUCTURE_BUILD_BIT_KHR,
+                           VK_ACCESS_2_ACCELERATION_STRUCTURE_READ_BIT_KHR |
+                               VK_ACCESS_2_ACCELERATION_STRUCTURE_WRITE_BIT_KHR);
+    }
+
+    gpu::ScopedLabel label(ctx_, cmd, "bvh.tlas_build");
+    work.tlasBuild->record(ctx_, cmd, tlas.handle(), scratch.address());
+}
+
+BvhUpdateOutputs addBvhUpdatePass(rg::Graph& graph, BvhManager& manager, const scene::BvhPlan& plan) {
+    std::shared_ptr<BvhManager::FrameWork> work = manager.prepare(plan);
+    const gpu::Capabilities& caps = manager.ctx_.caps();
+    const rg::BoundaryState accelState = tracedAccelState(caps);
+    const rg::BoundaryState bufferState = tracedBufferState(caps);
+    const rg::AccelStruct tlas = graph.importAccelStruct("bvh.tlas", {accelState, accelState});
+    const rg::Buffer pool =
+        graph.importBuffer("bvh.primitive_pool", {{manager.pool_.size()}, bufferState, bufferState});
+    const rg::Buffer offsets =
+        graph.importBuffer("bvh.primitive_offsets", {{manager.offsets_.size()}, bufferState, bufferState});
+    const uint64_t scratchBytes = manager.scratchCapacity_;
+
+    const BvhUpdateOutputs& out = graph.addPass<BvhUpdateOutputs>(
+        "bvh_update", rg::Queue::AsyncCompute,
+        [&](rg::Builder& b, BvhUpdateOutputs& d) {
+            d.tlas = b.write(tlas, rg::Access::AccelBuildWrite);
+            d.primitivePool = b.write(pool, rg::Access::StorageWrite);
+            d.primitiveOffsets = b.write(offsets, rg::Access::TransferDst);
+            d.scratch = b.write(b.createBuffer("bvh.scratch", {scratchBytes}), rg::Access::AccelBuildWrite);
+            // The BLASes are written here and observed only through the TLAS;
+            // a frame whose TLAS nobody reads must still build them (static
+            // BLASes are built exactly once).
+            b.markSideEffects();
+        },
+        [&manager, work](const BvhUpdateOutputs& d, rg::PassContext& pc) {
+            manager.record(*work, pc, d);
+        });
+    return out;
+}
+
+} // namespace glint::passes

@@ -1,0 +1,167 @@
+#pragma once
+// The GPU side of the BVH manager (issue 4): executes a scene::BvhPlan.
+//
+// BvhManager owns what lives across frames: the reflection-LOD geometry of
+// every mesh a BLAS was built from (uploaded once, material sampled at the
+// vertices on the CPU), one AccelerationStructure per resident BLAS, the
+// unwrapped build positions of the deformable ones, the one primitive pool
+// (PackedPrimitive per triangle, glint/packing.h), the primitive offset
+// buffer, the TLAS and its per-frame instance buffers.
+//
+// addBvhUpdatePass() declares the frame's builds as ONE render-graph pass on
+// the async compute queue (the graphics queue on one-queue devices):
+//   pack dispatches (positions + packed primitives, skinning included)
+//   -> barrier -> BLAS builds -> barrier -> TLAS build,
+// with build scratch from the graph.
+//
+//   passes::BvhManager bvh(ctx, scene);
+//   each frame:
+//     const scene::BvhPlan plan = planner.plan(scene, camera);
+//     rg::Graph graph(executor.queueCaps());
+//     const auto out = passes::addBvhUpdatePass(graph, bvh, plan);
+//     ... passes reading out.tlas (AccelRead), out.primitivePool and
+//         out.primitiveOffsets (StorageRead) on the graphics queue ...
+//     rg::FrameResources frame;
+//     bvh.bind(frame, out);
+//     executor.run(graph.compile(executor.compileOptions()), frame);
+//
+// Cross-frame safety: the imports' boundary states say the trace passes on
+// the graphics queue read the TLAS, pool and offsets, so the graph orders
+// this frame's builds after last frame's traces (a barrier on one queue, a
+// wait on the previous frame's graphics batches with two). The BLASes stay
+// inside the pass: they are only read through the TLAS, so the TLAS's edge
+// covers a BLAS rebuilt while last frame's traversal could still read it.
+// Objects the plan drops (BLASes, an outgrown pool, TLAS or buffer) are
+// destroyed only after every frame that could use them has finished.
+
+#include "gpu/accel.h"
+#include "gpu/context.h"
+#include "gpu/pipeline.h"
+#include "gpu/resources.h"
+#include "graph/executor.h"
+#include "graph/graph.h"
+#include "scene/bvh_planner.h"
+#include "scene/scene.h"
+
+#include <cstdint>
+#include <map>
+#include <memory>
+#include <tuple>
+#include <vector>
+
+namespace glint::passes {
+
+struct BvhUpdateOutputs {
+    rg::AccelStruct tlas;          // built; read it with Access::AccelRead
+    rg::Buffer primitivePool;      // PackedPrimitive per triangle; Access::StorageRead
+    rg::Buffer primitiveOffsets;   // uint per (custom index + geometry); Access::StorageRead
+    rg::Buffer scratch;            // the builds' scratch (transient)
+};
+
+// What the GPU side did this frame and holds now.
+struct BvhGpuStats {
+    uint64_t frame = 0;            // addBvhUpdatePass calls so far
+    uint32_t blasBuilds = 0;       // this frame: first builds of a BLAS
+    uint32_t blasRebuilds = 0;     // this frame: rebuilds of resident BLASes
+    uint32_t blasReleased = 0;     // this frame: BLASes the plan dropped
+    uint32_t packedTriangles = 0;  // this frame: triangles the pack dispatches wrote
+    uint32_t packDispatches = 0;   // this frame
+    uint32_t tlasInstances = 0;    // this frame
+    uint32_t residentBlases = 0;
+    uint32_t uploadedGeometries = 0;  // reflection-LOD geometries on the GPU
+    uint32_t poolGrowths = 0;         // total times the pool was reallocated (contents kept)
+    uint64_t blasBytes = 0;           // storage of the resident BLASes
+    uint64_t tlasBytes = 0;
+    uint64_t poolBytes = 0;           // allocated (capacity), not just used
+    uint64_t positionBytes = 0;       // unwrapped build positions (deformable BLASes, and static ones until built)
+    uint64_t geometryBytes = 0;       // uploaded vertices, indices and skin data
+    uint64_t scratchBytes = 0;        // this frame's scratch request to the graph
+    uint64_t totalBlasBuilds = 0;     // first builds and rebuilds, all frames
+};
+
+struct BvhUpdateOptions {
+    // Build flags: static BLASes are built once and traced for many frames
+    // (fast trace); deformable ones are rebuilt in the round-robin loop, so
+    // their build time is paid again and again (fast build).
+    VkBuildAccelerationStructureFlagsKHR staticFlags = VK_BUILD_ACCELERATION_STRUCTURE_PREFER_FAST_TRACE_BIT_KHR;
+    VkBuildAccelerationStructureFlagsKHR deformableFlags = VK_BUILD_ACCELERATION_STRUCTURE_PREFER_FAST_BUILD_BIT_KHR;
+    VkBuildAccelerationStructureFlagsKHR tlasFlags = VK_BUILD_ACCELERATION_STRUCTURE_PREFER_FAST_TRACE_BIT_KHR;
+};
+
+class BvhManager {
+public:
+    // `scene` must outlive the manager; its meshes must not change (the
+    // planner's BLAS ids stand for them), its instances and joint palette
+    // may. `framesInFlight` must be at least the executor's: host-written
+    // buffers are kept once per frame in flight.
+    BvhManager(gpu::Context& ctx, const scene::Scene& scene, uint32_t framesInFlight = 2,
+               const BvhUpdateOptions& options = {});
+    ~BvhManager();
+    BvhManager(const BvhManager&) = delete;
+    BvhManager& operator=(const BvhManager&) = delete;
+
+    // Binds the imports addBvhUpdatePass declared to this frame's objects.
+    void bind(rg::FrameResources& resources, const BvhUpdateOutputs& outputs) const;
+
+    const BvhGpuStats& stats() const { return stats_; }
+    // The current objects, for tools and tests (valid after addBvhUpdatePass).
+    const gpu::Buffer& primitivePool() const { return pool_; }
+    const gpu::Buffer& primitiveOffsets() const { return offsets_; }
+    const gpu::AccelerationStructure& tlas() const { return *tlas_; }
+    // Nullptr when the BLAS is not resident.
+    const gpu::AccelerationStructure* blas(scene::BlasId id) const;
+
+private:
+    friend BvhUpdateOutputs addBvhUpdatePass(rg::Graph&, BvhManager&, const scene::BvhPlan&);
+    struct SourceGeometry;
+    struct ResidentBlas;
+    struct Retired;
+    struct FrameWork;
+    using GeometryKey = std::tuple<uint32_t, uint32_t, uint32_t>;  // mesh, lod, geometry
+
+    std::shared_ptr<FrameWork> prepare(const scene::BvhPlan& plan);
+    void record(FrameWork& work, rg::PassContext& pc, const BvhUpdateOutputs& handles);
+    const SourceGeometry& sourceGeometry(uint32_t mesh, uint32_t lod, uint32_t geometry);
+    ResidentBlas& createBlas(const scene::BlasDesc& desc);
+    void ensurePool(uint32_t triangles, FrameWork& work);
+    void ensureTlas(uint32_t instances);
+    void ensureOffsets(size_t entries);
+    void ensureJointPalette(size_t matrices);
+    template <class T> void retire(T&& object);
+    void collectRetired();
+
+    gpu::Context& ctx_;
+    const scene::Scene& scene_;
+    uint32_t framesInFlight_;
+    BvhUpdateOptions options_;
+    gpu::Pipeline packPipeline_;
+    uint64_t frame_ = 0;  // frames prepared so far
+
+    std::map<GeometryKey, std::unique_ptr<SourceGeometry>> geometries_;
+    std::map<scene::BlasId, std::unique_ptr<ResidentBlas>> blases_;
+    gpu::Buffer pool_;
+    gpu::Buffer offsets_;                         // device-local, read by the traces
+    std::vector<gpu::Buffer> offsetStaging_;      // host-visible, one per frame in flight
+    std::vector<gpu::Buffer> instanceBuffers_;    // host-visible TLAS instances, one per frame in flight
+    std::vector<gpu::Buffer> jointPalettes_;      // host-visible joint matrices, one per frame in flight
+    std::unique_ptr<gpu::AccelerationStructure> tlas_;
+    uint32_t tlasCapacity_ = 0;                   // instances the TLAS and instance buffers hold
+    uint64_t scratchCapacity_ = 0;                // high-water mark of the scratch request
+    std::vector<Retired> retired_;
+    BvhGpuStats stats_;
+};
+
+// Declares this frame's BVH work (see the top of this file). Frames are
+// declared and run one at a time, once each: the manager's per-frame host
+// buffers and deferred releases count frames by these calls. Throws
+// gpu::GpuError when the plan names a BLAS the manager never built (a plan
+// from another planner or scene).
+BvhUpdateOutputs addBvhUpdatePass(rg::Graph& graph, BvhManager& manager, const scene::BvhPlan& plan);
+
+// The state the imports are left in and expected in: read by the trace
+// passes on the graphics queue, from compute (ray query) or the ray tracing
+// pipeline, so either backend (or both) may consume them.
+rg::BoundaryState tracedAccelState(const gpu::Capabilities& caps);
+rg::BoundaryState tracedBufferState(const gpu::Capabilities& caps);
+
+} // namespace glint::passes
