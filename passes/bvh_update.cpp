@@ -532,7 +532,7 @@ BvhUpdateOutputs addBvhUpdatePass(rg::Graph& graph, BvhManager& manager, const s
     const uint64_t scratchBytes = manager.scratchCapacity_;
 
     const BvhUpdateOutputs& out = graph.addPass<BvhUpdateOutputs>(
-        "bvh_update", rg::Queue::AsyncCompute,
+        "bvh_update", manager.options_.queue,
         [&](rg::Builder& b, BvhUpdateOutputs& d) {
             d.tlas = b.write(tlas, rg::Access::AccelBuildWrite);
             d.primitivePool = b.write(pool, rg::Access::StorageWrite);

@@ -9,7 +9,8 @@
 // buffer, the TLAS and its per-frame instance buffers.
 //
 // addBvhUpdatePass() declares the frame's builds as ONE render-graph pass on
-// the async compute queue (the graphics queue on one-queue devices):
+// the async compute queue (the graphics queue on one-queue devices, or where
+// BvhUpdateOptions::queue says Graphics):
 //   pack dispatches (positions + packed primitives, skinning included)
 //   -> barrier -> BLAS builds -> barrier -> TLAS build,
 // with build scratch from the graph.
@@ -86,6 +87,13 @@ struct BvhUpdateOptions {
     VkBuildAccelerationStructureFlagsKHR staticFlags = VK_BUILD_ACCELERATION_STRUCTURE_PREFER_FAST_TRACE_BIT_KHR;
     VkBuildAccelerationStructureFlagsKHR deformableFlags = VK_BUILD_ACCELERATION_STRUCTURE_PREFER_FAST_BUILD_BIT_KHR;
     VkBuildAccelerationStructureFlagsKHR tlasFlags = VK_BUILD_ACCELERATION_STRUCTURE_PREFER_FAST_TRACE_BIT_KHR;
+    // The queue of the update pass. AsyncCompute overlaps the builds with
+    // graphics work that does not need the TLAS (the graph maps it to the
+    // graphics queue on one-queue devices); Graphics serializes them with it
+    // (a baseline, or where async compute is slower). Fixed for the manager's
+    // lifetime: the pass orders itself after its own earlier frames by a
+    // barrier on this one queue.
+    rg::Queue queue = rg::Queue::AsyncCompute;
 };
 
 class BvhManager {
@@ -104,6 +112,7 @@ public:
     void bind(rg::FrameResources& resources, const BvhUpdateOutputs& outputs) const;
 
     const BvhGpuStats& stats() const { return stats_; }
+    const BvhUpdateOptions& options() const { return options_; }
     // The current objects, for tools and tests (valid after addBvhUpdatePass).
     const gpu::Buffer& primitivePool() const { return pool_; }
     const gpu::Buffer& primitiveOffsets() const { return offsets_; }

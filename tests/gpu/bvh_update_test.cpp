@@ -580,3 +580,40 @@ TEST_CASE("on two queues the async BVH build waits for the previous frame's grap
     CHECK(text.find("bvh_update") != std::string::npos);
     MESSAGE(text);
 }
+
+TEST_CASE("BvhUpdateOptions::queue = Graphics keeps the builds on the graphics queue of a two-queue device") {
+    test::GpuTest gpu;
+    scene::Scene s = scene::makePlaza();
+    scene::BvhPlanner planner;
+    passes::BvhUpdateOptions options;
+    options.queue = rg::Queue::Graphics;
+    passes::BvhManager bvh(gpu.ctx(), s, 2, options);
+    CHECK((bvh.options().queue == rg::Queue::Graphics));
+    const scene::BvhPlan plan = planner.plan(s, s.cameraPath.atFrame(0, 1).position, 0);
+
+    rg::QueueCaps caps;
+    caps.separateComputeFamily = true;
+    caps.graphicsFamily = 0;
+    caps.computeFamily = 1;
+    caps.rayQuery = true;
+    caps.rayTracingPipeline = true;
+    rg::Graph graph(caps);
+    const passes::BvhUpdateOutputs out = passes::addBvhUpdatePass(graph, bvh, plan);
+    struct Data {
+        rg::AccelStruct tlas;
+        rg::Buffer radiance;
+    };
+    const Data& trace = graph.addPass<Data>("trace_reflections", rg::Queue::Graphics, [&](rg::Builder& b, Data& d) {
+        b.setPipeline(rg::Pipeline::RayTracing);
+        d.tlas = b.read(out.tlas, rg::Access::AccelRead);
+        d.radiance = b.write(b.createBuffer("rt.radiance", {1024}), rg::Access::StorageWrite);
+    }, [](const Data&, rg::PassContext&) {});
+    graph.markOutput(trace.radiance);
+    const rg::Plan compiled = graph.compile();
+    CAPTURE(compiled.toText());
+    REQUIRE(compiled.passes.size() == 2);
+    for (const rg::PlannedPass& p : compiled.passes) {
+        CHECK((p.queue == rg::Queue::Graphics));
+    }
+    CHECK(compiled.batches.size() == 1);  // one queue: nothing to wait for across queues
+}
