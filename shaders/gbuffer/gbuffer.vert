@@ -1,0 +1,55 @@
+#version 460
+// G-buffer geometry: pulls the vertex from the scene's one vertex buffer
+// (gl_VertexIndex includes the draw's vertex offset), skins it with this and
+// last frame's joint palettes, and places it with this and last frame's
+// instance transform, so motion covers camera, rigid and skinned movement.
+#extension GL_GOOGLE_include_directive : require
+
+#include "gbuffer_common.glsl"
+
+layout(location = 0) out vec3 outWorldPosition;
+layout(location = 1) out vec3 outNormal;
+layout(location = 2) out vec3 outAlbedo;
+layout(location = 3) out vec3 outMaterial;  // roughness, metallic, reflectance
+layout(location = 4) out vec4 outClip;      // unjittered, this frame
+layout(location = 5) out vec4 outPreviousClip;
+
+// Linear blend skinning with the same guards as the BVH's pack pass: zero
+// weights and joints past the instance's skin contribute nothing.
+mat4 skinMatrix(GBufferVertex v, GBufferInstance inst, bool previous) {
+    const uint joint[4] = uint[4](v.joints.x & 0xFFFFu, v.joints.x >> 16u, v.joints.y & 0xFFFFu, v.joints.y >> 16u);
+    mat4 m = mat4(0.0);
+    for (int k = 0; k < 4; ++k) {
+        if (v.weights[k] > 0.0 && joint[k] < inst.jointCount) {
+            const uint j = inst.jointOffset + joint[k];
+            m += v.weights[k] * (previous ? previousJoints[j] : joints[j]);
+        }
+    }
+    return m;
+}
+
+void main() {
+    const GBufferVertex v = vertices[gl_VertexIndex];
+    const GBufferInstance inst = instances[draw.instance];
+    vec3 position = v.position;
+    vec3 previousPosition = v.position;
+    vec3 normal = v.normal;
+    if (inst.jointCount > 0u) {
+        const mat4 skin = skinMatrix(v, inst, false);
+        position = (skin * vec4(v.position, 1.0)).xyz;
+        previousPosition = (skinMatrix(v, inst, true) * vec4(v.position, 1.0)).xyz;
+        // Rigs carry no non-uniform scale: the upper 3x3 transforms normals.
+        normal = mat3(skin) * v.normal;
+    }
+    const vec4 world = inst.transform * vec4(position, 1.0);
+    const vec4 previousWorld = inst.previousTransform * vec4(previousPosition, 1.0);
+    // Instance transforms may scale non-uniformly: normals go through the
+    // inverse transpose.
+    outNormal = transpose(inverse(mat3(inst.transform))) * normal;
+    outWorldPosition = world.xyz;
+    outAlbedo = v.albedo;
+    outMaterial = vec3(v.roughness, v.metallic, v.reflectance);
+    outClip = frame.viewProjection * world;
+    outPreviousClip = frame.previousViewProjection * previousWorld;
+    gl_Position = frame.jitteredViewProjection * world;
+}

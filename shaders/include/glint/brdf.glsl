@@ -1,0 +1,95 @@
+// The unified lighting of Glint: the G-buffer's lit colour and the
+// reflection hit shaders light surfaces with these functions, so a surface
+// seen directly and in a reflection gets the same radiance.
+//
+// Specular: GGX / Trowbridge-Reitz distribution, height-correlated Smith
+// visibility and Schlick Fresnel, as Filament writes them ("Physically Based
+// Rendering in Filament", sections 4.4-4.6), alpha = roughness^2. Diffuse:
+// Lambert. Needs glint/gbuffer_shared.h (SceneLighting) first.
+#ifndef GLINT_BRDF_GLSL
+#define GLINT_BRDF_GLSL
+
+const float kPi = 3.14159265358979;
+
+// Filament clamps roughness so alpha^2 stays representable in half and
+// float; at alpha -> 0 the sun's highlight would be an infinite spike.
+const float kMinRoughness = 0.045;
+
+float ggxDistribution(float NoH, float alpha) {
+    const float a2 = alpha * alpha;
+    const float d = (NoH * a2 - NoH) * NoH + 1.0;
+    return a2 / (kPi * d * d);
+}
+
+float smithVisibility(float NoV, float NoL, float alpha) {
+    const float a2 = alpha * alpha;
+    const float ggxV = NoL * sqrt(NoV * NoV * (1.0 - a2) + a2);
+    const float ggxL = NoV * sqrt(NoL * NoL * (1.0 - a2) + a2);
+    return 0.5 / max(ggxV + ggxL, 1e-7);
+}
+
+vec3 fresnelSchlick(vec3 f0, float VoH) {
+    const float f = pow(1.0 - VoH, 5.0);
+    return f0 + (vec3(1.0) - f0) * f;
+}
+
+struct Surface {
+    vec3 position;  // world
+    vec3 normal;    // world, unit
+    vec3 albedo;    // linear base colour
+    float roughness;
+    float metallic;
+    float reflectance;
+};
+
+vec3 surfaceF0(Surface s) {
+    return mix(vec3(0.16 * s.reflectance * s.reflectance), s.albedo, s.metallic);
+}
+
+vec3 diffuseColor(Surface s) {
+    return s.albedo * (1.0 - s.metallic);
+}
+
+// Radiance of the gradient sky in direction `dir` (unit): ground below the
+// horizon, horizon to zenith above it.
+vec3 skyRadiance(SceneLighting l, vec3 dir) {
+    const float y = clamp(dir.y, -1.0, 1.0);
+    if (y < 0.0) {
+        // A short blend below the horizon keeps the seam from aliasing.
+        return mix(l.skyHorizon.rgb, l.skyGround.rgb, clamp(-y * 10.0, 0.0, 1.0));
+    }
+    return mix(l.skyHorizon.rgb, l.skyZenith.rgb, sqrt(y));
+}
+
+// Irradiance from the sky on a surface facing `n`, cosine-weighted: the
+// classic hemisphere-light approximation, blending the irradiance of a
+// surface facing straight up (sky only) and straight down (ground only).
+vec3 skyIrradiance(SceneLighting l, vec3 n) {
+    const vec3 up = kPi * mix(l.skyHorizon.rgb, l.skyZenith.rgb, 0.5);
+    const vec3 down = kPi * l.skyGround.rgb;
+    return mix(down, up, 0.5 + 0.5 * clamp(n.y, -1.0, 1.0));
+}
+
+// Sun (diffuse + specular) and diffuse sky light leaving `s` towards `toViewer`
+// (unit). `sunVisibility` is 1 unshadowed, 0 in shadow. Specular sky light
+// is left to the reflection passes.
+vec3 shadeSurface(SceneLighting l, Surface s, vec3 toViewer, float sunVisibility) {
+    const vec3 n = s.normal;
+    const vec3 L = l.sunDirection.xyz;
+    const float NoL = clamp(dot(n, L), 0.0, 1.0);
+    const float NoV = max(dot(n, toViewer), 1e-4);
+    const vec3 H = normalize(L + toViewer);
+    const float NoH = clamp(dot(n, H), 0.0, 1.0);
+    const float VoH = clamp(dot(toViewer, H), 0.0, 1.0);
+    const float roughness = max(s.roughness, kMinRoughness);
+    const float alpha = roughness * roughness;
+
+    const vec3 F = fresnelSchlick(surfaceF0(s), VoH);
+    const vec3 specular = F * (ggxDistribution(NoH, alpha) * smithVisibility(NoV, NoL, alpha));
+    const vec3 diffuse = diffuseColor(s) / kPi;
+    const vec3 sun = (diffuse + specular) * l.sunIrradiance.rgb * (NoL * sunVisibility);
+    const vec3 ambient = diffuseColor(s) / kPi * skyIrradiance(l, n);
+    return sun + ambient;
+}
+
+#endif

@@ -1,0 +1,83 @@
+// The G-buffer pass (passes/gbuffer.cpp, shaders/gbuffer/*): structs shared
+// by GLSL and C++. Buffers use scalar layout.
+//
+// Conventions of the outputs:
+//   depth          reversed Z (near 1, far or infinity 0), cleared to 0
+//   normal         world-space unit normal in xyz, w = 1 where geometry was drawn
+//   albedo         linear base colour, stored sRGB-encoded (R8G8B8A8_SRGB), a = 1
+//   roughnessMetal r = perceptual roughness, g = metallic, b = reflectance, a = 1
+//   motion         pixels from this frame's position back to last frame's, both
+//                  unjittered: history lookup = pixel + motion
+//   lit            radiance of the opaque scene (sun + diffuse ambient; no
+//                  specular ambient: the reflection passes add that), a = 1;
+//                  the sky's radiance with a = 0 where nothing was drawn
+#ifndef GLINT_GBUFFER_SHARED_H
+#define GLINT_GBUFFER_SHARED_H
+
+#include "glint/shared.h"
+
+GLINT_BEGIN
+
+// One vertex of a LOD-0 geometry, uploaded once (72 bytes). The material is
+// sampled at the vertex on the CPU (scene::surfaceAtVertex), exactly as the
+// BVH manager does for the packed primitives, so the rasterised surface and
+// the ray-traced one agree.
+struct GBufferVertex {
+    vec3 position;  // object space, bind pose for skinned geometry
+    vec3 normal;
+    vec3 albedo;    // linear
+    float roughness;
+    float metallic;
+    float reflectance;
+    uvec2 joints;   // four 16-bit joint indices: x = j0 | j1 << 16, y = j2 | j3 << 16
+    vec4 weights;   // zero for rigid geometry
+};
+
+// One scene instance this frame and last (144 bytes).
+struct GBufferInstance {
+    mat4 transform;
+    mat4 previousTransform;
+    uint jointOffset;  // first matrix in the joint palettes
+    uint jointCount;   // 0: rigid
+    uint pad0;
+    uint pad1;
+};
+
+// The sun and the procedural sky in the units of the lit output (see
+// GBufferSettings in passes/gbuffer.h). Shared with the hit shaders that
+// light reflections the same way.
+struct SceneLighting {
+    vec4 sunDirection;   // xyz: unit, towards the sun
+    vec4 sunIrradiance;  // rgb: at normal incidence
+    vec4 skyZenith;      // rgb radiance
+    vec4 skyHorizon;
+    vec4 skyGround;
+};
+
+// Per-frame constants (binding 0).
+struct GBufferFrame {
+    mat4 jitteredViewProjection;   // rasterisation
+    mat4 viewProjection;           // unjittered, for motion
+    mat4 previousViewProjection;   // unjittered, last frame
+    mat4 inverseViewProjection;    // unjittered: the sky's view rays
+    vec4 cameraPosition;
+    vec2 size;                     // pixels
+    vec2 pad;
+    SceneLighting lighting;
+};
+
+// Push constants of one draw (8 bytes).
+struct GBufferDraw {
+    uint instance;
+    uint doubleSided;  // 1: back faces are lit with the flipped normal
+};
+
+GLINT_END
+
+#ifdef __cplusplus
+static_assert(sizeof(glint::shader::GBufferVertex) == 72);
+static_assert(sizeof(glint::shader::GBufferInstance) == 144);
+static_assert(sizeof(glint::shader::GBufferDraw) == 8);
+#endif
+
+#endif

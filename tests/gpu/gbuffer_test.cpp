@@ -1,0 +1,433 @@
+// The G-buffer pass (passes/gbuffer.h) on a real device, validation and
+// synchronization validation on: planes at known places give the analytic
+// reversed-Z depth, normal and material; moving objects and a moving camera
+// give the analytic motion in pixels; the plaza renders finite and covered.
+#include "support/gpu_test.h"
+
+#include "gpu/error.h"
+#include "graph/executor.h"
+#include "graph/graph.h"
+#include "graph/verify.h"
+#include "passes/gbuffer.h"
+#include "scene/animation.h"
+#include "scene/builtin_scenes.h"
+
+#include "glint/packing.h"
+
+#include <glm/gtc/constants.hpp>
+#include <glm/gtc/matrix_transform.hpp>
+#include <glm/gtc/packing.hpp>
+
+#include <array>
+#include <cmath>
+#include <cstring>
+#include <string>
+
+using namespace glint;
+
+namespace {
+
+constexpr uint32_t kSize = 64;
+constexpr float kNear = 0.1f;
+
+constexpr rg::BoundaryState kHostRead =
+    rg::BoundaryState::raw(VK_PIPELINE_STAGE_2_HOST_BIT, VK_ACCESS_2_HOST_READ_BIT, VK_IMAGE_LAYOUT_UNDEFINED);
+
+// Every G-buffer target of one frame, decoded on the host.
+struct GBufferImage {
+    uint32_t width = 0, height = 0;
+    std::vector<float> depth;
+    std::vector<glm::vec4> normal;
+    std::vector<glm::u8vec4> albedo;  // sRGB-encoded bytes
+    std::vector<glm::u8vec4> roughnessMetal;
+    std::vector<glm::vec2> motion;
+    std::vector<glm::vec4> lit;
+
+    size_t at(uint32_t x, uint32_t y) const { return size_t(y) * width + x; }
+};
+
+// Copies the G-buffer into host-visible buffers inside the graph (a transfer
+// pass after the G-buffer), so the test reads what the graph produced under
+// its own barriers.
+class Readback {
+public:
+    Readback(gpu::Context& ctx, uint32_t width, uint32_t height) : width_(width), height_(height) {
+        const uint32_t bytes[6] = {4, 8, 4, 4, 4, 8};
+        for (size_t i = 0; i < buffers_.size(); ++i) {
+            buffers_[i] = gpu::Buffer(ctx, {VkDeviceSize(width) * height * bytes[i], VK_BUFFER_USAGE_TRANSFER_DST_BIT,
+                                            gpu::MemoryUsage::Readback, "gbuffer_test.readback" + std::to_string(i)});
+        }
+    }
+
+    void add(rg::Graph& graph, const passes::GBufferOutputs& gbuf, rg::FrameResources& frame) {
+        struct Data {
+            std::array<rg::Texture, 6> sources;
+            std::array<rg::Buffer, 6> targets;
+        };
+        const std::array<rg::Texture, 6> sources = {gbuf.depth, gbuf.normal, gbuf.albedo,
+                                                    gbuf.roughnessMetal, gbuf.motion, gbuf.lit};
+        std::array<rg::Buffer, 6> imports;
+        // Frames reuse the buffers: each frame's copy follows the last one's.
+        const rg::BoundaryState lastCopy = rg::BoundaryState::of(rg::Access::TransferDst);
+        for (size_t i = 0; i < imports.size(); ++i) {
+            imports[i] =
+                graph.importBuffer("readback" + std::to_string(i), {{buffers_[i].size()}, lastCopy, kHostRead});
+            frame.bind(imports[i], buffers_[i]);
+        }
+        const uint32_t width = width_, height = height_;
+        const Data& data = graph.addPass<Data>(
+            "readback", rg::Queue::Graphics,
+            [&](rg::Builder& b, Data& d) {
+                for (size_t i = 0; i < sources.size(); ++i) {
+                    d.sources[i] = b.read(sources[i], rg::Access::TransferSrc);
+                    d.targets[i] = b.write(imports[i], rg::Access::TransferDst);
+                }
+            },
+            [width, height](const Data& d, rg::PassContext& pc) {
+                for (size_t i = 0; i < d.sources.size(); ++i) {
+                    const gpu::Image& image = pc.image(d.sources[i]);
+                    VkBufferImageCopy region{};
+                    region.imageSubresource = {image.aspect(), 0, 0, 1};
+                    region.imageExtent = {width, height, 1};
+                    vkCmdCopyImageToBuffer(pc.cmd(), image.handle(), VK_IMAGE_LAYOUT_TRANSFER_SRC_OPTIMAL,
+                                           pc.buffer(d.targets[i]).handle(), 1, &region);
+                }
+            });
+        for (const rg::Buffer& written : data.targets) {
+            graph.markOutput(written);
+        }
+    }
+
+    GBufferImage decode() const {
+        GBufferImage out;
+        out.width = width_;
+        out.height = height_;
+        const size_t n = size_t(width_) * height_;
+        out.depth.resize(n);
+        std::memcpy(out.depth.data(), buffers_[0].mapped(), n * sizeof(float));
+        const auto halves = [](const gpu::Buffer& b, size_t i, int components) {
+            const uint16_t* h = reinterpret_cast<const uint16_t*>(b.mapped()) + i * components;
+            glm::vec4 v(0.0f);
+            for (int c = 0; c < components; ++c) v[c] = glm::unpackHalf1x16(h[c]);
+            return v;
+        };
+        out.normal.resize(n);
+        out.albedo.resize(n);
+        out.roughnessMetal.resize(n);
+        out.motion.resize(n);
+        out.lit.resize(n);
+        std::memcpy(out.albedo.data(), buffers_[2].mapped(), n * 4);
+        std::memcpy(out.roughnessMetal.data(), buffers_[3].mapped(), n * 4);
+        for (size_t i = 0; i < n; ++i) {
+            out.normal[i] = halves(buffers_[1], i, 4);
+            out.motion[i] = glm::vec2(halves(buffers_[4], i, 2));
+            out.lit[i] = halves(buffers_[5], i, 4);
+        }
+        return out;
+    }
+
+private:
+    uint32_t width_, height_;
+    std::array<gpu::Buffer, 6> buffers_;
+};
+
+// A square of side 2 * halfSize in the plane through `center` spanned by
+// `u` and `v`, facing u x v.
+scene::Geometry square(glm::vec3 center, glm::vec3 u, glm::vec3 v, float halfSize) {
+    scene::Geometry g;
+    const glm::vec3 n = glm::normalize(glm::cross(u, v));
+    for (const glm::vec2 c : {glm::vec2(-1, -1), glm::vec2(1, -1), glm::vec2(1, 1), glm::vec2(-1, 1)}) {
+        g.positions.push_back(center + halfSize * (c.x * u + c.y * v));
+        g.normals.push_back(n);
+    }
+    g.indices = {0, 1, 2, 0, 2, 3};
+    return g;
+}
+
+// One material, one mesh of the given geometry, one static instance.
+scene::Scene singleObjectScene(scene::Geometry geometry, const scene::Material& material) {
+    scene::Scene s;
+    s.name = "gbuffer-test";
+    s.materials.push_back(material);
+    scene::Mesh mesh;
+    mesh.name = "object";
+    mesh.lods.push_back({{std::move(geometry)}});
+    s.meshes.push_back(std::move(mesh));
+    scene::Instance inst;
+    inst.name = "object";
+    s.instances.push_back(inst);
+    scene::prepareScene(s);
+    return s;
+}
+
+// 90 degrees vertically on a square image: at distance d the image spans
+// [-d, d] in x and y, so one world unit at distance d is kSize / (2 d) pixels.
+scene::Camera testCamera(glm::vec3 position = glm::vec3(0.0f)) {
+    scene::Camera camera;
+    camera.resolution = {kSize, kSize};
+    camera.lens = {glm::radians(90.0f), kNear, scene::kInfiniteFar};
+    camera.jitter = false;
+    camera.reset({position, position + glm::vec3(0, 0, -1), {0, 1, 0}}, 0);
+    return camera;
+}
+
+GBufferImage render(test::GpuTest& gpu, const scene::Scene& scene, const std::vector<scene::Camera>& frames,
+                    passes::GBufferStats* stats = nullptr) {
+    auto& ctx = gpu.ctx();
+    rg::Executor executor(ctx);
+    passes::GBufferRenderer renderer(ctx, scene);
+    Readback readback(ctx, frames.front().resolution.x, frames.front().resolution.y);
+    for (const scene::Camera& camera : frames) {
+        rg::Graph graph(executor.queueCaps());
+        rg::FrameResources resources;
+        const passes::GBufferOutputs gbuf = passes::addGBufferPass(graph, renderer, {camera});
+        readback.add(graph, gbuf, resources);
+        const rg::Plan plan = graph.compile(executor.compileOptions());
+        const auto report = rg::verify(plan);
+        REQUIRE_MESSAGE(report.ok(), report.text());
+        executor.run(plan, resources);
+        executor.waitIdle();
+    }
+    if (stats) *stats = renderer.stats();
+    return readback.decode();
+}
+
+bool finite(glm::vec4 v) {
+    return std::isfinite(v.x) && std::isfinite(v.y) && std::isfinite(v.z) && std::isfinite(v.w);
+}
+
+int srgbByte(float linear) {
+    return int(shader::encodeUnorm8(shader::linearToSrgb(linear)));
+}
+
+} // namespace
+
+TEST_CASE("a plane facing the camera gives the reversed-Z depth, its normal and its material everywhere") {
+    test::GpuTest gpu;
+    scene::Material material;
+    material.baseColorFactor = {0.8f, 0.4f, 0.2f, 1.0f};
+    material.roughnessFactor = 0.3f;
+    material.metallicFactor = 0.7f;
+    constexpr float kDistance = 5.0f;
+    const scene::Scene scene =
+        singleObjectScene(square({0, 0, -kDistance}, {1, 0, 0}, {0, 1, 0}, 20.0f), material);
+    const GBufferImage img = render(gpu, scene, {testCamera()});
+
+    // Infinite far plane: depth = near / distance (engine/scene/camera.cpp).
+    const float expectedDepth = kNear / kDistance;
+    for (uint32_t y = 0; y < kSize; ++y) {
+        for (uint32_t x = 0; x < kSize; ++x) {
+            INFO("pixel " << x << ", " << y);
+            const size_t i = img.at(x, y);
+            REQUIRE(std::abs(img.depth[i] - expectedDepth) < 1e-5f);
+            REQUIRE(std::abs(img.normal[i].x) < 1e-3f);
+            REQUIRE(std::abs(img.normal[i].y) < 1e-3f);
+            REQUIRE(std::abs(img.normal[i].z - 1.0f) < 1e-3f);
+            REQUIRE(img.normal[i].w == 1.0f);
+            REQUIRE(std::abs(int(img.albedo[i].r) - srgbByte(0.8f)) <= 1);
+            REQUIRE(std::abs(int(img.albedo[i].g) - srgbByte(0.4f)) <= 1);
+            REQUIRE(std::abs(int(img.albedo[i].b) - srgbByte(0.2f)) <= 1);
+            REQUIRE(std::abs(int(img.roughnessMetal[i].r) - int(shader::encodeUnorm8(0.3f))) <= 1);
+            REQUIRE(std::abs(int(img.roughnessMetal[i].g) - int(shader::encodeUnorm8(0.7f))) <= 1);
+            REQUIRE(img.motion[i] == glm::vec2(0.0f));  // nothing moved
+            REQUIRE(finite(img.lit[i]));
+            REQUIRE(img.lit[i].r > 0.0f);
+        }
+    }
+}
+
+TEST_CASE("a plane the sun grazes is lit by the sky alone: albedo / pi times the hemisphere irradiance") {
+    test::GpuTest gpu;
+    scene::Material material;
+    material.baseColorFactor = {0.5f, 0.6f, 0.7f, 1.0f};
+    material.metallicFactor = 0.0f;
+    scene::Scene scene = singleObjectScene(square({0, 0, -5}, {1, 0, 0}, {0, 1, 0}, 20.0f), material);
+    // The sun straight up is parallel to the plane (normal +Z): N.L = 0.
+    scene.sun.directionToLight = {0, 1, 0};
+    scene.environment.sky.zenithColor = {0.2f, 0.3f, 0.6f};
+    scene.environment.sky.horizonColor = {0.8f, 0.7f, 0.6f};
+    scene.environment.sky.groundColor = {0.1f, 0.1f, 0.1f};
+    const GBufferImage img = render(gpu, scene, {testCamera()});
+
+    // glint/brdf.glsl skyIrradiance for n.y = 0: the mean of the upward
+    // (pi * mean of horizon and zenith) and downward (pi * ground) irradiance.
+    const scene::ProceduralSky& sky = scene.environment.sky;
+    const glm::vec3 up = glm::pi<float>() * 0.5f * (sky.horizonColor + sky.zenithColor);
+    const glm::vec3 down = glm::pi<float>() * sky.groundColor;
+    const glm::vec3 expected = glm::vec3(material.baseColorFactor) / glm::pi<float>() * 0.5f * (up + down);
+    for (size_t i = 0; i < img.lit.size(); ++i) {
+        INFO("pixel " << i % kSize << ", " << i / kSize);
+        for (int c = 0; c < 3; ++c) {
+            REQUIRE(std::abs(img.lit[i][c] - expected[c]) < 2e-3f * expected[c]);  // half precision
+        }
+    }
+}
+
+TEST_CASE("the nearer of two overlapping planes wins whichever is drawn first") {
+    test::GpuTest gpu;
+    scene::Scene scene;
+    scene.name = "gbuffer-test-two-planes";
+    scene::Material red, blue;
+    red.baseColorFactor = {1, 0, 0, 1};
+    blue.baseColorFactor = {0, 0, 1, 1};
+    scene.materials = {red, blue};
+    // Drawn in instance order; the subcases draw them both ways round.
+    for (const float distance : {3.0f, 6.0f}) {
+        scene::Geometry g = square({0, 0, -distance}, {1, 0, 0}, {0, 1, 0}, 50.0f);
+        g.material = distance < 4.0f ? 0 : 1;
+        scene::Mesh mesh;
+        mesh.name = "plane";
+        mesh.lods.push_back({{std::move(g)}});
+        scene.meshes.push_back(std::move(mesh));
+    }
+    scene::Instance nearPlane, farPlane;
+    nearPlane.mesh = 0;
+    farPlane.mesh = 1;
+    SUBCASE("near first") { scene.instances = {nearPlane, farPlane}; }
+    SUBCASE("far first") { scene.instances = {farPlane, nearPlane}; }
+    scene::prepareScene(scene);
+    const GBufferImage img = render(gpu, scene, {testCamera()});
+    for (size_t i = 0; i < img.depth.size(); ++i) {
+        INFO("pixel " << i % kSize << ", " << i / kSize);
+        REQUIRE(std::abs(img.depth[i] - kNear / 3.0f) < 1e-5f);
+        REQUIRE(img.albedo[i] == glm::u8vec4(255, 0, 0, 255));
+    }
+}
+
+TEST_CASE("a floor below the camera has the analytic depth per pixel, and the sky fills the rest") {
+    test::GpuTest gpu;
+    const scene::Scene scene = singleObjectScene(square({0, -1, -500}, {1, 0, 0}, {0, 0, -1}, 500.0f), {});
+    const GBufferImage img = render(gpu, scene, {testCamera()});
+
+    uint32_t floorPixels = 0, skyPixels = 0;
+    for (uint32_t y = 0; y < kSize; ++y) {
+        // Pixel centre in NDC; +y is down the image (the projection flips Y).
+        const float ndcY = (float(y) + 0.5f) / float(kSize) * 2.0f - 1.0f;
+        for (uint32_t x = 0; x < kSize; ++x) {
+            INFO("pixel " << x << ", " << y);
+            const size_t i = img.at(x, y);
+            if (ndcY > 0.0f) {
+                // The view ray (ndcX, -ndcY, -1) (tan 45 = 1) meets y = -1 at
+                // view distance 1 / ndcY, so depth = near * ndcY.
+                REQUIRE(std::abs(img.depth[i] - kNear * ndcY) < 1e-5f);
+                REQUIRE(std::abs(img.normal[i].y - 1.0f) < 1e-3f);
+                ++floorPixels;
+            } else {
+                REQUIRE(img.depth[i] == 0.0f);
+                REQUIRE(img.normal[i].w == 0.0f);  // no surface
+                REQUIRE(finite(img.lit[i]));
+                REQUIRE(img.lit[i].b > 0.0f);  // sky radiance
+                ++skyPixels;
+            }
+        }
+    }
+    CHECK(floorPixels == kSize * kSize / 2);
+    CHECK(skyPixels == kSize * kSize / 2);
+}
+
+TEST_CASE("an object moving sideways gives its motion in pixels, from this frame back to the last") {
+    test::GpuTest gpu;
+    constexpr float kDistance = 4.0f;
+    scene::Scene scene = singleObjectScene(square({0, 0, -kDistance}, {1, 0, 0}, {0, 1, 0}, 1.0f), {});
+    // Moved +1 in x since last frame: last frame it was 1 unit to the left.
+    scene.instances[0].transform = glm::translate(glm::mat4(1.0f), glm::vec3(1.0f, 0.0f, 0.0f));
+    scene.instances[0].previousTransform = glm::mat4(1.0f);
+    const GBufferImage img = render(gpu, scene, {testCamera()});
+
+    const float expected = -float(kSize) / (2.0f * kDistance);  // -8 pixels
+    uint32_t covered = 0;
+    for (size_t i = 0; i < img.depth.size(); ++i) {
+        if (img.normal[i].w == 0.0f) {
+            CHECK(img.motion[i] == glm::vec2(0.0f));  // sky, static camera
+            continue;
+        }
+        ++covered;
+        INFO("pixel " << i % kSize << ", " << i / kSize);
+        REQUIRE(std::abs(img.motion[i].x - expected) < 0.02f);
+        REQUIRE(std::abs(img.motion[i].y) < 0.02f);
+    }
+    // The square spans x in [0, 2], y in [-1, 1] at distance 4: 16 x 16 pixels.
+    CHECK(covered == 16 * 16);
+}
+
+TEST_CASE("a camera moving sideways makes static geometry move the other way on screen") {
+    test::GpuTest gpu;
+    constexpr float kDistance = 5.0f;
+    const scene::Scene scene = singleObjectScene(square({0, 0, -kDistance}, {1, 0, 0}, {0, 1, 0}, 50.0f), {});
+    scene::Camera camera = testCamera();
+    const scene::Camera first = camera;
+    camera.advance({{0.5f, 0, 0}, {0.5f, 0, -1}, {0, 1, 0}}, 1);
+    const GBufferImage img = render(gpu, scene, {first, camera});
+
+    // The camera moved +0.5: the wall was 0.5 units further right last frame.
+    const float expected = 0.5f * float(kSize) / (2.0f * kDistance);  // 3.2 pixels
+    for (size_t i = 0; i < img.depth.size(); ++i) {
+        INFO("pixel " << i % kSize << ", " << i / kSize);
+        REQUIRE(std::abs(img.motion[i].x - expected) < 0.01f);
+        REQUIRE(std::abs(img.motion[i].y) < 0.01f);
+    }
+}
+
+TEST_CASE("the plaza renders finite, mostly covered, over animated frames") {
+    test::GpuTest gpu;
+    scene::Scene scene = scene::makePlaza();
+    std::vector<scene::Camera> cameras;
+    scene::Camera camera;
+    camera.resolution = {kSize, kSize};
+    camera.lens = scene.lens;
+    camera.reset(scene.cameraPath.evaluate(0.0f), 0);
+    cameras.push_back(camera);
+
+    auto& ctx = gpu.ctx();
+    rg::Executor executor(ctx);
+    passes::GBufferRenderer renderer(ctx, scene);
+    Readback readback(ctx, kSize, kSize);
+    constexpr uint32_t kFrames = 3;
+    for (uint32_t frame = 0; frame < kFrames; ++frame) {
+        if (frame > 0) {
+            const float t = float(frame) / 30.0f;
+            scene::advanceScene(scene, t);
+            camera.advance(scene.cameraPath.evaluate(t), frame);
+        }
+        rg::Graph graph(executor.queueCaps());
+        rg::FrameResources resources;
+        const passes::GBufferOutputs gbuf = passes::addGBufferPass(graph, renderer, {camera});
+        readback.add(graph, gbuf, resources);
+        executor.run(graph.compile(executor.compileOptions()), resources);
+    }
+    executor.waitIdle();
+    const GBufferImage img = readback.decode();
+
+    CHECK(renderer.stats().frame == kFrames);
+    CHECK(renderer.stats().draws >= scene.instances.size());
+    uint32_t covered = 0;
+    for (size_t i = 0; i < img.depth.size(); ++i) {
+        INFO("pixel " << i % kSize << ", " << i / kSize);
+        REQUIRE(std::isfinite(img.depth[i]));
+        REQUIRE(img.depth[i] >= 0.0f);
+        REQUIRE(img.depth[i] <= 1.0f);
+        REQUIRE(finite(img.normal[i]));
+        REQUIRE(finite(img.lit[i]));
+        REQUIRE(std::isfinite(img.motion[i].x));
+        REQUIRE(std::isfinite(img.motion[i].y));
+        // A walking camera over 1/30 s moves the image by a few pixels at most.
+        REQUIRE(glm::length(img.motion[i]) < float(kSize) / 4.0f);
+        REQUIRE(img.lit[i].r >= 0.0f);
+        if (img.depth[i] > 0.0f) {
+            ++covered;
+            REQUIRE(std::abs(glm::length(glm::vec3(img.normal[i])) - 1.0f) < 1e-2f);
+        }
+    }
+    CHECK(covered > img.depth.size() / 2);
+}
+
+TEST_CASE("a camera without pixels is an error naming the G-buffer") {
+    test::GpuTest gpu;
+    const scene::Scene scene = singleObjectScene(square({0, 0, -1}, {1, 0, 0}, {0, 1, 0}, 1.0f), {});
+    passes::GBufferRenderer renderer(gpu.ctx(), scene);
+    rg::Graph graph;
+    scene::Camera camera = testCamera();
+    camera.resolution = {0, kSize};
+    CHECK_THROWS_WITH_AS(passes::addGBufferPass(graph, renderer, {camera}), doctest::Contains("G-buffer"),
+                         gpu::GpuError);
+}
