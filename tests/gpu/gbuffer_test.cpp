@@ -338,7 +338,9 @@ TEST_CASE("an object moving sideways gives its motion in pixels, from this frame
     uint32_t covered = 0;
     for (size_t i = 0; i < img.depth.size(); ++i) {
         if (img.normal[i].w == 0.0f) {
-            CHECK(img.motion[i] == glm::vec2(0.0f));  // sky, static camera
+            // Sky, static camera: zero up to the rounding of reprojecting a
+            // point at infinity (NVIDIA gives ~1e-6 px where lavapipe gives 0).
+            CHECK(glm::length(img.motion[i]) < 1e-3f);
             continue;
         }
         ++covered;
