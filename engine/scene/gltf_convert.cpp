@@ -366,16 +366,16 @@ private:
         c.sparseValues = place(s.values.bufferView, s.values.byteOffset, c.elementSize, "values");
     }
 
-    // All components of all elements as floats (normalised per glTF),
-    // sparse substitution applied, every value finite.
-    std::vector<float> readFloats(const CheckedAccessor& c) const {
-        const tinygltf::Accessor& a = *c.accessor;
-        const size_t componentBytes = componentSize(a.componentType);
-        context_.chargeDecoded(uint64_t(c.count) * c.components * sizeof(float), c.element);
-        std::vector<float> out(c.count * c.components, 0.0f);
+    // All components of all elements, each converted by `convert` from its
+    // bytes, with sparse substitution applied.
+    template <typename T, typename Convert>
+    std::vector<T> readComponents(const CheckedAccessor& c, Convert convert) const {
+        const size_t componentBytes = componentSize(c.accessor->componentType);
+        context_.chargeDecoded(uint64_t(c.count) * c.components * sizeof(T), c.element);
+        std::vector<T> out(c.count * c.components, T{});
         const auto readElement = [&](const uint8_t* src, size_t i) {
             for (uint32_t k = 0; k < c.components; ++k) {
-                out[i * c.components + k] = componentAsFloat(src + k * componentBytes, a.componentType, a.normalized);
+                out[i * c.components + k] = convert(src + k * componentBytes);
             }
         };
         if (c.base) {
@@ -392,6 +392,15 @@ private:
             }
             readElement(c.sparseValues + k * c.elementSize, target);
         }
+        return out;
+    }
+
+    // All components of all elements as floats (normalised per glTF),
+    // sparse substitution applied, every value finite.
+    std::vector<float> readFloats(const CheckedAccessor& c) const {
+        const tinygltf::Accessor& a = *c.accessor;
+        std::vector<float> out = readComponents<float>(
+            c, [&](const uint8_t* src) { return componentAsFloat(src, a.componentType, a.normalized); });
         for (size_t i = 0; i < out.size(); ++i) {
             if (!std::isfinite(out[i])) {
                 fail(c.element, "element " + std::to_string(i / c.components) + " is not finite");
@@ -402,29 +411,7 @@ private:
 
     std::vector<uint32_t> readUints(const CheckedAccessor& c) const {
         const tinygltf::Accessor& a = *c.accessor;
-        const size_t componentBytes = componentSize(a.componentType);
-        context_.chargeDecoded(uint64_t(c.count) * c.components * sizeof(uint32_t), c.element);
-        std::vector<uint32_t> out(c.count * c.components, 0u);
-        const auto readElement = [&](const uint8_t* src, size_t i) {
-            for (uint32_t k = 0; k < c.components; ++k) {
-                out[i * c.components + k] = componentAsUint(src + k * componentBytes, a.componentType);
-            }
-        };
-        if (c.base) {
-            for (size_t i = 0; i < c.count; ++i) {
-                readElement(c.base + i * c.stride, i);
-            }
-        }
-        for (size_t k = 0; k < c.sparseCount; ++k) {
-            const uint32_t target =
-                componentAsUint(c.sparseIndices + k * componentSize(c.sparseIndexType), c.sparseIndexType);
-            if (target >= c.count) {
-                fail(c.element, "sparse index " + std::to_string(target) + " at position " + std::to_string(k) +
-                                    " >= count " + std::to_string(c.count));
-            }
-            readElement(c.sparseValues + k * c.elementSize, target);
-        }
-        return out;
+        return readComponents<uint32_t>(c, [&](const uint8_t* src) { return componentAsUint(src, a.componentType); });
     }
 
     template <typename Vec> static std::vector<Vec> toVectors(const std::vector<float>& flat, uint32_t components) {
