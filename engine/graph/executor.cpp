@@ -439,6 +439,8 @@ void Executor::run(const Plan& plan, const FrameResources& imports) {
         for (const PlannedPass& p : plan.passesOf(batch)) {
             recordBarriers(cmd, plan, plan.barriersBefore(p));
             ctx.name_ = plan.passName(p);
+            ctx.plan_ = &plan;
+            ctx.pass_ = &p;
             gpu::ScopedLabel label(gpu_, cmd, ctx.name_);
             const uint32_t pair = p.timestampQuery / 2;
             slot.timer.begin(cmd, pair);
@@ -558,6 +560,18 @@ const gpu::AccelerationStructure& PassContext::accel(AccelStruct handle) const {
                             executor_.resourceNames_[handle.index] + "', which is not bound this frame");
     }
     return *p.accel;
+}
+
+VkImageLayout PassContext::layout(Texture handle) const {
+    for (const ir::Use& use : plan_->uses(*pass_)) {
+        if (use.resource == handle.index) {
+            return accessScope(use.kinds, ResourceKind::Texture, plan_->pipeline(*pass_)).layout;
+        }
+    }
+    const std::string name = handle.index < executor_.resourceNames_.size() ? executor_.resourceNames_[handle.index]
+                                                                            : std::string("(invalid handle)");
+    throw gpu::GpuError("render graph: pass '" + name_ + "' asked for the layout of texture '" + name +
+                        "', which it did not declare");
 }
 
 void PassContext::dispatch(const gpu::Pipeline& pipeline, uint32_t x, uint32_t y, uint32_t z) const {

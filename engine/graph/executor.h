@@ -74,6 +74,9 @@ public:
     // this frame's image of the pair). Errors name the pass and resource.
     const gpu::Image& image(Texture handle) const;
     VkImageView view(Texture handle) const { return image(handle).view(); }
+    // The layout this pass's use of `handle` has (what a descriptor for it
+    // must say): e.g. DEPTH_READ_ONLY_OPTIMAL for a sampled depth buffer.
+    VkImageLayout layout(Texture handle) const;
     const gpu::Buffer& buffer(Buffer handle) const;
     const gpu::AccelerationStructure& accel(AccelStruct handle) const;
 
@@ -90,6 +93,8 @@ private:
     std::string name_;
     uint64_t frame_ = 0;
     Queue queue_ = Queue::Graphics;
+    const Plan* plan_ = nullptr;
+    const PlannedPass* pass_ = nullptr;
 };
 
 struct PassTiming {

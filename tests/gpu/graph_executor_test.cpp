@@ -102,6 +102,8 @@ TEST_CASE("a multi-pass compute graph with aliased transients computes the right
                     rg::Access::StorageWrite);
             },
             [&pipelines](const ImageData& d, rg::PassContext& pc) {
+                CHECK(pc.layout(d.image) == VK_IMAGE_LAYOUT_GENERAL);  // storage images live in GENERAL
+                CHECK_THROWS_AS(pc.layout(rg::Texture{}), gpu::GpuError);
                 gpu::PushDescriptors(pipelines.imageWrite)
                     .storageBuffer(0, pc.buffer(d.src))
                     .storageImage(1, pc.view(d.image))

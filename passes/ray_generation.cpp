@@ -1,0 +1,135 @@
+#include "passes/ray_generation.h"
+
+#include "gpu/descriptors.h"
+#include "gpu/error.h"
+#include "graph/executor.h"
+
+#include "glint/ray_generation_shared.h"
+
+#include <array>
+
+namespace glint::passes {
+
+static_assert(kSslrArgsBytes == shader::kSslrArgsOffset * sizeof(uint32_t));
+static_assert(kRtArgsBytes == shader::kRtArgsOffset * sizeof(uint32_t));
+
+namespace {
+
+constexpr uint32_t kBindingCount = 9;
+
+std::vector<gpu::Binding> classifyBindings() {
+    std::vector<gpu::Binding> bindings;
+    for (uint32_t i = 0; i < kBindingCount; ++i) {
+        VkDescriptorType type = VK_DESCRIPTOR_TYPE_STORAGE_BUFFER;
+        if (i < 3) type = VK_DESCRIPTOR_TYPE_COMBINED_IMAGE_SAMPLER;
+        if (i == 8) type = VK_DESCRIPTOR_TYPE_STORAGE_IMAGE;
+        bindings.push_back({i, type, VK_SHADER_STAGE_COMPUTE_BIT});
+    }
+    return bindings;
+}
+
+} // namespace
+
+RayGenerationPipelines::RayGenerationPipelines(gpu::Context& ctx)
+    : ctx_(ctx),
+      classify_(gpu::createComputePipeline(ctx, {"ray_generation/classify.comp", classifyBindings(),
+                                                 uint32_t(sizeof(shader::RayGenerationConstants)),
+                                                 "ray_generation.classify"})),
+      // The G-buffer is read texel by texel (texelFetch); the sampler only
+      // completes the combined descriptor.
+      nearest_(ctx, {VK_FILTER_NEAREST, VK_SAMPLER_MIPMAP_MODE_NEAREST, VK_SAMPLER_ADDRESS_MODE_CLAMP_TO_EDGE, 0.0f,
+                     "ray_generation.nearest"}) {}
+
+RayGenerationOutputs addRayGenerationPass(rg::Graph& graph, RayGenerationPipelines& pipelines,
+                                          const RayGenerationInputs& inputs, const RayGenerationSettings& settings) {
+    const GBufferOutputs& gbuf = inputs.gbuffer;
+    if (gbuf.width == 0 || gbuf.height == 0) {
+        throw gpu::GpuError("addRayGenerationPass: the G-buffer has no size");
+    }
+    if (gbuf.width > shader::kRayPixelXMask + 1 || gbuf.height > shader::kRayPixelYMask + 1) {
+        throw gpu::GpuError("addRayGenerationPass: the packed ray holds pixels up to 32768 x 16384");
+    }
+    RayGenerationOutputs out;
+    out.width = gbuf.width;
+    out.height = gbuf.height;
+    out.tilesX = (gbuf.width + shader::kTileSize - 1) / shader::kTileSize;
+    out.tilesY = (gbuf.height + shader::kTileSize - 1) / shader::kTileSize;
+    const uint64_t pixels = uint64_t(gbuf.width) * gbuf.height;
+    const uint64_t tiles = uint64_t(out.tilesX) * out.tilesY;
+
+    // The lists count up from zero every frame, and a dispatch's y and z
+    // are 1: the args are reset by a transfer before the classification.
+    struct ClearData {
+        rg::Buffer args;
+    };
+    const ClearData& clear = graph.addPass<ClearData>(
+        "ray_generation.clear_args", rg::Queue::Graphics,
+        [&](rg::Builder& b, ClearData& d) {
+            d.args = b.write(b.createBuffer("ray_generation.indirect_args", {shader::kIndirectArgsWords * 4u}),
+                             rg::Access::TransferDst);
+        },
+        [](const ClearData& d, rg::PassContext& pc) {
+            const std::array<uint32_t, shader::kIndirectArgsWords> initial = {0, 1, 1, 0, 1, 1};
+            vkCmdUpdateBuffer(pc.cmd(), pc.buffer(d.args).handle(), 0, sizeof(initial), initial.data());
+        });
+
+    shader::RayGenerationConstants constants{};
+    constants.inverseViewProjection = glm::inverse(inputs.camera.viewProjection());
+    constants.cameraPosition = glm::vec4(inputs.camera.position, 1.0f);
+    constants.size = {gbuf.width, gbuf.height};
+    // The noise's sequences are 32-bit (glint/sampling.glsl); wrapping after
+    // 2^32 frames only restarts them.
+    constants.frame = uint32_t(inputs.frameIndex);
+    constants.roughnessCutoff = settings.roughnessCutoff;
+    constants.reuseRoughness = settings.reuseRoughness;
+    constants.rtMaxDistance = settings.rtMaxDistance;
+    constants.sslrMinDistance = settings.sslrMinDistance;
+    constants.reuseEnabled = settings.reuse ? 1u : 0u;
+
+    struct ClassifyData {
+        rg::Texture depth, normal, roughnessMetal;
+        RayGenerationOutputs out;
+    };
+    const ClassifyData& classify = graph.addPass<ClassifyData>(
+        "ray_generation", rg::Queue::Graphics,
+        [&](rg::Builder& b, ClassifyData& d) {
+            d.depth = b.read(gbuf.depth, rg::Access::SampledRead);
+            d.normal = b.read(gbuf.normal, rg::Access::SampledRead);
+            d.roughnessMetal = b.read(gbuf.roughnessMetal, rg::Access::SampledRead);
+            d.out = out;
+            const auto buffer = [&](const char* name, uint64_t bytes) {
+                return b.write(b.createBuffer(name, {bytes}), rg::Access::StorageWrite);
+            };
+            d.out.rays = buffer("ray_generation.rays", pixels * sizeof(shader::PackedRay));
+            d.out.classes = buffer("ray_generation.classes", pixels * sizeof(uint32_t));
+            d.out.sslrTiles = buffer("ray_generation.sslr_tiles", tiles * sizeof(uint32_t));
+            d.out.rtTiles = buffer("ray_generation.rt_tiles", tiles * sizeof(uint32_t));
+            d.out.indirectArgs = b.write(clear.args, rg::Access::StorageReadWrite);
+            d.out.classDebug = b.write(b.createTexture("ray_generation.class_debug",
+                                                       {.width = gbuf.width, .height = gbuf.height,
+                                                        .format = kRayClassDebugFormat}),
+                                       rg::Access::StorageWrite);
+        },
+        [&pipelines, constants](const ClassifyData& d, rg::PassContext& pc) {
+            const gpu::Pipeline& pipeline = pipelines.classify_;
+            const VkSampler sampler = pipelines.nearest_.handle();
+            pipeline.bind(pc.cmd());
+            gpu::PushDescriptors(pipeline)
+                // Layouts as the plan chose them (a sampled depth image stays depth read-only).
+                .sampledImage(0, pc.view(d.depth), sampler, pc.layout(d.depth))
+                .sampledImage(1, pc.view(d.normal), sampler, pc.layout(d.normal))
+                .sampledImage(2, pc.view(d.roughnessMetal), sampler, pc.layout(d.roughnessMetal))
+                .storageBuffer(3, pc.buffer(d.out.rays))
+                .storageBuffer(4, pc.buffer(d.out.classes))
+                .storageBuffer(5, pc.buffer(d.out.sslrTiles))
+                .storageBuffer(6, pc.buffer(d.out.rtTiles))
+                .storageBuffer(7, pc.buffer(d.out.indirectArgs))
+                .storageImage(8, pc.view(d.out.classDebug))
+                .push(pipelines.ctx_, pc.cmd());
+            pipeline.pushConstants(pc.cmd(), constants);
+            pc.dispatch(pipeline, d.out.tilesX, d.out.tilesY);
+        });
+    return classify.out;
+}
+
+} // namespace glint::passes

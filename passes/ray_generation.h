@@ -1,0 +1,94 @@
+#pragma once
+// Pass 2 of the reflection pipeline (issue 5): ray generation and tile
+// classification. One compute pass reads the G-buffer and, per pixel,
+//   - classifies it: sky (no ray), env (rougher than the cutoff: the
+//     environment map, no ray), RT (near), SSLR (far, beyond the BVH) or
+//     hybrid (between; the feedback counters decide later);
+//   - draws one reflection direction from GGX visible normals (Heitz 2018)
+//     with per-pixel, per-frame low-discrepancy noise (glint/sampling.glsl);
+//   - on rough quads, shares one ray per 2x2 quad (the leader rotates with
+//     the frame);
+// and lists the 8x8 tiles that hold SSLR/hybrid or RT pixels, with one
+// VkDispatchIndirectCommand per list. Layouts: glint/ray_generation_shared.h.
+//
+//   passes::RayGenerationPipelines pipelines(ctx);     // once
+//   each frame, after the G-buffer:
+//     const auto rays = passes::addRayGenerationPass(graph, pipelines, {gbuf, frame, camera}, {});
+//     ... SSLR: dispatchIndirect(rays.indirectArgs, kSslrArgsBytes) over rays.sslrTiles ...
+
+#include "gpu/context.h"
+#include "gpu/pipeline.h"
+#include "gpu/resources.h"
+#include "graph/graph.h"
+#include "passes/gbuffer.h"
+#include "scene/camera.h"
+
+#include <cstdint>
+
+namespace glint::passes {
+
+// Byte offsets of the two dispatch commands in RayGenerationOutputs::indirectArgs.
+inline constexpr VkDeviceSize kSslrArgsBytes = 0;
+inline constexpr VkDeviceSize kRtArgsBytes = 3 * sizeof(uint32_t);
+inline constexpr VkFormat kRayClassDebugFormat = VK_FORMAT_R8G8B8A8_UNORM;
+
+struct RayGenerationInputs {
+    GBufferOutputs gbuffer;
+    // Drives all noise (DESIGN.md section 5): the same index, the same rays.
+    uint64_t frameIndex = 0;
+    // This frame's unjittered matrices and position; the G-buffer's camera.
+    scene::Camera camera;
+};
+
+struct RayGenerationSettings {
+    // Perceptual roughness above which a pixel takes the environment map
+    // and traces nothing: FidelityFX Hybrid Reflections' default 0.22
+    // (DESIGN.md section 3).
+    float roughnessCutoff = 0.22f;
+    // Perceptual roughness from which a 2x2 quad shares one ray. Glint's
+    // starting value, not a published one: at 0.1 (alpha 0.01) the lobe
+    // spans a few degrees, about what neighbouring pixels' reflections
+    // differ by anyway; the bench sweeps it.
+    float reuseRoughness = 0.1f;
+    bool reuse = true;
+    // Pixels nearer than this (world units from the camera) go straight to
+    // RT. Glint's starting value (the talk gives none): near reflections
+    // are where SSLR most often leaves the screen; tuned by measurement.
+    float rtMaxDistance = 10.0f;
+    // Pixels at or beyond this go to SSLR only: the BVH covers a radius of
+    // 100 around the camera (Far Cry 6 talk, DESIGN.md section 3).
+    float sslrMinDistance = 100.0f;
+};
+
+struct RayGenerationOutputs {
+    rg::Buffer rays;          // shader::PackedRay per pixel
+    rg::Buffer classes;       // uint per pixel: shader::kPixel*
+    rg::Buffer sslrTiles;     // uint per listed tile: tx | ty << 16
+    rg::Buffer rtTiles;
+    rg::Buffer indirectArgs;  // VkDispatchIndirectCommand at kSslrArgsBytes and kRtArgsBytes
+    rg::Texture classDebug;   // kRayClassDebugFormat: a colour per class (debug view "ray_classes")
+    uint32_t width = 0;
+    uint32_t height = 0;
+    uint32_t tilesX = 0;
+    uint32_t tilesY = 0;
+};
+
+// The pipeline and the sampler the pass records with; created once.
+class RayGenerationPipelines {
+public:
+    explicit RayGenerationPipelines(gpu::Context& ctx);
+
+private:
+    friend RayGenerationOutputs addRayGenerationPass(rg::Graph&, RayGenerationPipelines&, const RayGenerationInputs&,
+                                                     const RayGenerationSettings&);
+    gpu::Context& ctx_;
+    gpu::Pipeline classify_;
+    gpu::Sampler nearest_;
+};
+
+// Declares the pass (see the top of this file) on the graphics queue.
+RayGenerationOutputs addRayGenerationPass(rg::Graph& graph, RayGenerationPipelines& pipelines,
+                                          const RayGenerationInputs& inputs,
+                                          const RayGenerationSettings& settings = {});
+
+} // namespace glint::passes

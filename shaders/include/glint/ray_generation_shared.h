@@ -1,0 +1,122 @@
+// Ray generation and tile classification (passes/ray_generation.cpp,
+// shaders/ray_generation/*): constants, the packed ray and the push
+// constants, shared by GLSL and C++. Buffers use scalar layout.
+//
+// Outputs, per pixel p = y * width + x:
+//   rays[p]    PackedRay; pixelFlags == kNoRay where the pixel traces nothing
+//   classes[p] one of kPixel*
+// Tiles (kTileSize^2 pixels, tile t = ty * tilesX + tx):
+//   sslrTiles  tiles with an SSLR or hybrid pixel, tile index packed as
+//              tx | ty << 16; rtTiles the same for RT pixels
+//   args       two VkDispatchIndirectCommand (SSLR at 0, RT at 12 bytes):
+//              one kTileSize x kTileSize workgroup per listed tile, so x is
+//              also the list's length
+#ifndef GLINT_RAY_GENERATION_SHARED_H
+#define GLINT_RAY_GENERATION_SHARED_H
+
+#include "glint/shared.h"
+
+GLINT_BEGIN
+
+// 8x8 tiles: the Far Cry 6 talk's and FidelityFX's tile (DESIGN.md section 3).
+GLINT_CONST uint kTileSize = 8u;
+
+// Pixel classes. Sky: nothing to reflect. Env: rougher than the cutoff, the
+// environment map alone. Sslr: beyond the BVH, screen space only. Hybrid:
+// SSLR first, RT for what it misses (the feedback counters decide later).
+// Rt: near pixels, straight to the ray tracer.
+GLINT_CONST uint kPixelSky = 0u;
+GLINT_CONST uint kPixelEnv = 1u;
+GLINT_CONST uint kPixelSslr = 2u;
+GLINT_CONST uint kPixelHybrid = 3u;
+GLINT_CONST uint kPixelRt = 4u;
+GLINT_CONST uint kPixelClassCount = 5u;
+
+// A packed ray (8 bytes).
+//   pixelFlags: bits 0-14 x, 15-28 y of the pixel whose ray this is (up to
+//               32767 x 16383, as FidelityFX SSSR packs its rays), bit 29
+//               kRayReused: this pixel reuses that (quad leader's) ray,
+//               bits 30-31 unused
+//   direction:  world-space unit direction, octahedral, two 16-bit snorms
+// A leader's own entry has its own pixel; a follower's entry names the
+// leader, so later passes trace leaders only and followers read the
+// leader's result.
+struct PackedRay {
+    uint pixelFlags;
+    uint direction;
+};
+
+GLINT_CONST uint kNoRay = 0xFFFFFFFFu;
+GLINT_CONST uint kRayReused = 1u << 29u;
+GLINT_CONST uint kRayPixelXMask = 0x7FFFu;
+GLINT_CONST uint kRayPixelYShift = 15u;
+GLINT_CONST uint kRayPixelYMask = 0x3FFFu;
+
+// Offsets, in uints, of the two dispatch commands in the args buffer.
+GLINT_CONST uint kSslrArgsOffset = 0u;
+GLINT_CONST uint kRtArgsOffset = 3u;
+GLINT_CONST uint kIndirectArgsWords = 6u;
+
+// Push constants of classify.comp (112 bytes).
+struct RayGenerationConstants {
+    mat4 inverseViewProjection;  // unjittered
+    vec4 cameraPosition;
+    uvec2 size;
+    uint frame;
+    float roughnessCutoff;
+    float reuseRoughness;
+    float rtMaxDistance;
+    float sslrMinDistance;
+    uint reuseEnabled;
+};
+
+GLINT_END
+
+#ifdef __cplusplus
+static_assert(sizeof(glint::shader::PackedRay) == 8);
+static_assert(sizeof(glint::shader::RayGenerationConstants) == 112);
+#endif
+
+// ---------------------------------------------------------------------------
+// Packing (both languages)
+// ---------------------------------------------------------------------------
+#include "glint/packing.h"
+
+GLINT_BEGIN
+
+GLINT_CONST float kSnorm16Max = 32767.0f;
+
+GLINT_FUNC uint encodeSnorm16(float x) {
+    return uint(int(floor(clamp(x, -1.0f, 1.0f) * kSnorm16Max + 0.5f))) & 0xFFFFu;
+}
+
+GLINT_FUNC float decodeSnorm16(uint bits) {
+    int v = int(bits & 0xFFFFu);
+    if (v >= 32768) {
+        v -= 65536;
+    }
+    return max(float(v) / kSnorm16Max, -1.0f);
+}
+
+// Octahedral (glint/packing.h's octEncode), 16 bits per component: about
+// 5e-5 rad of error, far below a pixel's footprint at any distance.
+GLINT_FUNC uint packRayDirection(vec3 d) {
+    const vec2 e = octEncode(d);
+    return encodeSnorm16(e.x) | (encodeSnorm16(e.y) << 16u);
+}
+
+GLINT_FUNC vec3 unpackRayDirection(uint bits) {
+    return octDecode(vec2(decodeSnorm16(bits), decodeSnorm16(bits >> 16u)));
+}
+
+GLINT_FUNC uint packRayPixel(uvec2 pixel, bool reused) {
+    return (pixel.x & kRayPixelXMask) | ((pixel.y & kRayPixelYMask) << kRayPixelYShift) | (reused ? kRayReused : 0u);
+}
+
+GLINT_FUNC uvec2 unpackRayPixel(uint pixelFlags) {
+    return uvec2(pixelFlags & kRayPixelXMask, (pixelFlags >> kRayPixelYShift) & kRayPixelYMask);
+}
+
+GLINT_END
+
+#endif

@@ -1,0 +1,127 @@
+#version 460
+// Ray generation and tile classification (passes/ray_generation.h): one
+// workgroup per 8x8 tile. Each pixel is classified (sky, env, SSLR,
+// hybrid, RT), draws one GGX visible-normal reflection ray, and rough
+// pixels of a 2x2 quad share the quad leader's ray; the tile then appends
+// itself to the SSLR and/or RT list and counts itself in the indirect args.
+#extension GL_GOOGLE_include_directive : require
+#extension GL_EXT_scalar_block_layout : require
+
+#include "glint/ray_generation_shared.h"
+#include "glint/sampling.glsl"
+
+layout(local_size_x = 8, local_size_y = 8) in;
+
+layout(set = 0, binding = 0) uniform sampler2D depthTexture;
+layout(set = 0, binding = 1) uniform sampler2D normalTexture;
+layout(set = 0, binding = 2) uniform sampler2D roughnessMetalTexture;
+layout(set = 0, binding = 3, scalar) writeonly buffer Rays { PackedRay rays[]; };
+layout(set = 0, binding = 4, scalar) writeonly buffer Classes { uint classes[]; };
+layout(set = 0, binding = 5, scalar) writeonly buffer SslrTiles { uint sslrTiles[]; };
+layout(set = 0, binding = 6, scalar) writeonly buffer RtTiles { uint rtTiles[]; };
+layout(set = 0, binding = 7, scalar) buffer Args { uint args[]; };
+layout(set = 0, binding = 8, rgba8) uniform writeonly image2D classDebug;
+
+layout(push_constant, scalar) uniform Constants { RayGenerationConstants pc; };
+
+shared uint sharedClass[64];
+shared uint sharedRough[64];  // 1: may share its quad's ray
+shared uint sharedDirection[64];
+shared uint sharedSslr;
+shared uint sharedRt;
+
+// Colours of the classes for the debug view: black sky, grey env, blue
+// SSLR, purple hybrid, red RT.
+const vec4 kClassColours[5] = vec4[5](vec4(0.0, 0.0, 0.0, 1.0), vec4(0.5, 0.5, 0.5, 1.0), vec4(0.1, 0.3, 1.0, 1.0),
+                                      vec4(0.7, 0.2, 0.9, 1.0), vec4(1.0, 0.15, 0.1, 1.0));
+
+void main() {
+    const uvec2 pixel = gl_GlobalInvocationID.xy;
+    const uint lane = gl_LocalInvocationIndex;
+    const bool inside = pixel.x < pc.size.x && pixel.y < pc.size.y;
+    if (lane == 0u) {
+        sharedSslr = 0u;
+        sharedRt = 0u;
+    }
+
+    uint pixelClass = kPixelSky;
+    uint direction = 0u;
+    bool rough = false;
+    if (inside) {
+        const ivec2 p = ivec2(pixel);
+        const float depth = texelFetch(depthTexture, p, 0).x;
+        const vec4 normal = texelFetch(normalTexture, p, 0);
+        const float roughness = texelFetch(roughnessMetalTexture, p, 0).x;
+        // gbuffer_shared.h: normal.w = 0 and depth 0 (reversed Z) where no
+        // geometry was drawn.
+        if (normal.w > 0.5 && depth > 0.0) {
+            const vec2 ndc = (vec2(pixel) + 0.5) / vec2(pc.size) * 2.0 - 1.0;
+            const vec4 world = pc.inverseViewProjection * vec4(ndc, depth, 1.0);
+            const vec3 position = world.xyz / world.w;
+            const vec3 toCamera = pc.cameraPosition.xyz - position;
+            const float distance = length(toCamera);
+            if (roughness > pc.roughnessCutoff) {
+                pixelClass = kPixelEnv;
+            } else {
+                pixelClass = distance < pc.rtMaxDistance ? kPixelRt
+                             : distance >= pc.sslrMinDistance ? kPixelSslr
+                                                              : kPixelHybrid;
+                const vec2 u = frameNoise(pixel, pc.frame);
+                const vec3 l = sampleReflection(normalize(normal.xyz), toCamera / distance, roughness, u);
+                direction = packRayDirection(l);
+                rough = pc.reuseEnabled != 0u && roughness >= pc.reuseRoughness;
+            }
+        }
+    }
+    sharedClass[lane] = pixelClass;
+    sharedRough[lane] = rough ? 1u : 0u;
+    sharedDirection[lane] = direction;
+    barrier();
+
+    // The quad's leader rotates with the frame so every pixel of a quad
+    // traces its own ray once every four frames (temporal accumulation
+    // then sees all four). A pixel shares the leader's ray when both are
+    // rough and in the same class (the same pass will trace it).
+    const uvec2 local = gl_LocalInvocationID.xy;
+    const uint leaderCorner = pc.frame & 3u;
+    const uvec2 leaderLocal = (local & ~1u) + uvec2(leaderCorner & 1u, leaderCorner >> 1u);
+    const uint leaderLane = leaderLocal.y * 8u + leaderLocal.x;
+    const uvec2 leaderPixel = gl_WorkGroupID.xy * 8u + leaderLocal;
+    const bool leaderInside = leaderPixel.x < pc.size.x && leaderPixel.y < pc.size.y;
+    const bool reused = rough && leaderLane != lane && leaderInside && sharedRough[leaderLane] == 1u &&
+                        sharedClass[leaderLane] == pixelClass;
+
+    if (inside) {
+        const uint index = pixel.y * pc.size.x + pixel.x;
+        classes[index] = pixelClass;
+        PackedRay ray;
+        if (pixelClass < kPixelSslr) {
+            ray.pixelFlags = kNoRay;
+            ray.direction = 0u;
+        } else if (reused) {
+            ray.pixelFlags = packRayPixel(leaderPixel, true);
+            ray.direction = sharedDirection[leaderLane];
+        } else {
+            ray.pixelFlags = packRayPixel(pixel, false);
+            ray.direction = direction;
+        }
+        rays[index] = ray;
+        imageStore(classDebug, ivec2(pixel), kClassColours[pixelClass]);
+        if (pixelClass == kPixelSslr || pixelClass == kPixelHybrid) {
+            atomicOr(sharedSslr, 1u);
+        } else if (pixelClass == kPixelRt) {
+            atomicOr(sharedRt, 1u);
+        }
+    }
+    barrier();
+
+    if (lane == 0u) {
+        const uint tile = gl_WorkGroupID.x | (gl_WorkGroupID.y << 16u);
+        if (sharedSslr != 0u) {
+            sslrTiles[atomicAdd(args[kSslrArgsOffset], 1u)] = tile;
+        }
+        if (sharedRt != 0u) {
+            rtTiles[atomicAdd(args[kRtArgsOffset], 1u)] = tile;
+        }
+    }
+}

@@ -1,0 +1,477 @@
+// Ray generation and tile classification (passes/ray_generation.h) on a
+// real device behind the real G-buffer pass, validation on: a mirror floor
+// gives the analytic reflection in every pixel, rough pixels beyond the
+// cutoff and the sky trace nothing, rays never leave below the surface,
+// tile lists and indirect args match a count of the classes, and rough
+// quads share one ray. The GGX sampler itself (glint/sampling.glsl) is
+// checked on the CPU against the analytic visible-normal distribution.
+#include "support/gpu_test.h"
+
+#include "graph/executor.h"
+#include "graph/graph.h"
+#include "graph/verify.h"
+#include "passes/gbuffer.h"
+#include "passes/ray_generation.h"
+#include "scene/animation.h"
+
+#include "glint/ray_generation_shared.h"
+#include "glint/sampling.glsl"
+
+#include <glm/gtc/constants.hpp>
+
+#include <algorithm>
+#include <array>
+#include <cmath>
+#include <cstring>
+#include <set>
+#include <string>
+#include <vector>
+
+using namespace glint;
+
+namespace {
+
+constexpr uint32_t kSize = 64;
+constexpr float kNear = 0.1f;
+
+constexpr rg::BoundaryState kHostRead =
+    rg::BoundaryState::raw(VK_PIPELINE_STAGE_2_HOST_BIT, VK_ACCESS_2_HOST_READ_BIT, VK_IMAGE_LAYOUT_UNDEFINED);
+
+// What the pass wrote in one frame, read back on the host.
+struct RayFrame {
+    std::vector<shader::PackedRay> rays;
+    std::vector<uint32_t> classes;
+    std::vector<uint32_t> sslrTiles;  // the whole buffer; the args say how much is listed
+    std::vector<uint32_t> rtTiles;
+    std::array<uint32_t, shader::kIndirectArgsWords> args{};
+
+    size_t at(uint32_t x, uint32_t y) const { return size_t(y) * kSize + x; }
+};
+
+// Copies the pass's buffers into host-visible buffers inside the graph, so
+// the test reads them under the graph's own barriers.
+class Readback {
+public:
+    explicit Readback(gpu::Context& ctx) {
+        const uint64_t tiles = (kSize / shader::kTileSize) * (kSize / shader::kTileSize);
+        const std::array<uint64_t, 5> bytes = {kSize * kSize * sizeof(shader::PackedRay), kSize * kSize * 4,
+                                               tiles * 4, tiles * 4, shader::kIndirectArgsWords * 4};
+        for (size_t i = 0; i < buffers_.size(); ++i) {
+            buffers_[i] = gpu::Buffer(ctx, {bytes[i], VK_BUFFER_USAGE_TRANSFER_DST_BIT, gpu::MemoryUsage::Readback,
+                                            "ray_generation_test.readback" + std::to_string(i)});
+        }
+    }
+
+    void add(rg::Graph& graph, const passes::RayGenerationOutputs& out, rg::FrameResources& frame) {
+        struct Data {
+            std::array<rg::Buffer, 5> sources;
+            std::array<rg::Buffer, 5> targets;
+        };
+        const std::array<rg::Buffer, 5> sources = {out.rays, out.classes, out.sslrTiles, out.rtTiles,
+                                                   out.indirectArgs};
+        std::array<rg::Buffer, 5> imports;
+        const rg::BoundaryState lastCopy = rg::BoundaryState::of(rg::Access::TransferDst);
+        for (size_t i = 0; i < imports.size(); ++i) {
+            imports[i] =
+                graph.importBuffer("readback" + std::to_string(i), {{buffers_[i].size()}, lastCopy, kHostRead});
+            frame.bind(imports[i], buffers_[i]);
+        }
+        const Data& data = graph.addPass<Data>(
+            "readback", rg::Queue::Graphics,
+            [&](rg::Builder& b, Data& d) {
+                for (size_t i = 0; i < sources.size(); ++i) {
+                    d.sources[i] = b.read(sources[i], rg::Access::TransferSrc);
+                    d.targets[i] = b.write(imports[i], rg::Access::TransferDst);
+                }
+            },
+            [](const Data& d, rg::PassContext& pc) {
+                for (size_t i = 0; i < d.sources.size(); ++i) {
+                    const gpu::Buffer& target = pc.buffer(d.targets[i]);
+                    const VkBufferCopy region{0, 0, target.size()};
+                    vkCmdCopyBuffer(pc.cmd(), pc.buffer(d.sources[i]).handle(), target.handle(), 1, &region);
+                }
+            });
+        for (const rg::Buffer& written : data.targets) {
+            graph.markOutput(written);
+        }
+    }
+
+    RayFrame decode() const {
+        RayFrame f;
+        const auto copy = [](auto& vec, const gpu::Buffer& b) {
+            vec.resize(b.size() / sizeof(vec[0]));
+            std::memcpy(vec.data(), b.mapped(), b.size());
+        };
+        copy(f.rays, buffers_[0]);
+        copy(f.classes, buffers_[1]);
+        copy(f.sslrTiles, buffers_[2]);
+        copy(f.rtTiles, buffers_[3]);
+        std::memcpy(f.args.data(), buffers_[4].mapped(), sizeof(f.args));
+        return f;
+    }
+
+private:
+    std::array<gpu::Buffer, 5> buffers_;
+};
+
+// A square of side 2 * halfSize in the plane through `center` spanned by
+// `u` and `v`, facing u x v.
+scene::Geometry square(glm::vec3 center, glm::vec3 u, glm::vec3 v, float halfSize) {
+    scene::Geometry g;
+    const glm::vec3 n = glm::normalize(glm::cross(u, v));
+    for (const glm::vec2 c : {glm::vec2(-1, -1), glm::vec2(1, -1), glm::vec2(1, 1), glm::vec2(-1, 1)}) {
+        g.positions.push_back(center + halfSize * (c.x * u + c.y * v));
+        g.normals.push_back(n);
+    }
+    g.indices = {0, 1, 2, 0, 2, 3};
+    return g;
+}
+
+// A floor at y = -1 under a camera at the origin looking down -Z: the lower
+// half of the image is floor, the upper half sky, and the floor's rows near
+// the horizon are seen at grazing angles.
+scene::Scene floorScene(float roughness) {
+    scene::Scene s;
+    s.name = "ray-generation-test";
+    scene::Material material;
+    material.roughnessFactor = roughness;
+    material.metallicFactor = 1.0f;
+    s.materials.push_back(material);
+    scene::Mesh mesh;
+    mesh.name = "floor";
+    mesh.lods.push_back({{square({0, -1, -500}, {1, 0, 0}, {0, 0, -1}, 500.0f)}});
+    s.meshes.push_back(std::move(mesh));
+    scene::Instance inst;
+    inst.name = "floor";
+    s.instances.push_back(inst);
+    scene::prepareScene(s);
+    return s;
+}
+
+// 90 degrees vertically on a square image (as the G-buffer test's camera).
+scene::Camera testCamera() {
+    scene::Camera camera;
+    camera.resolution = {kSize, kSize};
+    camera.lens = {glm::radians(90.0f), kNear, scene::kInfiniteFar};
+    camera.jitter = false;
+    camera.reset({glm::vec3(0.0f), glm::vec3(0, 0, -1), {0, 1, 0}}, 0);
+    return camera;
+}
+
+// The unit view ray through a pixel's centre (+y is down the image).
+glm::vec3 viewRay(uint32_t x, uint32_t y) {
+    const float ndcX = (float(x) + 0.5f) / float(kSize) * 2.0f - 1.0f;
+    const float ndcY = (float(y) + 0.5f) / float(kSize) * 2.0f - 1.0f;
+    return glm::normalize(glm::vec3(ndcX, -ndcY, -1.0f));
+}
+
+// Renders the G-buffer and the ray generation for each frame index.
+std::vector<RayFrame> generate(test::GpuTest& gpu, const scene::Scene& scene, const std::vector<uint64_t>& frames,
+                               const passes::RayGenerationSettings& settings = {}) {
+    auto& ctx = gpu.ctx();
+    rg::Executor executor(ctx);
+    passes::GBufferRenderer renderer(ctx, scene);
+    passes::RayGenerationPipelines pipelines(ctx);
+    Readback readback(ctx);
+    const scene::Camera camera = testCamera();
+    std::vector<RayFrame> out;
+    for (const uint64_t frame : frames) {
+        rg::Graph graph(executor.queueCaps());
+        rg::FrameResources resources;
+        const passes::GBufferOutputs gbuf = passes::addGBufferPass(graph, renderer, {camera});
+        const passes::RayGenerationOutputs rays =
+            passes::addRayGenerationPass(graph, pipelines, {gbuf, frame, camera}, settings);
+        REQUIRE(rays.tilesX == kSize / shader::kTileSize);
+        readback.add(graph, rays, resources);
+        const rg::Plan plan = graph.compile(executor.compileOptions());
+        const auto report = rg::verify(plan);
+        REQUIRE_MESSAGE(report.ok(), report.text());
+        executor.run(plan, resources);
+        executor.waitIdle();
+        out.push_back(readback.decode());
+    }
+    return out;
+}
+
+bool isFloor(uint32_t y) { return float(y) + 0.5f > float(kSize) / 2.0f; }
+
+// Expected value of f(h) over GGX visible normals for view v (tangent
+// frame), by quadrature. The substitution u = tan^2 / (alpha^2 + tan^2),
+// the inverse CDF of D(h) cos(h), makes D(h) h.z d(omega) = du dphi / 2 pi,
+// so the integrand G1(v) max(0, v.h) / (v.z h.z) f(h) is bounded however
+// peaked D is, except for a 1 / sqrt(1 - u) growth at the horizon, which
+// u = 1 - s^2 (du = 2 s ds) removes.
+template <class F> double vndfExpectation(glm::dvec3 v, double alpha, F f) {
+    constexpr int kU = 4096, kPhi = 512;
+    const double g1 = shader::ggxSmithG1(float(v.z), float(alpha));
+    double sum = 0.0;
+    for (int i = 0; i < kU; ++i) {
+        const double s = (i + 0.5) / kU;
+        const double u = 1.0 - s * s;
+        const double tanTheta = alpha * std::sqrt(u / (1.0 - u));
+        const double cosTheta = 1.0 / std::sqrt(1.0 + tanTheta * tanTheta);
+        const double sinTheta = tanTheta * cosTheta;
+        for (int j = 0; j < kPhi; ++j) {
+            const double phi = (j + 0.5) / kPhi * 2.0 * glm::pi<double>();
+            const glm::dvec3 h(sinTheta * std::cos(phi), sinTheta * std::sin(phi), cosTheta);
+            sum += 2.0 * s * g1 * std::max(0.0, glm::dot(v, h)) / (v.z * cosTheta) * f(h);
+        }
+    }
+    return sum / (double(kU) * kPhi);
+}
+
+} // namespace
+
+TEST_CASE("GGX visible-normal samples match the analytic distribution's moments up to 89.9 degrees") {
+    for (const float alpha : {0.05f, 0.2f, 0.5f, 1.0f}) {
+        for (const float viewDegrees : {0.0f, 45.0f, 80.0f, 89.9f}) {
+            INFO("alpha " << alpha << ", view " << viewDegrees << " degrees");
+            const float theta = glm::radians(viewDegrees);
+            const glm::vec3 v(std::sin(theta), 0.0f, std::cos(theta));
+            constexpr uint32_t kSamples = 1u << 18;
+            double meanZ = 0.0, meanX = 0.0, meanZ2 = 0.0;
+            for (uint32_t i = 0; i < kSamples; ++i) {
+                const glm::vec2 u = shader::frameNoise({i % 512u, i / 512u}, 7u);
+                const glm::vec3 h = shader::sampleGgxVndf(v, alpha, u);
+                REQUIRE(std::isfinite(h.x));
+                REQUIRE(h.z > 0.0f);
+                meanZ += h.z;
+                meanZ2 += double(h.z) * h.z;
+                meanX += h.x;
+            }
+            meanZ /= kSamples;
+            meanZ2 /= kSamples;
+            meanX /= kSamples;
+            const glm::dvec3 vd(v);
+            const double expectedZ = vndfExpectation(vd, alpha, [](glm::dvec3 h) { return h.z; });
+            const double expectedZ2 = vndfExpectation(vd, alpha, [](glm::dvec3 h) { return h.z * h.z; });
+            const double expectedX = vndfExpectation(vd, alpha, [](glm::dvec3 h) { return h.x; });
+            // The distribution integrates to one (checks the reference).
+            CHECK(std::abs(vndfExpectation(vd, alpha, [](glm::dvec3) { return 1.0; }) - 1.0) < 2e-3);
+            CHECK(std::abs(meanZ - expectedZ) < 2e-3);
+            CHECK(std::abs(meanZ2 - expectedZ2) < 2e-3);
+            CHECK(std::abs(meanX - expectedX) < 2e-3);
+        }
+    }
+}
+
+TEST_CASE("GGX samples at normal incidence are uniform in the inverse CDF of D cos (chi-square)") {
+    // At v = n the visible normals are distributed as D(h) h.z, whose CDF in
+    // t = tan^2 is t / (alpha^2 + t): that value must be uniform on [0, 1).
+    for (const float alpha : {0.1f, 0.4f, 1.0f}) {
+        INFO("alpha " << alpha);
+        constexpr int kBins = 32;
+        constexpr uint32_t kSamples = 1u << 16;
+        std::array<int, kBins> histogram{};
+        for (uint32_t i = 0; i < kSamples; ++i) {
+            const glm::vec3 h = shader::sampleGgxVndf({0, 0, 1}, alpha, shader::frameNoise({i % 256u, i / 256u}, 3u));
+            const double t = (double(h.x) * h.x + double(h.y) * h.y) / (double(h.z) * h.z);
+            const double cdf = t / (double(alpha) * alpha + t);
+            ++histogram[std::min(kBins - 1, int(cdf * kBins))];
+        }
+        const double expected = double(kSamples) / kBins;
+        double chi2 = 0.0;
+        for (const int count : histogram) chi2 += (count - expected) * (count - expected) / expected;
+        // 31 degrees of freedom: p = 0.001 at 61.1.
+        CHECK(chi2 < 61.1);
+    }
+}
+
+TEST_CASE("reflection sampling is finite and above the surface at roughness 0, 1e-4, 1 and grazing views") {
+    uint32_t count = 0;
+    for (const float roughness : {0.0f, 1e-4f, 0.01f, 0.22f, 0.5f, 1.0f}) {
+        for (uint32_t i = 0; i < 4096; ++i) {
+            // Normals and views from the noise; views may face away from
+            // the normal (interpolated normals do) or graze it.
+            const glm::vec2 a = shader::frameNoise({i, 1u}, 11u);
+            const glm::vec2 b = shader::frameNoise({i, 2u}, 13u);
+            const auto sphere = [](glm::vec2 u) {
+                const float z = 1.0f - 2.0f * u.x, r = std::sqrt(std::max(0.0f, 1.0f - z * z));
+                return glm::vec3(r * std::cos(6.2831853f * u.y), r * std::sin(6.2831853f * u.y), z);
+            };
+            const glm::vec3 n = sphere(a);
+            glm::vec3 v = sphere(b);
+            if (i % 4 == 0) v = glm::normalize(v - n * glm::dot(v, n) + n * 1e-5f);  // grazing
+            const glm::vec3 l = shader::sampleReflection(n, v, roughness, shader::frameNoise({i, 3u}, 17u));
+            const glm::vec3 packed = shader::unpackRayDirection(shader::packRayDirection(l));
+            INFO("roughness " << roughness << ", sample " << i);
+            REQUIRE(std::isfinite(l.x));
+            REQUIRE(std::isfinite(l.y));
+            REQUIRE(std::isfinite(l.z));
+            REQUIRE(std::abs(glm::length(l) - 1.0f) < 1e-4f);
+            REQUIRE(glm::dot(packed, n) > 0.0f);
+            ++count;
+        }
+    }
+    CHECK(count == 6u * 4096u);
+}
+
+TEST_CASE("the noise is deterministic and walks a different sample every frame") {
+    CHECK(shader::frameNoise({3, 5}, 9) == shader::frameNoise({3, 5}, 9));
+    CHECK(shader::frameNoise({3, 5}, 9) != shader::frameNoise({3, 5}, 10));
+    CHECK(shader::frameNoise({3, 5}, 9) != shader::frameNoise({5, 3}, 9));
+}
+
+TEST_CASE("a mirror floor (roughness 0) gives exactly the reflected view direction in every floor pixel") {
+    test::GpuTest gpu;
+    const std::vector<RayFrame> frames = generate(gpu, floorScene(0.0f), {0, 1});
+    for (const RayFrame& f : frames) {
+        for (uint32_t y = 0; y < kSize; ++y) {
+            for (uint32_t x = 0; x < kSize; ++x) {
+                INFO("pixel " << x << ", " << y);
+                const size_t i = f.at(x, y);
+                if (!isFloor(y)) {
+                    REQUIRE(f.classes[i] == shader::kPixelSky);
+                    REQUIRE(f.rays[i].pixelFlags == shader::kNoRay);
+                    continue;
+                }
+                REQUIRE(f.classes[i] >= shader::kPixelSslr);
+                REQUIRE(f.rays[i].pixelFlags == shader::packRayPixel({x, y}, false));  // mirrors never share
+                const glm::vec3 d = viewRay(x, y);
+                const glm::vec3 expected(d.x, -d.y, d.z);  // reflected about the floor's normal +Y
+                const glm::vec3 got = shader::unpackRayDirection(f.rays[i].direction);
+                // 16-bit octahedral packing: ~5e-5 rad.
+                REQUIRE(glm::length(got - expected) < 2e-4f);
+            }
+        }
+    }
+}
+
+TEST_CASE("roughness above the cutoff gives no ray, and no tile is listed") {
+    test::GpuTest gpu;
+    const RayFrame f = generate(gpu, floorScene(0.5f), {0}).front();
+    for (uint32_t y = 0; y < kSize; ++y) {
+        for (uint32_t x = 0; x < kSize; ++x) {
+            INFO("pixel " << x << ", " << y);
+            const size_t i = f.at(x, y);
+            REQUIRE(f.classes[i] == (isFloor(y) ? shader::kPixelEnv : shader::kPixelSky));
+            REQUIRE(f.rays[i].pixelFlags == shader::kNoRay);
+        }
+    }
+    CHECK(f.args == std::array<uint32_t, 6>{0, 1, 1, 0, 1, 1});
+}
+
+TEST_CASE("rough rays stay in the upper hemisphere of the normal over many frames, grazing rows included") {
+    test::GpuTest gpu;
+    passes::RayGenerationSettings settings;
+    settings.reuse = false;  // every pixel samples its own direction
+    std::vector<uint64_t> frameIndices;
+    for (uint64_t i = 0; i < 16; ++i) frameIndices.push_back(i * 977);
+    const std::vector<RayFrame> frames = generate(gpu, floorScene(0.2f), frameIndices, settings);
+    uint32_t rays = 0;
+    double meanCosine = 0.0;
+    for (const RayFrame& f : frames) {
+        for (uint32_t y = kSize / 2; y < kSize; ++y) {
+            for (uint32_t x = 0; x < kSize; ++x) {
+                const shader::PackedRay& ray = f.rays[f.at(x, y)];
+                INFO("pixel " << x << ", " << y);
+                REQUIRE(ray.pixelFlags == shader::packRayPixel({x, y}, false));
+                const glm::vec3 l = shader::unpackRayDirection(ray.direction);
+                REQUIRE(l.y > 0.0f);
+                meanCosine += l.y;
+                ++rays;
+            }
+        }
+    }
+    CHECK(rays == 16u * kSize * kSize / 2);
+    // The rays are rough, not mirrors: successive frames differ.
+    CHECK(frames[0].rays[frames[0].at(10, 50)].direction != frames[1].rays[frames[1].at(10, 50)].direction);
+    CHECK(meanCosine / rays > 0.0);
+}
+
+TEST_CASE("the same frame index gives the same rays") {
+    test::GpuTest gpu;
+    const std::vector<RayFrame> frames = generate(gpu, floorScene(0.15f), {5, 5});
+    for (size_t i = 0; i < frames[0].rays.size(); ++i) {
+        REQUIRE(frames[0].rays[i].pixelFlags == frames[1].rays[i].pixelFlags);
+        REQUIRE(frames[0].rays[i].direction == frames[1].rays[i].direction);
+    }
+}
+
+TEST_CASE("the distance split classes pixels, and tile lists and indirect args agree with a CPU count") {
+    test::GpuTest gpu;
+    passes::RayGenerationSettings settings;
+    settings.rtMaxDistance = 3.0f;
+    settings.sslrMinDistance = 8.0f;
+    const RayFrame f = generate(gpu, floorScene(0.05f), {0}, settings).front();
+    constexpr uint32_t kTiles = kSize / shader::kTileSize;
+    std::set<uint32_t> sslr, rt;
+    std::array<uint32_t, shader::kPixelClassCount> counts{};
+    for (uint32_t y = 0; y < kSize; ++y) {
+        for (uint32_t x = 0; x < kSize; ++x) {
+            const uint32_t c = f.classes[f.at(x, y)];
+            REQUIRE(c < shader::kPixelClassCount);
+            ++counts[c];
+            const uint32_t tile = (x / shader::kTileSize) | ((y / shader::kTileSize) << 16);
+            if (c == shader::kPixelSslr || c == shader::kPixelHybrid) sslr.insert(tile);
+            if (c == shader::kPixelRt) rt.insert(tile);
+            if (!isFloor(y)) continue;
+            // The floor y = -1 along view ray d is at distance 1 / -d.y.
+            const float distance = 1.0f / -viewRay(x, y).y;
+            INFO("pixel " << x << ", " << y << " at distance " << distance);
+            if (distance < 0.99f * 3.0f) REQUIRE(c == shader::kPixelRt);
+            if (distance > 1.01f * 3.0f && distance < 0.99f * 8.0f) REQUIRE(c == shader::kPixelHybrid);
+            if (distance > 1.01f * 8.0f) REQUIRE(c == shader::kPixelSslr);
+        }
+    }
+    // All three ray classes occur, so the lists are really exercised.
+    CHECK(counts[shader::kPixelRt] > 0);
+    CHECK(counts[shader::kPixelHybrid] > 0);
+    CHECK(counts[shader::kPixelSslr] > 0);
+    CHECK(counts[shader::kPixelSky] == kSize * kSize / 2);
+    REQUIRE(f.args[0] == sslr.size());
+    REQUIRE(f.args[3] == rt.size());
+    CHECK(f.args[1] == 1);
+    CHECK(f.args[2] == 1);
+    CHECK(f.args[4] == 1);
+    CHECK(f.args[5] == 1);
+    CHECK(sslr.size() < kTiles * kTiles);
+    const std::set<uint32_t> listedSslr(f.sslrTiles.begin(), f.sslrTiles.begin() + f.args[0]);
+    const std::set<uint32_t> listedRt(f.rtTiles.begin(), f.rtTiles.begin() + f.args[3]);
+    CHECK(listedSslr == sslr);  // and, being sets of the listed size, no duplicates
+    CHECK(listedSslr.size() == f.args[0]);
+    CHECK(listedRt == rt);
+    CHECK(listedRt.size() == f.args[3]);
+}
+
+TEST_CASE("rough 2x2 quads share their leader's ray, and the leader rotates with the frame") {
+    test::GpuTest gpu;
+    passes::RayGenerationSettings settings;
+    settings.sslrMinDistance = 1e9f;  // RT and hybrid only
+    const std::vector<RayFrame> frames = generate(gpu, floorScene(0.15f), {0, 1, 2, 3}, settings);
+    for (uint32_t frame = 0; frame < frames.size(); ++frame) {
+        const RayFrame& f = frames[frame];
+        const uint32_t lx = frame & 1u, ly = frame >> 1u;
+        uint32_t sharedQuads = 0;
+        for (uint32_t qy = kSize / 2; qy < kSize; qy += 2) {
+            for (uint32_t qx = 0; qx < kSize; qx += 2) {
+                const uint32_t c = f.classes[f.at(qx, qy)];
+                bool sameClass = true;
+                for (uint32_t k = 0; k < 4; ++k) sameClass &= f.classes[f.at(qx + (k & 1), qy + (k >> 1))] == c;
+                if (!sameClass) continue;
+                INFO("frame " << frame << ", quad " << qx << ", " << qy);
+                const shader::PackedRay& leader = f.rays[f.at(qx + lx, qy + ly)];
+                REQUIRE(leader.pixelFlags == shader::packRayPixel({qx + lx, qy + ly}, false));
+                for (uint32_t k = 0; k < 4; ++k) {
+                    const uint32_t x = qx + (k & 1), y = qy + (k >> 1);
+                    if (x == qx + lx && y == qy + ly) continue;
+                    const shader::PackedRay& ray = f.rays[f.at(x, y)];
+                    REQUIRE(ray.pixelFlags == shader::packRayPixel({qx + lx, qy + ly}, true));
+                    REQUIRE(ray.direction == leader.direction);
+                }
+                ++sharedQuads;
+            }
+        }
+        CHECK(sharedQuads > kSize * kSize / 4 / 2 - 2 * kSize);
+    }
+}
+
+TEST_CASE("below the reuse roughness every pixel keeps its own ray") {
+    test::GpuTest gpu;
+    const RayFrame f = generate(gpu, floorScene(0.05f), {0}).front();
+    for (uint32_t y = kSize / 2; y < kSize; ++y) {
+        for (uint32_t x = 0; x < kSize; ++x) {
+            REQUIRE(f.rays[f.at(x, y)].pixelFlags == shader::packRayPixel({x, y}, false));
+        }
+    }
+}
