@@ -1,0 +1,158 @@
+#include "passes/sslr.h"
+
+#include "gpu/descriptors.h"
+#include "gpu/error.h"
+#include "graph/executor.h"
+
+#include "glint/ray_generation_shared.h"
+#include "glint/sslr_shared.h"
+
+#include <array>
+#include <cmath>
+
+namespace glint::passes {
+
+namespace {
+
+constexpr uint32_t kBindingCount = 11;
+
+std::vector<gpu::Binding> traceBindings() {
+    std::vector<gpu::Binding> bindings;
+    for (uint32_t i = 0; i < kBindingCount; ++i) {
+        VkDescriptorType type = VK_DESCRIPTOR_TYPE_STORAGE_BUFFER;
+        if (i < 3) type = VK_DESCRIPTOR_TYPE_COMBINED_IMAGE_SAMPLER;
+        if (i >= 6 && i <= 8) type = VK_DESCRIPTOR_TYPE_STORAGE_IMAGE;
+        bindings.push_back({i, type, VK_SHADER_STAGE_COMPUTE_BIT});
+    }
+    return bindings;
+}
+
+// The trace inverts the projection from P00, P11, P22 and P32 alone
+// (glint/sslr_shared.h); anything else (an off-centre or orthographic
+// projection) would be reconstructed wrongly, so it is refused.
+void checkProjection(const glm::mat4& p) {
+    const bool perspective = p[2][0] == 0.0f && p[2][1] == 0.0f && p[2][3] == -1.0f && p[3][3] == 0.0f &&
+                             p[0][1] == 0.0f && p[1][0] == 0.0f && p[3][0] == 0.0f && p[3][1] == 0.0f;
+    if (!perspective) {
+        throw gpu::GpuError("addSslrPass: the projection must be an unjittered, centred perspective");
+    }
+}
+
+} // namespace
+
+SslrPipelines::SslrPipelines(gpu::Context& ctx)
+    : ctx_(ctx),
+      trace_(gpu::createComputePipeline(
+          ctx, {"sslr/trace.comp", traceBindings(), uint32_t(sizeof(shader::SslrConstants)), "sslr.trace"})),
+      // Every read is a texelFetch; the sampler only completes the combined
+      // descriptor.
+      nearest_(ctx, {VK_FILTER_NEAREST, VK_SAMPLER_MIPMAP_MODE_NEAREST, VK_SAMPLER_ADDRESS_MODE_CLAMP_TO_EDGE, 0.0f,
+                     "sslr.nearest"}) {}
+
+SslrOutputs addSslrPass(rg::Graph& graph, SslrPipelines& pipelines, const SslrInputs& inputs,
+                        const SslrSettings& settings) {
+    const GBufferOutputs& gbuf = inputs.gbuffer;
+    const RayGenerationOutputs& rays = inputs.rays;
+    if (gbuf.width == 0 || gbuf.height == 0 || rays.width != gbuf.width || rays.height != gbuf.height) {
+        throw gpu::GpuError("addSslrPass: the G-buffer and the rays must have the same, non-zero size");
+    }
+    if (settings.linearSteps == 0) {
+        throw gpu::GpuError("addSslrPass: linearSteps must be at least 1");
+    }
+    checkProjection(inputs.projection);
+
+    SslrOutputs out;
+    out.width = gbuf.width;
+    out.height = gbuf.height;
+    const uint64_t pixels = uint64_t(gbuf.width) * gbuf.height;
+
+    // Every frame starts from an empty RT list (group count 0, y = z = 1)
+    // and zero radiance and confidence: only listed tiles' leaders are
+    // written, and later passes read the rest as "no reflection yet".
+    struct ClearData {
+        rg::Texture radiance, confidence, hitDebug;
+        rg::Buffer args;
+    };
+    const ClearData& clear = graph.addPass<ClearData>(
+        "sslr.clear", rg::Queue::Graphics,
+        [&](rg::Builder& b, ClearData& d) {
+            const auto texture = [&](const char* name, VkFormat format) {
+                return b.write(b.createTexture(name, {.width = gbuf.width, .height = gbuf.height, .format = format}),
+                               rg::Access::TransferDst);
+            };
+            d.radiance = texture("sslr.radiance", kSslrRadianceFormat);
+            d.confidence = texture("sslr.confidence", kSslrConfidenceFormat);
+            d.hitDebug = texture("sslr.hit_debug", kSslrHitDebugFormat);
+            d.args = b.write(b.createBuffer("sslr.rt_args", {shader::kSslrRtArgsWords * 4u}), rg::Access::TransferDst);
+        },
+        [](const ClearData& d, rg::PassContext& pc) {
+            const std::array<uint32_t, shader::kSslrRtArgsWords> initial = {0, 1, 1, 0};
+            vkCmdUpdateBuffer(pc.cmd(), pc.buffer(d.args).handle(), 0, sizeof(initial), initial.data());
+            const VkClearColorValue zero{};
+            const VkImageSubresourceRange range{VK_IMAGE_ASPECT_COLOR_BIT, 0, 1, 0, 1};
+            for (const rg::Texture t : {d.radiance, d.confidence, d.hitDebug}) {
+                vkCmdClearColorImage(pc.cmd(), pc.image(t).handle(), pc.layout(t), &zero, 1, &range);
+            }
+        });
+
+    shader::SslrConstants constants{};
+    constants.view = inputs.view;
+    const glm::mat4& p = inputs.projection;
+    constants.projection = {p[0][0], p[1][1], p[2][2], p[3][2]};
+    constants.size = {gbuf.width, gbuf.height};
+    // The same 32-bit frame as ray generation's noise (glint/sampling.glsl).
+    constants.frame = uint32_t(inputs.frameIndex);
+    constants.linearSteps = settings.linearSteps;
+    constants.refineSteps = settings.refineSteps;
+    constants.thickness = settings.thickness;
+    constants.maxDistance = settings.maxDistance;
+    constants.edgeFade = settings.edgeFade;
+    constants.confidenceThreshold = settings.confidenceThreshold;
+
+    struct TraceData {
+        rg::Texture depth, normal, lit;
+        rg::Buffer rays, classes, tiles, tileArgs;
+        SslrOutputs out;
+    };
+    const TraceData& trace = graph.addPass<TraceData>(
+        "sslr", rg::Queue::Graphics,
+        [&](rg::Builder& b, TraceData& d) {
+            d.depth = b.read(gbuf.depth, rg::Access::SampledRead);
+            d.normal = b.read(gbuf.normal, rg::Access::SampledRead);
+            d.lit = b.read(gbuf.lit, rg::Access::SampledRead);
+            d.rays = b.read(rays.rays, rg::Access::StorageRead);
+            d.classes = b.read(rays.classes, rg::Access::StorageRead);
+            d.tiles = b.read(rays.sslrTiles, rg::Access::StorageRead);
+            d.tileArgs = b.read(rays.indirectArgs, rg::Access::IndirectArgs);
+            d.out = out;
+            d.out.radiance = b.write(clear.radiance, rg::Access::StorageWrite);
+            d.out.confidence = b.write(clear.confidence, rg::Access::StorageWrite);
+            d.out.hitDebug = b.write(clear.hitDebug, rg::Access::StorageWrite);
+            d.out.rtRayList = b.write(b.createBuffer("sslr.rt_rays", {pixels * sizeof(shader::PackedRay)}),
+                                      rg::Access::StorageWrite);
+            d.out.rtArgs = b.write(clear.args, rg::Access::StorageReadWrite);
+        },
+        [&pipelines, constants](const TraceData& d, rg::PassContext& pc) {
+            const gpu::Pipeline& pipeline = pipelines.trace_;
+            const VkSampler sampler = pipelines.nearest_.handle();
+            pipeline.bind(pc.cmd());
+            gpu::PushDescriptors(pipeline)
+                .sampledImage(0, pc.view(d.depth), sampler, pc.layout(d.depth))
+                .sampledImage(1, pc.view(d.normal), sampler, pc.layout(d.normal))
+                .sampledImage(2, pc.view(d.lit), sampler, pc.layout(d.lit))
+                .storageBuffer(3, pc.buffer(d.rays))
+                .storageBuffer(4, pc.buffer(d.classes))
+                .storageBuffer(5, pc.buffer(d.tiles))
+                .storageImage(6, pc.view(d.out.radiance))
+                .storageImage(7, pc.view(d.out.confidence))
+                .storageImage(8, pc.view(d.out.hitDebug))
+                .storageBuffer(9, pc.buffer(d.out.rtRayList))
+                .storageBuffer(10, pc.buffer(d.out.rtArgs))
+                .push(pipelines.ctx_, pc.cmd());
+            pipeline.pushConstants(pc.cmd(), constants);
+            pc.dispatchIndirect(pipeline, d.tileArgs, kSslrArgsBytes);
+        });
+    return trace.out;
+}
+
+} // namespace glint::passes

@@ -1,0 +1,92 @@
+#pragma once
+// Pass 3 of the reflection pipeline (issue 5): screen-space reflections.
+// One compute pass, dispatched indirectly over ray generation's SSLR tile
+// list (8x8 tiles), traces each ray leader of the SSLR and hybrid pixels
+// across the depth buffer: a linear march of large steps with a per-pixel
+// random start offset, then binary refinement (Far Cry 6 talk, DESIGN.md
+// section 3). It writes the lit colour at the hit and a confidence in
+// [0, 1], and lists the hybrid rays below the confidence threshold, with
+// indirect args, for the ray-traced pass. Layouts: glint/sslr_shared.h.
+//
+//   passes::SslrPipelines sslrPipelines(ctx);           // once
+//   each frame, after the ray generation:
+//     const auto sslr = passes::addSslrPass(graph, sslrPipelines, {gbuf, rays, frame, camera}, {});
+//     ... RT: dispatchIndirect(sslr.rtArgs) over sslr.rtRayList ...
+
+#include "gpu/context.h"
+#include "gpu/pipeline.h"
+#include "gpu/resources.h"
+#include "graph/graph.h"
+#include "passes/gbuffer.h"
+#include "passes/ray_generation.h"
+
+#include <glm/glm.hpp>
+
+#include <cstdint>
+
+namespace glint::passes {
+
+inline constexpr VkFormat kSslrRadianceFormat = VK_FORMAT_R16G16B16A16_SFLOAT;
+inline constexpr VkFormat kSslrConfidenceFormat = VK_FORMAT_R16_SFLOAT;
+inline constexpr VkFormat kSslrHitDebugFormat = VK_FORMAT_R16G16B16A16_SFLOAT;
+
+struct SslrInputs {
+    GBufferOutputs gbuffer;
+    RayGenerationOutputs rays;
+    // The frame index ray generation used: it drives the start offsets.
+    uint64_t frameIndex = 0;
+    // The G-buffer's unjittered camera: world -> view and view -> clip in
+    // scene::perspectiveReversedZ's form (the trace inverts it per pixel
+    // from four entries; glint/sslr_shared.h).
+    glm::mat4 view{1.0f};
+    glm::mat4 projection{1.0f};
+};
+
+struct SslrSettings {
+    // Large linear steps, then refinement steps: issue 5's 64 + 8, the
+    // Far Cry 6 talk's linear-then-refine trace (DESIGN.md section 3).
+    uint32_t linearSteps = 64;
+    uint32_t refineSteps = 8;
+    // A hit counts when the refined point lies at most this fraction of
+    // the surface's view distance behind the depth buffer (which has no
+    // thickness of its own); a relative test holds at every distance.
+    // Glint's starting value, not a published one: the bench tunes it.
+    float thickness = 0.02f;
+    // Length of a ray in view units; a ray that meets nothing within it misses.
+    float maxDistance = 1000.0f;
+    // Confidence fades to zero over this fraction of the image at each
+    // border, where neighbouring rays start to leave the screen (FidelityFX
+    // SSSR's hit validation fades the same way). Glint's starting value.
+    float edgeFade = 0.05f;
+    // Hybrid rays below this confidence go to the ray tracer: the Far Cry 6
+    // talk's 0.9 (DESIGN.md section 3).
+    float confidenceThreshold = 0.9f;
+};
+
+struct SslrOutputs {
+    rg::Texture radiance;    // kSslrRadianceFormat: lit colour at the hit, a = hit
+    rg::Texture confidence;  // kSslrConfidenceFormat, [0, 1]
+    rg::Texture hitDebug;    // kSslrHitDebugFormat: hit uv, confidence, hit (debug view "sslr_hits")
+    rg::Buffer rtRayList;    // shader::PackedRay per listed ray (capacity: one per pixel)
+    rg::Buffer rtArgs;       // VkDispatchIndirectCommand at 0, ray count at word kSslrRtCountOffset
+    uint32_t width = 0;
+    uint32_t height = 0;
+};
+
+// The pipeline and the sampler the pass records with; created once.
+class SslrPipelines {
+public:
+    explicit SslrPipelines(gpu::Context& ctx);
+
+private:
+    friend SslrOutputs addSslrPass(rg::Graph&, SslrPipelines&, const SslrInputs&, const SslrSettings&);
+    gpu::Context& ctx_;
+    gpu::Pipeline trace_;
+    gpu::Sampler nearest_;
+};
+
+// Declares the pass (see the top of this file) on the graphics queue.
+SslrOutputs addSslrPass(rg::Graph& graph, SslrPipelines& pipelines, const SslrInputs& inputs,
+                        const SslrSettings& settings = {});
+
+} // namespace glint::passes

@@ -1,0 +1,206 @@
+#version 460
+// Screen-space reflections (passes/sslr.h): one 8x8 workgroup per tile of
+// ray generation's SSLR list (dispatched indirectly from its args). Each
+// ray leader of an SSLR or hybrid pixel marches its ray across the depth
+// buffer in screen space: kLinearSteps large steps with a per-pixel random
+// start offset, then a binary search between the last step in front of the
+// surface and the first behind it (the Far Cry 6 talk's linear-then-refine
+// trace; issue 5's 64 + 8 steps). Hits sample the lit colour; the
+// confidence falls to zero for misses, thick or back-facing hits and near
+// the screen border, and hybrid rays below the threshold are listed for RT.
+#extension GL_GOOGLE_include_directive : require
+#extension GL_EXT_scalar_block_layout : require
+
+#include "glint/ray_generation_shared.h"
+#include "glint/sampling.glsl"
+#include "glint/sslr_shared.h"
+
+layout(local_size_x = 8, local_size_y = 8) in;
+
+layout(set = 0, binding = 0) uniform sampler2D depthTexture;
+layout(set = 0, binding = 1) uniform sampler2D normalTexture;
+layout(set = 0, binding = 2) uniform sampler2D litTexture;
+layout(set = 0, binding = 3, scalar) readonly buffer Rays { PackedRay rays[]; };
+layout(set = 0, binding = 4, scalar) readonly buffer Classes { uint classes[]; };
+layout(set = 0, binding = 5, scalar) readonly buffer SslrTiles { uint sslrTiles[]; };
+layout(set = 0, binding = 6, rgba16f) uniform writeonly image2D radianceImage;
+// R16F is not among the formats every device can store with a format
+// qualifier; the context enables shaderStorageImageWriteWithoutFormat.
+layout(set = 0, binding = 7) uniform writeonly image2D confidenceImage;
+layout(set = 0, binding = 8, rgba16f) uniform writeonly image2D hitDebugImage;
+layout(set = 0, binding = 9, scalar) writeonly buffer RtRays { PackedRay rtRays[]; };
+layout(set = 0, binding = 10, scalar) buffer RtArgs { uint rtArgs[]; };
+
+layout(push_constant, scalar) uniform Constants { SslrConstants pc; };
+
+// View-space z (negative in front of the camera) of a reversed-Z depth;
+// see SslrConstants for the projection's form. Depth 0 (the sky) is
+// infinitely far: the caller tests it first.
+float viewZ(float depth) { return -pc.projection.w / (depth + pc.projection.z); }
+
+// View-space position of a pixel position (in pixels) at a depth.
+vec3 viewPosition(vec2 pixelPosition, float depth) {
+    const vec2 ndc = pixelPosition / vec2(pc.size) * 2.0 - 1.0;
+    const float z = viewZ(depth);
+    return vec3(ndc.x * -z / pc.projection.x, ndc.y * -z / pc.projection.y, z);
+}
+
+// Homogeneous clip position (x, y, w) of a view-space point.
+vec3 clipXYW(vec3 p) { return vec3(pc.projection.x * p.x, pc.projection.y * p.y, -p.z); }
+
+vec2 toPixels(vec3 clip) { return (clip.xy / clip.z * 0.5 + 0.5) * vec2(pc.size); }
+
+struct March {
+    vec2 start;   // pixels
+    vec2 delta;   // pixels, start to end
+    float k0;     // 1 / w at the start (linear in screen space)
+    float dk;
+};
+
+// How far the ray at screen parameter t lies behind the depth buffer, in
+// view units (positive: behind), and whether the texel is sky.
+float behind(March m, float t, out ivec2 texel, out bool sky) {
+    const vec2 pos = m.start + t * m.delta;
+    texel = clamp(ivec2(floor(pos)), ivec2(0), ivec2(pc.size) - 1);
+    const float depth = texelFetch(depthTexture, texel, 0).x;
+    sky = depth <= 0.0;
+    const float rayDistance = 1.0 / (m.k0 + t * m.dk);
+    return sky ? -1.0 : rayDistance - (-viewZ(depth));
+}
+
+void writeResult(ivec2 pixel, vec3 radiance, float confidence, vec2 hitUv, bool hit) {
+    imageStore(radianceImage, pixel, vec4(radiance, hit ? 1.0 : 0.0));
+    imageStore(confidenceImage, pixel, vec4(confidence));
+    imageStore(hitDebugImage, pixel, vec4(hitUv, confidence, hit ? 1.0 : 0.0));
+}
+
+void main() {
+    const uint tile = sslrTiles[gl_WorkGroupID.x];
+    const uvec2 pixel = uvec2(tile & 0xFFFFu, tile >> 16u) * kTileSize + gl_LocalInvocationID.xy;
+    if (pixel.x >= pc.size.x || pixel.y >= pc.size.y) {
+        return;
+    }
+    const uint index = pixel.y * pc.size.x + pixel.x;
+    const uint pixelClass = classes[index];
+    const PackedRay ray = rays[index];
+    // Followers read their leader's result (ray_generation_shared.h); RT
+    // pixels of a mixed tile belong to the RT pass.
+    if ((pixelClass != kPixelSslr && pixelClass != kPixelHybrid) || ray.pixelFlags == kNoRay ||
+        (ray.pixelFlags & kRayReused) != 0u) {
+        return;
+    }
+    const ivec2 p = ivec2(pixel);
+    const vec2 centre = vec2(pixel) + 0.5;
+    const vec3 origin = viewPosition(centre, texelFetch(depthTexture, p, 0).x);
+    const vec3 direction = normalize(mat3(pc.view) * unpackRayDirection(ray.direction));
+
+    // Clip the ray in view space: no further than maxDistance, and in
+    // front of the near plane (z = -P32 where depth is 1) so w stays > 0.
+    float rayLength = pc.maxDistance;
+    const float nearZ = -pc.projection.w / (1.0 + pc.projection.z);
+    if (direction.z > 0.0) {
+        rayLength = min(rayLength, (nearZ - origin.z) / direction.z * 0.99);
+    }
+    const vec3 clip0 = clipXYW(origin);
+    const vec3 clip1 = clipXYW(origin + rayLength * direction);
+    March m;
+    m.start = toPixels(clip0);
+    m.delta = toPixels(clip1) - m.start;
+    m.k0 = 1.0 / clip0.z;
+    m.dk = 1.0 / clip1.z - m.k0;
+
+    // Screen exit: the largest t in [0, 1] with the position inside the image.
+    float tEnd = 1.0;
+    for (int axis = 0; axis < 2; ++axis) {
+        const float d = m.delta[axis];
+        if (abs(d) > 1e-6) {
+            const float bound = d > 0.0 ? float(pc.size[axis]) : 0.0;
+            tEnd = min(tEnd, (bound - m.start[axis]) / d);
+        }
+    }
+    tEnd = max(tEnd, 0.0);
+    const float pixelsPerT = length(m.delta);
+
+    // The random start offset (a fraction of one step, new every frame)
+    // turns the banding of large steps into noise the temporal filter
+    // removes (Far Cry 6 talk).
+    const float jitter = frameNoise(pixel, pc.frame).x;
+    const float step = tEnd / float(pc.linearSteps);
+    float tFront = 0.0;
+    float tHit = -1.0;
+    ivec2 hitTexel = ivec2(0);
+    float gap = 0.0;
+    for (uint i = 0u; i < pc.linearSteps; ++i) {
+        const float t = (float(i) + jitter) * step;
+        // Within a pixel of the origin the ray can only find its own surface.
+        if (t * pixelsPerT < 1.0) {
+            tFront = t;
+            continue;
+        }
+        ivec2 texel;
+        bool sky;
+        const float d = behind(m, t, texel, sky);
+        if (sky || d < 0.0) {
+            tFront = t;
+            continue;
+        }
+        // A crossing: refine between the last point in front and this one.
+        float lo = tFront, hi = t;
+        ivec2 hiTexel = texel;
+        float hiGap = d;
+        for (uint j = 0u; j < pc.refineSteps; ++j) {
+            const float mid = 0.5 * (lo + hi);
+            ivec2 midTexel;
+            bool midSky;
+            const float md = behind(m, mid, midTexel, midSky);
+            if (midSky || md < 0.0) {
+                lo = mid;
+            } else {
+                hi = mid;
+                hiTexel = midTexel;
+                hiGap = md;
+            }
+        }
+        // Thickness test: the depth buffer holds only front surfaces, so a
+        // ray found far behind one passed behind it; keep marching.
+        const float surfaceDistance = -viewZ(texelFetch(depthTexture, hiTexel, 0).x);
+        if (hiGap <= pc.thickness * surfaceDistance) {
+            tHit = hi;
+            hitTexel = hiTexel;
+            gap = hiGap / (pc.thickness * surfaceDistance);
+            break;
+        }
+        tFront = t;
+    }
+
+    float confidence = 0.0;
+    vec3 radiance = vec3(0.0);
+    vec2 hitUv = vec2(0.0);
+    if (tHit >= 0.0) {
+        hitUv = (vec2(hitTexel) + 0.5) / vec2(pc.size);
+        radiance = texelFetch(litTexture, hitTexel, 0).rgb;
+        // Back faces: the hit surface must face the ray (world normals).
+        const vec3 worldDirection = unpackRayDirection(ray.direction);
+        const vec3 hitNormal = texelFetch(normalTexture, hitTexel, 0).xyz;
+        const float facing = dot(hitNormal, worldDirection) < 0.0 ? 1.0 : 0.0;
+        // Fade near the border, where neighbouring rays start to leave the
+        // screen, and as the hit's depth gap approaches the thickness (as
+        // FidelityFX SSSR validates its hits).
+        const vec2 border = min(hitUv, 1.0 - hitUv);
+        const float edge = clamp(min(border.x, border.y) / max(pc.edgeFade, 1e-6), 0.0, 1.0);
+        const float thick = 1.0 - smoothstep(0.5, 1.0, gap);
+        confidence = clamp(facing * edge * thick, 0.0, 1.0);
+    }
+    writeResult(p, radiance, confidence, hitUv, tHit >= 0.0);
+
+    // Only hybrid rays go on: SSLR-class pixels lie beyond the BVH's reach
+    // (DESIGN.md section 3), where the ray tracer could find nothing better.
+    if (pixelClass == kPixelHybrid && confidence < pc.confidenceThreshold) {
+        const uint slot = atomicAdd(rtArgs[kSslrRtCountOffset], 1u);
+        rtRays[slot] = ray;
+        // The slot that opens a group counts the group.
+        if (slot % kSslrRtGroupSize == 0u) {
+            atomicAdd(rtArgs[0], 1u);
+        }
+    }
+}
