@@ -3,6 +3,7 @@
 // reversed-Z depth, normal and material; moving objects and a moving camera
 // give the analytic motion in pixels; the plaza renders finite and covered.
 #include "support/gpu_test.h"
+#include "support/pass_test_scene.h"
 
 #include "gpu/error.h"
 #include "graph/executor.h"
@@ -27,8 +28,10 @@ using namespace glint;
 
 namespace {
 
-constexpr uint32_t kSize = 64;
-constexpr float kNear = 0.1f;
+constexpr uint32_t kSize = test::kPassTestSize;
+constexpr float kNear = test::kPassTestNear;
+using test::square;
+using test::testCamera;
 
 constexpr rg::BoundaryState kHostRead =
     rg::BoundaryState::raw(VK_PIPELINE_STAGE_2_HOST_BIT, VK_ACCESS_2_HOST_READ_BIT, VK_IMAGE_LAYOUT_UNDEFINED);
@@ -131,19 +134,6 @@ private:
     std::array<gpu::Buffer, 6> buffers_;
 };
 
-// A square of side 2 * halfSize in the plane through `center` spanned by
-// `u` and `v`, facing u x v.
-scene::Geometry square(glm::vec3 center, glm::vec3 u, glm::vec3 v, float halfSize) {
-    scene::Geometry g;
-    const glm::vec3 n = glm::normalize(glm::cross(u, v));
-    for (const glm::vec2 c : {glm::vec2(-1, -1), glm::vec2(1, -1), glm::vec2(1, 1), glm::vec2(-1, 1)}) {
-        g.positions.push_back(center + halfSize * (c.x * u + c.y * v));
-        g.normals.push_back(n);
-    }
-    g.indices = {0, 1, 2, 0, 2, 3};
-    return g;
-}
-
 // One material, one mesh of the given geometry, one static instance.
 scene::Scene singleObjectScene(scene::Geometry geometry, const scene::Material& material) {
     scene::Scene s;
@@ -158,17 +148,6 @@ scene::Scene singleObjectScene(scene::Geometry geometry, const scene::Material& 
     s.instances.push_back(inst);
     scene::prepareScene(s);
     return s;
-}
-
-// 90 degrees vertically on a square image: at distance d the image spans
-// [-d, d] in x and y, so one world unit at distance d is kSize / (2 d) pixels.
-scene::Camera testCamera(glm::vec3 position = glm::vec3(0.0f)) {
-    scene::Camera camera;
-    camera.resolution = {kSize, kSize};
-    camera.lens = {glm::radians(90.0f), kNear, scene::kInfiniteFar};
-    camera.jitter = false;
-    camera.reset({position, position + glm::vec3(0, 0, -1), {0, 1, 0}}, 0);
-    return camera;
 }
 
 GBufferImage render(test::GpuTest& gpu, const scene::Scene& scene, const std::vector<scene::Camera>& frames,

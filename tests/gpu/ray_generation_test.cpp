@@ -6,6 +6,7 @@
 // quads share one ray. The GGX sampler itself (glint/sampling.glsl) is
 // checked on the CPU against the analytic visible-normal distribution.
 #include "support/gpu_test.h"
+#include "support/pass_test_scene.h"
 
 #include "graph/executor.h"
 #include "graph/graph.h"
@@ -31,8 +32,10 @@ using namespace glint;
 
 namespace {
 
-constexpr uint32_t kSize = 64;
-constexpr float kNear = 0.1f;
+constexpr uint32_t kSize = test::kPassTestSize;
+constexpr float kNear = test::kPassTestNear;
+using test::square;
+using test::testCamera;
 
 constexpr rg::BoundaryState kHostRead =
     rg::BoundaryState::raw(VK_PIPELINE_STAGE_2_HOST_BIT, VK_ACCESS_2_HOST_READ_BIT, VK_IMAGE_LAYOUT_UNDEFINED);
@@ -114,19 +117,6 @@ private:
     std::array<gpu::Buffer, 5> buffers_;
 };
 
-// A square of side 2 * halfSize in the plane through `center` spanned by
-// `u` and `v`, facing u x v.
-scene::Geometry square(glm::vec3 center, glm::vec3 u, glm::vec3 v, float halfSize) {
-    scene::Geometry g;
-    const glm::vec3 n = glm::normalize(glm::cross(u, v));
-    for (const glm::vec2 c : {glm::vec2(-1, -1), glm::vec2(1, -1), glm::vec2(1, 1), glm::vec2(-1, 1)}) {
-        g.positions.push_back(center + halfSize * (c.x * u + c.y * v));
-        g.normals.push_back(n);
-    }
-    g.indices = {0, 1, 2, 0, 2, 3};
-    return g;
-}
-
 // A floor at y = -1 under a camera at the origin looking down -Z: the lower
 // half of the image is floor, the upper half sky, and the floor's rows near
 // the horizon are seen at grazing angles.
@@ -148,21 +138,10 @@ scene::Scene floorScene(float roughness) {
     return s;
 }
 
-// 90 degrees vertically on a square image (as the G-buffer test's camera).
-scene::Camera testCamera() {
-    scene::Camera camera;
-    camera.resolution = {kSize, kSize};
-    camera.lens = {glm::radians(90.0f), kNear, scene::kInfiniteFar};
-    camera.jitter = false;
-    camera.reset({glm::vec3(0.0f), glm::vec3(0, 0, -1), {0, 1, 0}}, 0);
-    return camera;
-}
-
 // The unit view ray through a pixel's centre (+y is down the image).
 glm::vec3 viewRay(uint32_t x, uint32_t y) {
-    const float ndcX = (float(x) + 0.5f) / float(kSize) * 2.0f - 1.0f;
-    const float ndcY = (float(y) + 0.5f) / float(kSize) * 2.0f - 1.0f;
-    return glm::normalize(glm::vec3(ndcX, -ndcY, -1.0f));
+    const glm::vec2 ndc = test::pixelNdc(x, y);
+    return glm::normalize(glm::vec3(ndc.x, -ndc.y, -1.0f));
 }
 
 // Renders the G-buffer and the ray generation for each frame index.

@@ -6,6 +6,7 @@
 // sky get zero confidence and go to the RT list, whose length and args
 // match a count on the CPU; nothing is NaN.
 #include "support/gpu_test.h"
+#include "support/pass_test_scene.h"
 
 #include "graph/executor.h"
 #include "graph/graph.h"
@@ -31,8 +32,10 @@ using namespace glint;
 
 namespace {
 
-constexpr uint32_t kSize = 64;
-constexpr float kNear = 0.1f;
+constexpr uint32_t kSize = test::kPassTestSize;
+constexpr float kNear = test::kPassTestNear;
+using test::square;
+using test::testCamera;
 // The wall: the plane z = -kWallDistance, facing the camera, from the
 // floor (y = -1) up to y = kWallTop.
 constexpr float kWallDistance = 6.0f;
@@ -148,18 +151,6 @@ private:
     std::array<gpu::Buffer, kBuffers + kTextures> buffers_;
 };
 
-scene::Geometry square(glm::vec3 center, glm::vec3 u, glm::vec3 v, float halfSize, uint32_t material) {
-    scene::Geometry g;
-    const glm::vec3 n = glm::normalize(glm::cross(u, v));
-    for (const glm::vec2 c : {glm::vec2(-1, -1), glm::vec2(1, -1), glm::vec2(1, 1), glm::vec2(-1, 1)}) {
-        g.positions.push_back(center + halfSize * (c.x * u + c.y * v));
-        g.normals.push_back(n);
-    }
-    g.indices = {0, 1, 2, 0, 2, 3};
-    g.material = material;
-    return g;
-}
-
 // A mirror floor at y = -1 and a rough red wall at z = -6 from the floor
 // to y = 1 (wide enough to fill the image), under a camera at the origin
 // looking down -Z. A rough wall (the default) traces nothing itself; a
@@ -190,27 +181,13 @@ scene::Scene mirrorScene(float wallRoughness = 1.0f) {
     return s;
 }
 
-scene::Camera testCamera() {
-    scene::Camera camera;
-    camera.resolution = {kSize, kSize};
-    camera.lens = {glm::radians(90.0f), kNear, scene::kInfiniteFar};
-    camera.jitter = false;
-    camera.reset({glm::vec3(0.0f), glm::vec3(0, 0, -1), {0, 1, 0}}, 0);
-    return camera;
-}
-
-// NDC of a pixel's centre (+y down the image, as the G-buffer draws it).
-glm::vec2 ndc(uint32_t x, uint32_t y) {
-    return {(float(x) + 0.5f) / float(kSize) * 2.0f - 1.0f, (float(y) + 0.5f) / float(kSize) * 2.0f - 1.0f};
-}
-
 // Where the mirror reflection of the view ray through a floor pixel meets
 // the wall's plane, in world units. The view ray (ndcX, -ndcY, -1) meets
 // the floor at depth 1 / ndcY; the reflection keeps x / z and climbs at the
 // slope it fell, so at z = -kWallDistance it is at
 // y = -1 + (kWallDistance - 1 / ndcY) ndcY and x = ndcX kWallDistance.
 glm::vec2 wallHit(uint32_t x, uint32_t y) {
-    const glm::vec2 n = ndc(x, y);
+    const glm::vec2 n = test::pixelNdc(x, y);
     return {n.x * kWallDistance, -1.0f + (kWallDistance * n.y - 1.0f)};
 }
 
