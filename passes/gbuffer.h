@@ -23,6 +23,7 @@
 #include "gpu/pipeline.h"
 #include "gpu/resources.h"
 #include "graph/graph.h"
+#include "passes/lighting.h"
 #include "scene/camera.h"
 #include "scene/scene.h"
 
@@ -46,14 +47,9 @@ struct GBufferInputs {
 };
 
 struct GBufferSettings {
-    // Scene lux -> lit-colour units, in which the procedural sky's colours
-    // are radiance. A clear sky gives about a fifth of the direct sun's
-    // illuminance (CIE clear sky: ~20 klx diffuse beside ~100 klx direct);
-    // a sky of radiance ~0.5 gives an irradiance of ~1.6, so a 100 klx sun
-    // becomes ~8 at this scale.
-    float sunIlluminanceScale = 8.0f / 100000.0f;
-    // Multiplies the sky's contribution (environment intensity still applies).
-    float ambientScale = 1.0f;
+    // The sun's and the sky's scale (passes/lighting.h); the hit shaders of
+    // the reflections must light with the same values.
+    LightingSettings lighting;
     // Fill uncovered pixels with the sky's radiance in the lit colour; off,
     // they keep the clear value (zero).
     bool drawSky = true;

@@ -70,6 +70,18 @@ vec3 skyIrradiance(SceneLighting l, vec3 n) {
     return mix(down, up, 0.5 + 0.5 * clamp(n.y, -1.0, 1.0));
 }
 
+// Radiance the environment reflects towards a surface of perceptual
+// `roughness` around the mirror direction `dir` (unit): the sky itself for
+// a mirror, blending towards the cosine-weighted irradiance over pi as the
+// GGX lobe widens (alpha = roughness^2 reaches a hemisphere near 1). The
+// gradient sky is smooth, so this stands in for a roughness-prefiltered
+// environment map; ray-traced misses, the SSLR fallback and the
+// environment-only pixels all use it, so they agree.
+vec3 environmentRadiance(SceneLighting l, vec3 dir, float roughness) {
+    const float alpha = clamp(roughness * roughness, 0.0, 1.0);
+    return mix(skyRadiance(l, dir), skyIrradiance(l, dir) / kPi, alpha);
+}
+
 // Sun (diffuse + specular) and diffuse sky light leaving `s` towards `toViewer`
 // (unit). `sunVisibility` is 1 unshadowed, 0 in shadow. Specular sky light
 // is left to the reflection passes.
