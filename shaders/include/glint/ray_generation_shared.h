@@ -57,6 +57,21 @@ GLINT_CONST uint kSslrArgsOffset = 0u;
 GLINT_CONST uint kRtArgsOffset = 3u;
 GLINT_CONST uint kIndirectArgsWords = 6u;
 
+// The RT ray list: PackedRay entries (one per pixel of capacity) of the
+// rays the ray tracer must trace. Ray generation appends its RT pixels' ray
+// leaders, SSLR appends the hybrid rays it could not resolve. Its args
+// buffer (kRtListArgsWords uints) serves both backends:
+//   words 0-2  VkDispatchIndirectCommand {ceil(count / kRtListGroupSize), 1, 1}
+//              (compute with ray query, kRtListGroupSize invocations per group)
+//   words 3-5  VkTraceRaysIndirectCommandKHR {count, 1, 1} (RT pipeline);
+//              word kRtListCountOffset is the list's length
+// Appenders reserve slots with atomicAdd on the count and raise the group
+// count with atomicMax, so both commands stay consistent.
+GLINT_CONST uint kRtListGroupSize = 64u;
+GLINT_CONST uint kRtListDispatchOffset = 0u;
+GLINT_CONST uint kRtListCountOffset = 3u;
+GLINT_CONST uint kRtListArgsWords = 6u;
+
 // Push constants of classify.comp (112 bytes).
 struct RayGenerationConstants {
     mat4 inverseViewProjection;  // unjittered
