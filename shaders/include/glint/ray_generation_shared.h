@@ -72,6 +72,11 @@ GLINT_CONST uint kRtListDispatchOffset = 0u;
 GLINT_CONST uint kRtListCountOffset = 3u;
 GLINT_CONST uint kRtListArgsWords = 6u;
 
+// The hit distance that stands for "at infinity" (a miss, the sky, the
+// environment): finite so that half floats hold it (their largest finite
+// value) and reprojection through the reflected point stays finite.
+GLINT_CONST float kMissHitDistance = 65504.0f;
+
 // Push constants of classify.comp (112 bytes).
 struct RayGenerationConstants {
     mat4 inverseViewProjection;  // unjittered
