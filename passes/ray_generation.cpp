@@ -11,11 +11,14 @@
 namespace glint::passes {
 
 static_assert(kSslrArgsBytes == shader::kSslrArgsOffset * sizeof(uint32_t));
-static_assert(kRtArgsBytes == shader::kRtArgsOffset * sizeof(uint32_t));
+static_assert(kRtDispatchArgsBytes == shader::kRtListDispatchOffset * sizeof(uint32_t));
+static_assert(kRtTraceArgsBytes == shader::kRtListCountOffset * sizeof(uint32_t));
+static_assert(uint32_t(ReflectionMode::Hybrid) == shader::kModeHybrid && uint32_t(ReflectionMode::Ssr) == shader::kModeSsr &&
+              uint32_t(ReflectionMode::Rt) == shader::kModeRt);
 
 namespace {
 
-constexpr uint32_t kBindingCount = 9;
+constexpr uint32_t kBindingCount = 11;
 
 std::vector<gpu::Binding> classifyBindings() {
     std::vector<gpu::Binding> bindings;
@@ -57,20 +60,25 @@ RayGenerationOutputs addRayGenerationPass(rg::Graph& graph, RayGenerationPipelin
     const uint64_t pixels = uint64_t(gbuf.width) * gbuf.height;
     const uint64_t tiles = uint64_t(out.tilesX) * out.tilesY;
 
-    // The lists count up from zero every frame, and a dispatch's y and z
-    // are 1: the args are reset by a transfer before the classification.
+    // The lists count up from zero every frame, and a dispatch's (or a
+    // trace's) y and z are 1: the args are reset by a transfer before the
+    // classification.
     struct ClearData {
-        rg::Buffer args;
+        rg::Buffer args, rtArgs;
     };
     const ClearData& clear = graph.addPass<ClearData>(
         "ray_generation.clear_args", rg::Queue::Graphics,
         [&](rg::Builder& b, ClearData& d) {
             d.args = b.write(b.createBuffer("ray_generation.indirect_args", {shader::kIndirectArgsWords * 4u}),
                              rg::Access::TransferDst);
+            d.rtArgs = b.write(b.createBuffer("ray_generation.rt_args", {shader::kRtListArgsWords * 4u}),
+                               rg::Access::TransferDst);
         },
         [](const ClearData& d, rg::PassContext& pc) {
-            const std::array<uint32_t, shader::kIndirectArgsWords> initial = {0, 1, 1, 0, 1, 1};
+            const std::array<uint32_t, shader::kIndirectArgsWords> initial = {0, 1, 1};
             vkCmdUpdateBuffer(pc.cmd(), pc.buffer(d.args).handle(), 0, sizeof(initial), initial.data());
+            const std::array<uint32_t, shader::kRtListArgsWords> rtInitial = {0, 1, 1, 0, 1, 1};
+            vkCmdUpdateBuffer(pc.cmd(), pc.buffer(d.rtArgs).handle(), 0, sizeof(rtInitial), rtInitial.data());
         });
 
     shader::RayGenerationConstants constants{};
@@ -85,9 +93,14 @@ RayGenerationOutputs addRayGenerationPass(rg::Graph& graph, RayGenerationPipelin
     constants.rtMaxDistance = settings.rtMaxDistance;
     constants.sslrMinDistance = settings.sslrMinDistance;
     constants.reuseEnabled = settings.reuse ? 1u : 0u;
+    constants.mode = uint32_t(settings.mode);
+    constants.tileModesEnabled = inputs.tileModes.valid() ? 1u : 0u;
+    constants.rtToHybridShare = settings.rtToHybridShare;
+    constants.tilesX = out.tilesX;
 
     struct ClassifyData {
         rg::Texture depth, normal, roughnessMetal;
+        rg::Buffer tileModes;
         RayGenerationOutputs out;
     };
     const ClassifyData& classify = graph.addPass<ClassifyData>(
@@ -96,6 +109,9 @@ RayGenerationOutputs addRayGenerationPass(rg::Graph& graph, RayGenerationPipelin
             d.depth = b.read(gbuf.depth, rg::Access::SampledRead);
             d.normal = b.read(gbuf.normal, rg::Access::SampledRead);
             d.roughnessMetal = b.read(gbuf.roughnessMetal, rg::Access::SampledRead);
+            if (inputs.tileModes.valid()) {
+                d.tileModes = b.read(inputs.tileModes, rg::Access::StorageRead);
+            }
             d.out = out;
             const auto buffer = [&](const char* name, uint64_t bytes) {
                 return b.write(b.createBuffer(name, {bytes}), rg::Access::StorageWrite);
@@ -103,8 +119,9 @@ RayGenerationOutputs addRayGenerationPass(rg::Graph& graph, RayGenerationPipelin
             d.out.rays = buffer("ray_generation.rays", pixels * sizeof(shader::PackedRay));
             d.out.classes = buffer("ray_generation.classes", pixels * sizeof(uint32_t));
             d.out.sslrTiles = buffer("ray_generation.sslr_tiles", tiles * sizeof(uint32_t));
-            d.out.rtTiles = buffer("ray_generation.rt_tiles", tiles * sizeof(uint32_t));
+            d.out.rtRays = buffer("ray_generation.rt_rays", pixels * sizeof(shader::PackedRay));
             d.out.indirectArgs = b.write(clear.args, rg::Access::StorageReadWrite);
+            d.out.rtArgs = b.write(clear.rtArgs, rg::Access::StorageReadWrite);
             d.out.classDebug = b.write(b.createTexture("ray_generation.class_debug",
                                                        {.width = gbuf.width, .height = gbuf.height,
                                                         .format = kRayClassDebugFormat}),
@@ -122,9 +139,13 @@ RayGenerationOutputs addRayGenerationPass(rg::Graph& graph, RayGenerationPipelin
                 .storageBuffer(3, pc.buffer(d.out.rays))
                 .storageBuffer(4, pc.buffer(d.out.classes))
                 .storageBuffer(5, pc.buffer(d.out.sslrTiles))
-                .storageBuffer(6, pc.buffer(d.out.rtTiles))
+                .storageBuffer(6, pc.buffer(d.out.rtRays))
                 .storageBuffer(7, pc.buffer(d.out.indirectArgs))
                 .storageImage(8, pc.view(d.out.classDebug))
+                .storageBuffer(9, pc.buffer(d.out.rtArgs))
+                // Without tile modes the shader never reads binding 10; the
+                // class buffer only completes the descriptor set.
+                .storageBuffer(10, pc.buffer(d.tileModes.valid() ? d.tileModes : d.out.classes))
                 .push(pipelines.ctx_, pc.cmd());
             pipeline.pushConstants(pc.cmd(), constants);
             pc.dispatch(pipeline, d.out.tilesX, d.out.tilesY);

@@ -8,8 +8,11 @@
 //     with per-pixel, per-frame low-discrepancy noise (glint/sampling.glsl);
 //   - on rough quads, shares one ray per 2x2 quad (the leader rotates with
 //     the frame);
-// and lists the 8x8 tiles that hold SSLR/hybrid or RT pixels, with one
-// VkDispatchIndirectCommand per list. Layouts: glint/ray_generation_shared.h.
+// and lists the 8x8 tiles that hold SSLR/hybrid pixels with their
+// VkDispatchIndirectCommand, and the ray leaders of the RT pixels in the RT
+// ray list (which SSLR extends with the hybrid rays it cannot resolve) with
+// args for compute and for vkCmdTraceRaysIndirectKHR. Layouts:
+// glint/ray_generation_shared.h.
 //
 //   passes::RayGenerationPipelines pipelines(ctx);     // once
 //   each frame, after the G-buffer:
@@ -27,9 +30,15 @@
 
 namespace glint::passes {
 
-// Byte offsets of the two dispatch commands in RayGenerationOutputs::indirectArgs.
+// Byte offset of the SSLR tiles' dispatch command in RayGenerationOutputs::indirectArgs.
 inline constexpr VkDeviceSize kSslrArgsBytes = 0;
-inline constexpr VkDeviceSize kRtArgsBytes = 3 * sizeof(uint32_t);
+// Byte offsets of the RT ray list's compute dispatch and trace-rays commands
+// in RayGenerationOutputs::rtArgs.
+inline constexpr VkDeviceSize kRtDispatchArgsBytes = 0;
+inline constexpr VkDeviceSize kRtTraceArgsBytes = 3 * sizeof(uint32_t);
+
+// Which trace resolves a pixel's reflection: issue 5's three modes.
+enum class ReflectionMode : uint32_t { Hybrid, Ssr, Rt };
 inline constexpr VkFormat kRayClassDebugFormat = VK_FORMAT_R8G8B8A8_UNORM;
 
 struct RayGenerationInputs {
@@ -38,6 +47,9 @@ struct RayGenerationInputs {
     uint64_t frameIndex = 0;
     // This frame's unjittered matrices and position; the G-buffer's camera.
     scene::Camera camera;
+    // The feedback pass's tile modes (u32 per tile, glint/feedback_shared.h)
+    // for the hybrid band; without them (invalid) hybrid pixels stay hybrid.
+    rg::Buffer tileModes;
 };
 
 struct RayGenerationSettings {
@@ -58,14 +70,21 @@ struct RayGenerationSettings {
     // Pixels at or beyond this go to SSLR only: the BVH covers a radius of
     // 100 around the camera (Far Cry 6 talk, DESIGN.md section 3).
     float sslrMinDistance = 100.0f;
+    ReflectionMode mode = ReflectionMode::Hybrid;
+    // Share of the hybrid-band pixels of a tile the feedback sends to RT that
+    // stay hybrid (tried with SSLR first) this frame, so that the tile's
+    // counters keep seeing SSLR and it can return to SSLR (Far Cry 6 talk,
+    // DESIGN.md section 3). Glint's starting value; the bench sweeps it.
+    float rtToHybridShare = 1.0f / 16.0f;
 };
 
 struct RayGenerationOutputs {
     rg::Buffer rays;          // shader::PackedRay per pixel
     rg::Buffer classes;       // uint per pixel: shader::kPixel*
     rg::Buffer sslrTiles;     // uint per listed tile: tx | ty << 16
-    rg::Buffer rtTiles;
-    rg::Buffer indirectArgs;  // VkDispatchIndirectCommand at kSslrArgsBytes and kRtArgsBytes
+    rg::Buffer indirectArgs;  // VkDispatchIndirectCommand over sslrTiles at kSslrArgsBytes
+    rg::Buffer rtRays;        // RT ray list: shader::PackedRay per RT ray leader (capacity: one per pixel)
+    rg::Buffer rtArgs;        // shader::kRtListArgsWords: dispatch at kRtDispatchArgsBytes, trace at kRtTraceArgsBytes
     rg::Texture classDebug;   // kRayClassDebugFormat: a colour per class (debug view "ray_classes")
     uint32_t width = 0;
     uint32_t height = 0;

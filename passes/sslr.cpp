@@ -64,14 +64,12 @@ SslrOutputs addSslrPass(rg::Graph& graph, SslrPipelines& pipelines, const SslrIn
     SslrOutputs out;
     out.width = gbuf.width;
     out.height = gbuf.height;
-    const uint64_t pixels = uint64_t(gbuf.width) * gbuf.height;
 
-    // Every frame starts from an empty RT list (group count 0, y = z = 1)
-    // and zero radiance and confidence: only listed tiles' leaders are
-    // written, and later passes read the rest as "no reflection yet".
+    // Every frame starts from zero radiance and confidence: only listed
+    // tiles' leaders are written, and later passes read the rest as "no
+    // reflection yet".
     struct ClearData {
         rg::Texture radiance, confidence, hitDebug;
-        rg::Buffer args;
     };
     const ClearData& clear = graph.addPass<ClearData>(
         "sslr.clear", rg::Queue::Graphics,
@@ -83,11 +81,8 @@ SslrOutputs addSslrPass(rg::Graph& graph, SslrPipelines& pipelines, const SslrIn
             d.radiance = texture("sslr.radiance", kSslrRadianceFormat);
             d.confidence = texture("sslr.confidence", kSslrConfidenceFormat);
             d.hitDebug = texture("sslr.hit_debug", kSslrHitDebugFormat);
-            d.args = b.write(b.createBuffer("sslr.rt_args", {shader::kSslrRtArgsWords * 4u}), rg::Access::TransferDst);
         },
         [](const ClearData& d, rg::PassContext& pc) {
-            const std::array<uint32_t, shader::kSslrRtArgsWords> initial = {0, 1, 1, 0};
-            vkCmdUpdateBuffer(pc.cmd(), pc.buffer(d.args).handle(), 0, sizeof(initial), initial.data());
             const VkClearColorValue zero{};
             const VkImageSubresourceRange range{VK_IMAGE_ASPECT_COLOR_BIT, 0, 1, 0, 1};
             for (const rg::Texture t : {d.radiance, d.confidence, d.hitDebug}) {
@@ -128,9 +123,9 @@ SslrOutputs addSslrPass(rg::Graph& graph, SslrPipelines& pipelines, const SslrIn
             d.out.radiance = b.write(clear.radiance, rg::Access::StorageWrite);
             d.out.confidence = b.write(clear.confidence, rg::Access::StorageWrite);
             d.out.hitDebug = b.write(clear.hitDebug, rg::Access::StorageWrite);
-            d.out.rtRayList = b.write(b.createBuffer("sslr.rt_rays", {pixels * sizeof(shader::PackedRay)}),
-                                      rg::Access::StorageWrite);
-            d.out.rtArgs = b.write(clear.args, rg::Access::StorageReadWrite);
+            // Appends after ray generation's RT rays.
+            d.out.rtRayList = b.write(rays.rtRays, rg::Access::StorageReadWrite);
+            d.out.rtArgs = b.write(rays.rtArgs, rg::Access::StorageReadWrite);
         },
         [&pipelines, constants](const TraceData& d, rg::PassContext& pc) {
             const gpu::Pipeline& pipeline = pipelines.trace_;

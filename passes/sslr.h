@@ -6,12 +6,13 @@
 // random start offset, then binary refinement (Far Cry 6 talk, DESIGN.md
 // section 3). It writes the lit colour at the hit and a confidence in
 // [0, 1], and lists the hybrid rays below the confidence threshold, with
-// indirect args, for the ray-traced pass. Layouts: glint/sslr_shared.h.
+// indirect args, for the ray-traced pass: it appends them to ray
+// generation's RT ray list. Layouts: glint/sslr_shared.h.
 //
 //   passes::SslrPipelines sslrPipelines(ctx);           // once
 //   each frame, after the ray generation:
 //     const auto sslr = passes::addSslrPass(graph, sslrPipelines, {gbuf, rays, frame, camera}, {});
-//     ... RT: dispatchIndirect(sslr.rtArgs) over sslr.rtRayList ...
+//     ... RT: dispatchIndirect(sslr.rtArgs, kRtDispatchArgsBytes) over sslr.rtRayList ...
 
 #include "gpu/context.h"
 #include "gpu/pipeline.h"
@@ -67,8 +68,8 @@ struct SslrOutputs {
     rg::Texture radiance;    // kSslrRadianceFormat: lit colour at the hit, a = hit
     rg::Texture confidence;  // kSslrConfidenceFormat, [0, 1]
     rg::Texture hitDebug;    // kSslrHitDebugFormat: hit uv, confidence, hit (debug view "sslr_hits")
-    rg::Buffer rtRayList;    // shader::PackedRay per listed ray (capacity: one per pixel)
-    rg::Buffer rtArgs;       // VkDispatchIndirectCommand at 0, ray count at word kSslrRtCountOffset
+    rg::Buffer rtRayList;    // ray generation's RT ray list with the unresolved hybrid rays appended
+    rg::Buffer rtArgs;       // its args (glint/ray_generation_shared.h kRtList*)
     uint32_t width = 0;
     uint32_t height = 0;
 };

@@ -3,10 +3,12 @@
 // workgroup per 8x8 tile. Each pixel is classified (sky, env, SSLR,
 // hybrid, RT), draws one GGX visible-normal reflection ray, and rough
 // pixels of a 2x2 quad share the quad leader's ray; the tile then appends
-// itself to the SSLR and/or RT list and counts itself in the indirect args.
+// itself to the SSLR tile list and its RT pixels' ray leaders to the RT ray
+// list, counting both in their indirect args.
 #extension GL_GOOGLE_include_directive : require
 #extension GL_EXT_scalar_block_layout : require
 
+#include "glint/feedback_shared.h"
 #include "glint/ray_generation_shared.h"
 #include "glint/sampling.glsl"
 
@@ -18,9 +20,13 @@ layout(set = 0, binding = 2) uniform sampler2D roughnessMetalTexture;
 layout(set = 0, binding = 3, scalar) writeonly buffer Rays { PackedRay rays[]; };
 layout(set = 0, binding = 4, scalar) writeonly buffer Classes { uint classes[]; };
 layout(set = 0, binding = 5, scalar) writeonly buffer SslrTiles { uint sslrTiles[]; };
-layout(set = 0, binding = 6, scalar) writeonly buffer RtTiles { uint rtTiles[]; };
+layout(set = 0, binding = 6, scalar) writeonly buffer RtRays { PackedRay rtRays[]; };
 layout(set = 0, binding = 7, scalar) buffer Args { uint args[]; };
 layout(set = 0, binding = 8, rgba8) uniform writeonly image2D classDebug;
+layout(set = 0, binding = 9, scalar) buffer RtArgs { uint rtArgs[]; };
+// The feedback pass's kTileMode* per tile (glint/feedback_shared.h); read
+// only when pc.tileModesEnabled is 1.
+layout(set = 0, binding = 10, scalar) readonly buffer TileModes { uint tileModes[]; };
 
 layout(push_constant, scalar) uniform Constants { RayGenerationConstants pc; };
 
@@ -28,12 +34,41 @@ shared uint sharedClass[64];
 shared uint sharedRough[64];  // 1: may share its quad's ray
 shared uint sharedDirection[64];
 shared uint sharedSslr;
-shared uint sharedRt;
+shared uint sharedRtCount;  // RT ray leaders of the tile
+shared uint sharedRtBase;   // their first slot in the RT list
 
 // Colours of the classes for the debug view: black sky, grey env, blue
 // SSLR, purple hybrid, red RT.
 const vec4 kClassColours[5] = vec4[5](vec4(0.0, 0.0, 0.0, 1.0), vec4(0.5, 0.5, 0.5, 1.0), vec4(0.1, 0.3, 1.0, 1.0),
                                       vec4(0.7, 0.2, 0.9, 1.0), vec4(1.0, 0.15, 0.1, 1.0));
+
+// The mode and the feedback refine the distance split: ssr and rt send
+// every traced pixel one way; in hybrid mode the middle band follows its
+// tile's feedback (Far Cry 6 talk, DESIGN.md section 3), except that a
+// random share of an RT tile's pixels stays hybrid, so SSLR keeps being
+// tried there and the tile can come back to it when SSLR starts to hit.
+uint applyMode(uint pixelClass, uvec2 pixel) {
+    if (pc.mode == kModeSsr) {
+        return kPixelSslr;
+    }
+    if (pc.mode == kModeRt) {
+        return kPixelRt;
+    }
+    if (pixelClass != kPixelHybrid || pc.tileModesEnabled == 0u) {
+        return pixelClass;
+    }
+    const uint tileMode = tileModes[(pixel.y / kTileSize) * pc.tilesX + pixel.x / kTileSize];
+    if (tileMode == kTileModeSslr) {
+        return kPixelSslr;
+    }
+    if (tileMode == kTileModeRt) {
+        // Decorrelated from the ray's own noise (frameNoise) by the extra
+        // frame offset; the share is exact on average over frames.
+        const float u = frameNoise(pixel, pc.frame + 0x9E3779B9u).x;
+        return u < pc.rtToHybridShare ? kPixelHybrid : kPixelRt;
+    }
+    return kPixelHybrid;
+}
 
 void main() {
     const uvec2 pixel = gl_GlobalInvocationID.xy;
@@ -41,7 +76,7 @@ void main() {
     const bool inside = pixel.x < pc.size.x && pixel.y < pc.size.y;
     if (lane == 0u) {
         sharedSslr = 0u;
-        sharedRt = 0u;
+        sharedRtCount = 0u;
     }
 
     uint pixelClass = kPixelSky;
@@ -66,6 +101,7 @@ void main() {
                 pixelClass = distance < pc.rtMaxDistance ? kPixelRt
                              : distance >= pc.sslrMinDistance ? kPixelSslr
                                                               : kPixelHybrid;
+                pixelClass = applyMode(pixelClass, pixel);
                 const vec2 u = frameNoise(pixel, pc.frame);
                 const vec3 l = sampleReflection(normalize(normal.xyz), toCamera / distance, roughness, u);
                 direction = packRayDirection(l);
@@ -109,9 +145,14 @@ void main() {
         imageStore(classDebug, ivec2(pixel), kClassColours[pixelClass]);
         if (pixelClass == kPixelSslr || pixelClass == kPixelHybrid) {
             atomicOr(sharedSslr, 1u);
-        } else if (pixelClass == kPixelRt) {
-            atomicOr(sharedRt, 1u);
         }
+    }
+    // RT ray leaders take consecutive slots of the tile's range in the RT
+    // list: one global atomic per tile, not per ray.
+    const bool rtLeader = inside && pixelClass == kPixelRt && !reused;
+    uint localSlot = 0u;
+    if (rtLeader) {
+        localSlot = atomicAdd(sharedRtCount, 1u);
     }
     barrier();
 
@@ -120,8 +161,18 @@ void main() {
         if (sharedSslr != 0u) {
             sslrTiles[atomicAdd(args[kSslrArgsOffset], 1u)] = tile;
         }
-        if (sharedRt != 0u) {
-            rtTiles[atomicAdd(args[kRtArgsOffset], 1u)] = tile;
+        if (sharedRtCount != 0u) {
+            const uint base = atomicAdd(rtArgs[kRtListCountOffset], sharedRtCount);
+            sharedRtBase = base;
+            const uint end = base + sharedRtCount;
+            atomicMax(rtArgs[kRtListDispatchOffset], (end + kRtListGroupSize - 1u) / kRtListGroupSize);
         }
+    }
+    barrier();
+    if (rtLeader) {
+        PackedRay ray;
+        ray.pixelFlags = packRayPixel(pixel, false);
+        ray.direction = direction;
+        rtRays[sharedRtBase + localSlot] = ray;
     }
 }

@@ -196,11 +196,9 @@ void main() {
     // Only hybrid rays go on: SSLR-class pixels lie beyond the BVH's reach
     // (DESIGN.md section 3), where the ray tracer could find nothing better.
     if (pixelClass == kPixelHybrid && confidence < pc.confidenceThreshold) {
-        const uint slot = atomicAdd(rtArgs[kSslrRtCountOffset], 1u);
+        // Appended after ray generation's RT rays (glint/ray_generation_shared.h).
+        const uint slot = atomicAdd(rtArgs[kRtListCountOffset], 1u);
         rtRays[slot] = ray;
-        // The slot that opens a group counts the group.
-        if (slot % kSslrRtGroupSize == 0u) {
-            atomicAdd(rtArgs[0], 1u);
-        }
+        atomicMax(rtArgs[kRtListDispatchOffset], slot / kRtListGroupSize + 1u);
     }
 }

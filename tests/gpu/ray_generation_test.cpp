@@ -15,6 +15,7 @@
 #include "passes/ray_generation.h"
 #include "scene/animation.h"
 
+#include "glint/feedback_shared.h"
 #include "glint/ray_generation_shared.h"
 #include "glint/sampling.glsl"
 
@@ -39,14 +40,18 @@ using test::testCamera;
 
 constexpr rg::BoundaryState kHostRead =
     rg::BoundaryState::raw(VK_PIPELINE_STAGE_2_HOST_BIT, VK_ACCESS_2_HOST_READ_BIT, VK_IMAGE_LAYOUT_UNDEFINED);
+constexpr rg::BoundaryState kHostWrite =
+    rg::BoundaryState::raw(VK_PIPELINE_STAGE_2_HOST_BIT, VK_ACCESS_2_HOST_WRITE_BIT, VK_IMAGE_LAYOUT_UNDEFINED);
+constexpr size_t kReadbacks = 6;
 
 // What the pass wrote in one frame, read back on the host.
 struct RayFrame {
     std::vector<shader::PackedRay> rays;
     std::vector<uint32_t> classes;
     std::vector<uint32_t> sslrTiles;  // the whole buffer; the args say how much is listed
-    std::vector<uint32_t> rtTiles;
+    std::vector<shader::PackedRay> rtRays;
     std::array<uint32_t, shader::kIndirectArgsWords> args{};
+    std::array<uint32_t, shader::kRtListArgsWords> rtArgs{};
 
     size_t at(uint32_t x, uint32_t y) const { return size_t(y) * kSize + x; }
 };
@@ -57,8 +62,12 @@ class Readback {
 public:
     explicit Readback(gpu::Context& ctx) {
         const uint64_t tiles = (kSize / shader::kTileSize) * (kSize / shader::kTileSize);
-        const std::array<uint64_t, 5> bytes = {kSize * kSize * sizeof(shader::PackedRay), kSize * kSize * 4,
-                                               tiles * 4, tiles * 4, shader::kIndirectArgsWords * 4};
+        const std::array<uint64_t, kReadbacks> bytes = {kSize * kSize * sizeof(shader::PackedRay),
+                                                        kSize * kSize * 4,
+                                                        tiles * 4,
+                                                        kSize * kSize * sizeof(shader::PackedRay),
+                                                        shader::kIndirectArgsWords * 4,
+                                                        shader::kRtListArgsWords * 4};
         for (size_t i = 0; i < buffers_.size(); ++i) {
             buffers_[i] = gpu::Buffer(ctx, {bytes[i], VK_BUFFER_USAGE_TRANSFER_DST_BIT, gpu::MemoryUsage::Readback,
                                             "ray_generation_test.readback" + std::to_string(i)});
@@ -67,12 +76,12 @@ public:
 
     void add(rg::Graph& graph, const passes::RayGenerationOutputs& out, rg::FrameResources& frame) {
         struct Data {
-            std::array<rg::Buffer, 5> sources;
-            std::array<rg::Buffer, 5> targets;
+            std::array<rg::Buffer, kReadbacks> sources;
+            std::array<rg::Buffer, kReadbacks> targets;
         };
-        const std::array<rg::Buffer, 5> sources = {out.rays, out.classes, out.sslrTiles, out.rtTiles,
-                                                   out.indirectArgs};
-        std::array<rg::Buffer, 5> imports;
+        const std::array<rg::Buffer, kReadbacks> sources = {out.rays,   out.classes,      out.sslrTiles,
+                                                            out.rtRays, out.indirectArgs, out.rtArgs};
+        std::array<rg::Buffer, kReadbacks> imports;
         const rg::BoundaryState lastCopy = rg::BoundaryState::of(rg::Access::TransferDst);
         for (size_t i = 0; i < imports.size(); ++i) {
             imports[i] =
@@ -108,13 +117,14 @@ public:
         copy(f.rays, buffers_[0]);
         copy(f.classes, buffers_[1]);
         copy(f.sslrTiles, buffers_[2]);
-        copy(f.rtTiles, buffers_[3]);
+        copy(f.rtRays, buffers_[3]);
         std::memcpy(f.args.data(), buffers_[4].mapped(), sizeof(f.args));
+        std::memcpy(f.rtArgs.data(), buffers_[5].mapped(), sizeof(f.rtArgs));
         return f;
     }
 
 private:
-    std::array<gpu::Buffer, 5> buffers_;
+    std::array<gpu::Buffer, kReadbacks> buffers_;
 };
 
 // A floor at y = -1 under a camera at the origin looking down -Z: the lower
@@ -144,22 +154,35 @@ glm::vec3 viewRay(uint32_t x, uint32_t y) {
     return glm::normalize(glm::vec3(ndc.x, -ndc.y, -1.0f));
 }
 
-// Renders the G-buffer and the ray generation for each frame index.
+// Renders the G-buffer and the ray generation for each frame index, with
+// the given tile modes (u32 per tile, glint/feedback_shared.h) when not empty.
 std::vector<RayFrame> generate(test::GpuTest& gpu, const scene::Scene& scene, const std::vector<uint64_t>& frames,
-                               const passes::RayGenerationSettings& settings = {}) {
+                               const passes::RayGenerationSettings& settings = {},
+                               const std::vector<uint32_t>& tileModes = {}) {
     auto& ctx = gpu.ctx();
     rg::Executor executor(ctx);
     passes::GBufferRenderer renderer(ctx, scene);
     passes::RayGenerationPipelines pipelines(ctx);
     Readback readback(ctx);
+    gpu::Buffer modes;
+    if (!tileModes.empty()) {
+        modes = gpu::Buffer(ctx, {tileModes.size() * 4, VK_BUFFER_USAGE_STORAGE_BUFFER_BIT, gpu::MemoryUsage::Upload,
+                                  "ray_generation_test.tile_modes"});
+        std::memcpy(modes.mapped(), tileModes.data(), tileModes.size() * 4);
+    }
     const scene::Camera camera = testCamera();
     std::vector<RayFrame> out;
     for (const uint64_t frame : frames) {
         rg::Graph graph(executor.queueCaps());
         rg::FrameResources resources;
         const passes::GBufferOutputs gbuf = passes::addGBufferPass(graph, renderer, {camera});
-        const passes::RayGenerationOutputs rays =
-            passes::addRayGenerationPass(graph, pipelines, {gbuf, frame, camera}, settings);
+        passes::RayGenerationInputs inputs{gbuf, frame, camera};
+        if (!tileModes.empty()) {
+            inputs.tileModes = graph.importBuffer(
+                "tile_modes", {{modes.size()}, kHostWrite, rg::BoundaryState::of(rg::Access::StorageRead)});
+            resources.bind(inputs.tileModes, modes);
+        }
+        const passes::RayGenerationOutputs rays = passes::addRayGenerationPass(graph, pipelines, inputs, settings);
         REQUIRE(rays.tilesX == kSize / shader::kTileSize);
         readback.add(graph, rays, resources);
         const rg::Plan plan = graph.compile(executor.compileOptions());
@@ -327,7 +350,8 @@ TEST_CASE("roughness above the cutoff gives no ray, and no tile is listed") {
             REQUIRE(f.rays[i].pixelFlags == shader::kNoRay);
         }
     }
-    CHECK(f.args == std::array<uint32_t, 6>{0, 1, 1, 0, 1, 1});
+    CHECK(f.args == std::array<uint32_t, 3>{0, 1, 1});
+    CHECK(f.rtArgs == std::array<uint32_t, 6>{0, 1, 1, 0, 1, 1});
 }
 
 TEST_CASE("rough rays stay in the upper hemisphere of the normal over many frames, grazing rows included") {
@@ -374,7 +398,7 @@ TEST_CASE("the distance split classes pixels, and tile lists and indirect args a
     settings.sslrMinDistance = 8.0f;
     const RayFrame f = generate(gpu, floorScene(0.05f), {0}, settings).front();
     constexpr uint32_t kTiles = kSize / shader::kTileSize;
-    std::set<uint32_t> sslr, rt;
+    std::set<uint32_t> sslr, rtLeaders;
     std::array<uint32_t, shader::kPixelClassCount> counts{};
     for (uint32_t y = 0; y < kSize; ++y) {
         for (uint32_t x = 0; x < kSize; ++x) {
@@ -383,7 +407,10 @@ TEST_CASE("the distance split classes pixels, and tile lists and indirect args a
             ++counts[c];
             const uint32_t tile = (x / shader::kTileSize) | ((y / shader::kTileSize) << 16);
             if (c == shader::kPixelSslr || c == shader::kPixelHybrid) sslr.insert(tile);
-            if (c == shader::kPixelRt) rt.insert(tile);
+            const shader::PackedRay& ray = f.rays[f.at(x, y)];
+            if (c == shader::kPixelRt && ray.pixelFlags == shader::packRayPixel({x, y}, false)) {
+                rtLeaders.insert(ray.pixelFlags);
+            }
             if (!isFloor(y)) continue;
             // The floor y = -1 along view ray d is at distance 1 / -d.y.
             const float distance = 1.0f / -viewRay(x, y).y;
@@ -399,18 +426,30 @@ TEST_CASE("the distance split classes pixels, and tile lists and indirect args a
     CHECK(counts[shader::kPixelSslr] > 0);
     CHECK(counts[shader::kPixelSky] == kSize * kSize / 2);
     REQUIRE(f.args[0] == sslr.size());
-    REQUIRE(f.args[3] == rt.size());
     CHECK(f.args[1] == 1);
     CHECK(f.args[2] == 1);
-    CHECK(f.args[4] == 1);
-    CHECK(f.args[5] == 1);
     CHECK(sslr.size() < kTiles * kTiles);
     const std::set<uint32_t> listedSslr(f.sslrTiles.begin(), f.sslrTiles.begin() + f.args[0]);
-    const std::set<uint32_t> listedRt(f.rtTiles.begin(), f.rtTiles.begin() + f.args[3]);
     CHECK(listedSslr == sslr);  // and, being sets of the listed size, no duplicates
     CHECK(listedSslr.size() == f.args[0]);
-    CHECK(listedRt == rt);
-    CHECK(listedRt.size() == f.args[3]);
+    // The RT list holds each RT ray leader once, with its own ray; the
+    // dispatch covers it in 64-wide groups and the trace-rays command is
+    // {count, 1, 1}.
+    const uint32_t count = f.rtArgs[shader::kRtListCountOffset];
+    REQUIRE(count == rtLeaders.size());
+    CHECK(f.rtArgs[0] == (count + shader::kRtListGroupSize - 1) / shader::kRtListGroupSize);
+    CHECK(f.rtArgs[1] == 1);
+    CHECK(f.rtArgs[2] == 1);
+    CHECK(f.rtArgs[4] == 1);
+    CHECK(f.rtArgs[5] == 1);
+    std::set<uint32_t> listedRt;
+    for (uint32_t k = 0; k < count; ++k) {
+        const shader::PackedRay& listed = f.rtRays[k];
+        listedRt.insert(listed.pixelFlags);
+        const glm::uvec2 p = shader::unpackRayPixel(listed.pixelFlags);
+        REQUIRE(listed.direction == f.rays[f.at(p.x, p.y)].direction);
+    }
+    CHECK(listedRt == rtLeaders);
 }
 
 TEST_CASE("rough 2x2 quads share their leader's ray, and the leader rotates with the frame") {
@@ -453,4 +492,81 @@ TEST_CASE("below the reuse roughness every pixel keeps its own ray") {
             REQUIRE(f.rays[f.at(x, y)].pixelFlags == shader::packRayPixel({x, y}, false));
         }
     }
+}
+
+TEST_CASE("the ssr and rt modes send every traced pixel one way, and the RT list holds exactly the RT leaders") {
+    test::GpuTest gpu;
+    passes::RayGenerationSettings settings;
+    settings.rtMaxDistance = 3.0f;
+    settings.sslrMinDistance = 8.0f;
+    for (const passes::ReflectionMode mode : {passes::ReflectionMode::Ssr, passes::ReflectionMode::Rt}) {
+        settings.mode = mode;
+        const uint32_t expected = mode == passes::ReflectionMode::Ssr ? shader::kPixelSslr : shader::kPixelRt;
+        const RayFrame f = generate(gpu, floorScene(0.05f), {0}, settings).front();
+        uint32_t traced = 0, leaders = 0;
+        for (uint32_t y = 0; y < kSize; ++y) {
+            for (uint32_t x = 0; x < kSize; ++x) {
+                const uint32_t c = f.classes[f.at(x, y)];
+                INFO("mode " << int(mode) << ", pixel " << x << ", " << y);
+                if (!isFloor(y)) {
+                    REQUIRE(c == shader::kPixelSky);
+                    continue;
+                }
+                REQUIRE(c == expected);
+                ++traced;
+                leaders += f.rays[f.at(x, y)].pixelFlags == shader::packRayPixel({x, y}, false) ? 1u : 0u;
+            }
+        }
+        CHECK(traced == kSize * kSize / 2);
+        const uint32_t count = f.rtArgs[shader::kRtListCountOffset];
+        if (mode == passes::ReflectionMode::Ssr) {
+            CHECK(count == 0);
+            CHECK(f.rtArgs[0] == 0);
+            CHECK(f.args[0] == kSize / shader::kTileSize * kSize / shader::kTileSize / 2);
+        } else {
+            CHECK(count == leaders);
+            CHECK(f.rtArgs[0] == (count + shader::kRtListGroupSize - 1) / shader::kRtListGroupSize);
+            CHECK(f.args[0] == 0);
+        }
+    }
+}
+
+TEST_CASE("hybrid pixels follow their tile's mode, and an RT tile keeps the configured share hybrid") {
+    test::GpuTest gpu;
+    passes::RayGenerationSettings settings;
+    settings.rtMaxDistance = 0.0f;    // no RT band
+    settings.sslrMinDistance = 1e9f;  // no SSLR band: every floor pixel is hybrid before the feedback
+    settings.rtToHybridShare = 0.25f;
+    constexpr uint32_t kTiles = kSize / shader::kTileSize;
+    // Columns of tiles: SSLR, hybrid, RT, repeating.
+    std::vector<uint32_t> modes(kTiles * kTiles);
+    for (uint32_t t = 0; t < modes.size(); ++t) {
+        const uint32_t tx = t % kTiles;
+        modes[t] = tx % 3 == 0 ? shader::kTileModeSslr : tx % 3 == 1 ? shader::kTileModeHybrid : shader::kTileModeRt;
+    }
+    uint64_t rtTilePixels = 0, keptHybrid = 0;
+    const std::vector<RayFrame> frames = generate(gpu, floorScene(0.05f), {0, 1, 2, 3, 4, 5, 6, 7}, settings, modes);
+    for (const RayFrame& f : frames) {
+        for (uint32_t y = kSize / 2; y < kSize; ++y) {
+            for (uint32_t x = 0; x < kSize; ++x) {
+                const uint32_t mode = modes[(y / shader::kTileSize) * kTiles + x / shader::kTileSize];
+                const uint32_t c = f.classes[f.at(x, y)];
+                INFO("pixel " << x << ", " << y << ", tile mode " << mode);
+                if (mode == shader::kTileModeSslr) {
+                    REQUIRE(c == shader::kPixelSslr);
+                } else if (mode == shader::kTileModeHybrid) {
+                    REQUIRE(c == shader::kPixelHybrid);
+                } else {
+                    REQUIRE((c == shader::kPixelRt || c == shader::kPixelHybrid));
+                    ++rtTilePixels;
+                    keptHybrid += c == shader::kPixelHybrid ? 1u : 0u;
+                }
+            }
+        }
+    }
+    // 8 frames x ~700 pixels: the binomial standard deviation of the share
+    // is ~0.006, so 0.03 is a five-sigma bound.
+    REQUIRE(rtTilePixels > 4000);
+    const double share = double(keptHybrid) / double(rtTilePixels);
+    CHECK(std::abs(share - 0.25) < 0.03);
 }

@@ -7,10 +7,11 @@
 //   classes[p] one of kPixel*
 // Tiles (kTileSize^2 pixels, tile t = ty * tilesX + tx):
 //   sslrTiles  tiles with an SSLR or hybrid pixel, tile index packed as
-//              tx | ty << 16; rtTiles the same for RT pixels
-//   args       two VkDispatchIndirectCommand (SSLR at 0, RT at 12 bytes):
-//              one kTileSize x kTileSize workgroup per listed tile, so x is
-//              also the list's length
+//              tx | ty << 16
+//   args       VkDispatchIndirectCommand over sslrTiles: one kTileSize x
+//              kTileSize workgroup per listed tile, so x is also the
+//              list's length
+// and the RT ray list (below): the ray leaders of the RT pixels.
 #ifndef GLINT_RAY_GENERATION_SHARED_H
 #define GLINT_RAY_GENERATION_SHARED_H
 
@@ -52,10 +53,16 @@ GLINT_CONST uint kRayPixelXMask = 0x7FFFu;
 GLINT_CONST uint kRayPixelYShift = 15u;
 GLINT_CONST uint kRayPixelYMask = 0x3FFFu;
 
-// Offsets, in uints, of the two dispatch commands in the args buffer.
+// Offset and size, in uints, of the SSLR tiles' dispatch command.
 GLINT_CONST uint kSslrArgsOffset = 0u;
-GLINT_CONST uint kRtArgsOffset = 3u;
-GLINT_CONST uint kIndirectArgsWords = 6u;
+GLINT_CONST uint kIndirectArgsWords = 3u;
+
+// Reflection modes (RayGenerationSettings::mode): hybrid is the Far Cry 6
+// scheme; ssr turns every traced pixel into SSLR (the environment where it
+// finds nothing), rt every one into RT.
+GLINT_CONST uint kModeHybrid = 0u;
+GLINT_CONST uint kModeSsr = 1u;
+GLINT_CONST uint kModeRt = 2u;
 
 // The RT ray list: PackedRay entries (one per pixel of capacity) of the
 // rays the ray tracer must trace. Ray generation appends its RT pixels' ray
@@ -77,7 +84,7 @@ GLINT_CONST uint kRtListArgsWords = 6u;
 // value) and reprojection through the reflected point stays finite.
 GLINT_CONST float kMissHitDistance = 65504.0f;
 
-// Push constants of classify.comp (112 bytes).
+// Push constants of classify.comp (128 bytes).
 struct RayGenerationConstants {
     mat4 inverseViewProjection;  // unjittered
     vec4 cameraPosition;
@@ -88,13 +95,17 @@ struct RayGenerationConstants {
     float rtMaxDistance;
     float sslrMinDistance;
     uint reuseEnabled;
+    uint mode;              // kMode*
+    uint tileModesEnabled;  // 1: hybrid pixels follow the feedback's tile modes
+    float rtToHybridShare;  // share of an RT tile's hybrid pixels kept hybrid
+    uint tilesX;
 };
 
 GLINT_END
 
 #ifdef __cplusplus
 static_assert(sizeof(glint::shader::PackedRay) == 8);
-static_assert(sizeof(glint::shader::RayGenerationConstants) == 112);
+static_assert(sizeof(glint::shader::RayGenerationConstants) == 128);
 #endif
 
 // ---------------------------------------------------------------------------

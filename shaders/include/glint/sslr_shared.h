@@ -7,22 +7,15 @@
 //   radiance    lit colour at the hit, rgb; a = 1 where a hit was found
 //   confidence  [0, 1]: 0 for misses (off screen, sky, too thick, back face)
 //   hitDebug    xy = hit uv, z = confidence, w = 1 on a hit
-// RT hand-off:
-//   rtRays      PackedRay (glint/ray_generation_shared.h) of each hybrid
-//               ray whose confidence is below the threshold
-//   rtArgs      VkDispatchIndirectCommand (one kSslrRtGroupSize-wide
-//               workgroup per kSslrRtGroupSize listed rays) followed by the
-//               list's length in rays (word kSslrRtCountOffset)
+// RT hand-off: each hybrid ray whose confidence is below the threshold is
+// appended to ray generation's RT ray list (glint/ray_generation_shared.h,
+// kRtList*), after the RT pixels' rays.
 #ifndef GLINT_SSLR_SHARED_H
 #define GLINT_SSLR_SHARED_H
 
 #include "glint/shared.h"
 
 GLINT_BEGIN
-
-GLINT_CONST uint kSslrRtGroupSize = 64u;
-GLINT_CONST uint kSslrRtCountOffset = 3u;
-GLINT_CONST uint kSslrRtArgsWords = 4u;
 
 // Push constants of trace.comp (128 bytes, Vulkan's guaranteed minimum).
 // The projection travels as its four non-trivial entries: an unjittered
