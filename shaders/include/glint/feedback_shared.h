@@ -18,6 +18,8 @@
 
 #include "glint/shared.h"
 #include "glint/packing.h"  // GLINT_FUNC, min in C++
+#include "glint/ray_generation_shared.h"  // kTileSize
+#include "glint/sampling.glsl"            // pcgHash
 
 GLINT_BEGIN
 
@@ -46,6 +48,63 @@ GLINT_FUNC uint rotateFeedback(uint reprojected, uint hits, uint misses) {
     return packFeedback(hits, misses, feedbackHits(reprojected), feedbackMisses(reprojected));
 }
 
+// ---------------------------------------------------------------------------
+// The feedback pass (passes/feedback.cpp, shaders/feedback/reproject.comp)
+// ---------------------------------------------------------------------------
+
+// The tile's mode from its two frames of counts (a reprojected counter):
+//   fewer than minRays traced rays in both frames  -> hybrid (no evidence)
+//   misses at most sslrMissFraction of the rays     -> SSLR (only hits)
+//   hits at most rtHitFraction of the rays          -> RT (only misses)
+//   otherwise                                       -> hybrid (mixed)
+// With both fractions 0 a tile needs every ray to agree before it leaves
+// hybrid, the Far Cry 6 talk's rule (DESIGN.md section 3); passes/feedback.h
+// documents the knobs.
+GLINT_FUNC uint decideTileMode(uint counter, uint minRays, float sslrMissFraction, float rtHitFraction) {
+    const uint hits = feedbackHits(counter) + feedbackPreviousHits(counter);
+    const uint misses = feedbackMisses(counter) + feedbackPreviousMisses(counter);
+    const uint total = hits + misses;
+    if (total == 0u || total < minRays) {
+        return kTileModeHybrid;
+    }
+    if (float(misses) <= sslrMissFraction * float(total)) {
+        return kTileModeSslr;
+    }
+    if (float(hits) <= rtHitFraction * float(total)) {
+        return kTileModeRt;
+    }
+    return kTileModeHybrid;
+}
+
+// The pixel of `tile` whose motion carries the tile's counter this frame:
+// a new pseudo-random one every frame (the talk's "random motion vector of
+// the tile"), so over frames the whole tile votes, not one corner. Inside
+// the image for the partial tiles at the right and bottom edges.
+GLINT_FUNC uvec2 feedbackProbePixel(uvec2 tile, uint frame, uvec2 size) {
+    const uint h = pcgHash(tile.x + pcgHash(tile.y + pcgHash(frame)));
+    const uint x0 = tile.x * kTileSize;
+    const uint y0 = tile.y * kTileSize;
+    const uint w = min(kTileSize, size.x - x0);
+    const uint hgt = min(kTileSize, size.y - y0);
+    return uvec2(x0 + (h & 0xFFFFu) % w, y0 + (h >> 16u) % hgt);
+}
+
+// Push constants of reproject.comp (40 bytes).
+struct FeedbackConstants {
+    uvec2 size;   // pixels
+    uvec2 tiles;  // tiles in x and y
+    uint frame;
+    uint minRays;
+    float sslrMissFraction;
+    float rtHitFraction;
+    uint adaptive;  // 0: every tile hybrid
+    uint pad0;
+};
+
 GLINT_END
+
+#ifdef __cplusplus
+static_assert(sizeof(glint::shader::FeedbackConstants) == 40);
+#endif
 
 #endif

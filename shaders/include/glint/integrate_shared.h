@@ -1,0 +1,67 @@
+// Integrate (passes/integrate.cpp, shaders/integrate/*): the per-frame
+// constants and the sources a pixel's reflection can come from, shared by
+// GLSL and C++. Buffers use scalar layout.
+//
+// Outputs, per pixel:
+//   radiance     rgb: the radiance arriving along the pixel's reflection;
+//                a = 1 where a surface reflects (every class but the sky)
+//   hitDistance  world distance from the surface to the reflected point;
+//                kMissHitDistance (glint/ray_generation_shared.h) for the
+//                environment, misses and the sky
+//   sourceDebug  integrateSourceColour(source) (debug view "reflection_source")
+//   counters     one u32 per 8x8 tile (glint/feedback_shared.h)
+#ifndef GLINT_INTEGRATE_SHARED_H
+#define GLINT_INTEGRATE_SHARED_H
+
+#include "glint/shared.h"
+#include "glint/gbuffer_shared.h"  // SceneLighting
+#include "glint/packing.h"         // GLINT_FUNC
+
+GLINT_BEGIN
+
+// Where a pixel's reflection came from.
+//   Sky          nothing reflects: no surface
+//   Environment  an env-class pixel (rougher than the tracing cutoff)
+//   Sslr         the screen-space hit
+//   Rt           the ray-traced hit (or its miss: the true environment)
+//   Fallback     a traced pixel whose traces found nothing usable: the
+//                environment map
+GLINT_CONST uint kSourceSky = 0u;
+GLINT_CONST uint kSourceEnvironment = 1u;
+GLINT_CONST uint kSourceSslr = 2u;
+GLINT_CONST uint kSourceRt = 3u;
+GLINT_CONST uint kSourceFallback = 4u;
+GLINT_CONST uint kSourceCount = 5u;
+
+// Debug colours: grey environment, blue SSLR, red RT, yellow fallback,
+// black sky. Every channel is a multiple of 0.2, so 255 x it lies far from
+// a rounding boundary and the RGBA8 value is the same on every device.
+GLINT_FUNC vec4 integrateSourceColour(uint source) {
+    if (source == kSourceEnvironment) return vec4(0.6f, 0.6f, 0.6f, 1.0f);
+    if (source == kSourceSslr) return vec4(0.2f, 0.4f, 1.0f, 1.0f);
+    if (source == kSourceRt) return vec4(1.0f, 0.2f, 0.2f, 1.0f);
+    if (source == kSourceFallback) return vec4(1.0f, 0.8f, 0.2f, 1.0f);
+    return vec4(0.0f, 0.0f, 0.0f, 1.0f);
+}
+
+// Per-frame constants (a storage buffer: with the lighting they outgrow the
+// 128 bytes of push constants every device has; 192 bytes).
+struct IntegrateConstants {
+    mat4 inverseViewProjection;  // unjittered, the G-buffer's camera
+    vec4 cameraPosition;
+    SceneLighting lighting;
+    uvec2 size;                  // pixels
+    uvec2 tiles;                 // 8x8 tiles in x and y
+    float confidenceThreshold;   // SSLR confidence that counts as a hit
+    uint pad0;
+    uint pad1;
+    uint pad2;
+};
+
+GLINT_END
+
+#ifdef __cplusplus
+static_assert(sizeof(glint::shader::IntegrateConstants) == 192);
+#endif
+
+#endif

@@ -1,0 +1,8 @@
+#version 460
+// Integrate with no traces: the environment map everywhere (a baseline), writing the feedback counters.
+// The body and what the defines mean: integrate.glsl (passes/integrate.h).
+#extension GL_GOOGLE_include_directive : require
+#define GLINT_INTEGRATE_SSLR 0
+#define GLINT_INTEGRATE_RT 0
+#define GLINT_INTEGRATE_FEEDBACK 1
+#include "integrate.glsl"

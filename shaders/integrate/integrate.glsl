@@ -1,0 +1,207 @@
+// Integrate (passes/integrate.h), the body of every variant: one 8x8
+// workgroup per tile. Each pixel picks the source of its reflection from
+// its class and the confidences of the traces (a follower reads its quad
+// leader's traces), writes the radiance, the hit distance and a debug
+// colour, and the tile's SSLR hit/miss counts go into its feedback counter.
+//
+// The variant file defines which inputs exist this frame:
+//   GLINT_INTEGRATE_SSLR      1: SSLR radiance, confidence and hits are bound
+//   GLINT_INTEGRATE_RT        1: RT radiance and hit distance are bound
+//   GLINT_INTEGRATE_FEEDBACK  1: the reprojected and the new counters are bound
+// so a frame without one declares and binds nothing for it.
+#extension GL_EXT_scalar_block_layout : require
+
+#include "glint/feedback_shared.h"
+#include "glint/gbuffer_shared.h"
+#include "glint/integrate_shared.h"
+#include "glint/ray_generation_shared.h"
+#include "glint/brdf.glsl"
+
+layout(local_size_x = 8, local_size_y = 8) in;
+
+layout(set = 0, binding = 0) uniform sampler2D depthTexture;
+layout(set = 0, binding = 1) uniform sampler2D normalTexture;
+layout(set = 0, binding = 2) uniform sampler2D roughnessMetalTexture;
+layout(set = 0, binding = 3, scalar) readonly buffer Constants { IntegrateConstants C; };
+layout(set = 0, binding = 4, scalar) readonly buffer Rays { PackedRay rays[]; };
+layout(set = 0, binding = 5, scalar) readonly buffer Classes { uint classes[]; };
+layout(set = 0, binding = 6, rgba16f) uniform writeonly image2D radianceImage;
+layout(set = 0, binding = 7, r32f) uniform writeonly image2D hitDistanceImage;
+layout(set = 0, binding = 8, rgba8) uniform writeonly image2D sourceImage;
+#if GLINT_INTEGRATE_FEEDBACK
+layout(set = 0, binding = 9, scalar) readonly buffer Reprojected { uint reprojected[]; };
+layout(set = 0, binding = 10, scalar) writeonly buffer Counters { uint counters[]; };
+#endif
+#if GLINT_INTEGRATE_SSLR
+layout(set = 0, binding = 11) uniform sampler2D sslrRadianceTexture;
+layout(set = 0, binding = 12) uniform sampler2D sslrConfidenceTexture;
+layout(set = 0, binding = 13) uniform sampler2D sslrHitTexture;
+#endif
+#if GLINT_INTEGRATE_RT
+layout(set = 0, binding = 14) uniform sampler2D rtRadianceTexture;
+layout(set = 0, binding = 15) uniform sampler2D rtHitDistanceTexture;
+#endif
+
+// The largest finite half float: radiance above it would become +Inf in the
+// RGBA16F output.
+const float kMaxHalf = 65504.0;
+
+shared uint sharedHits;
+shared uint sharedMisses;
+
+// By the bits, not isnan/isinf: an implementation may assume floats are
+// finite (Vulkan's default float controls) and fold those tests away, and
+// NaN or Inf from an upstream pass must not get through.
+bool isFinite(float x) { return (floatBitsToUint(x) & 0x7F800000u) != 0x7F800000u; }
+bool isFinite(vec2 v) { return isFinite(v.x) && isFinite(v.y); }
+bool isFinite(vec3 v) { return isFinite(v.x) && isFinite(v.y) && isFinite(v.z); }
+
+// World position of a pixel position (in pixels) at a reversed-Z depth.
+vec3 worldPosition(vec2 pixelPosition, float depth) {
+    const vec2 ndc = pixelPosition / vec2(C.size) * 2.0 - 1.0;
+    const vec4 world = C.inverseViewProjection * vec4(ndc, depth, 1.0);
+    return world.xyz / world.w;
+}
+
+struct Reflection {
+    vec3 radiance;
+    float reflects;     // 1 where a surface reflects
+    float hitDistance;
+    uint source;
+};
+
+Reflection integratePixel(uvec2 pixel) {
+    Reflection r;
+    r.radiance = vec3(0.0);
+    r.reflects = 0.0;
+    r.hitDistance = kMissHitDistance;
+    r.source = kSourceSky;
+    const uint index = pixel.y * C.size.x + pixel.x;
+    const uint pixelClass = classes[index];
+    if (pixelClass == kPixelSky || pixelClass >= kPixelClassCount) {
+        return r;
+    }
+    const ivec2 p = ivec2(pixel);
+    const float depth = texelFetch(depthTexture, p, 0).x;
+    const vec3 position = worldPosition(vec2(pixel) + 0.5, depth);
+    const vec3 n = texelFetch(normalTexture, p, 0).xyz;
+    const vec3 N = n * inversesqrt(max(dot(n, n), 1e-12));
+    const vec3 V = normalize(C.cameraPosition.xyz - position);
+    const float roughness = texelFetch(roughnessMetalTexture, p, 0).x;
+    r.reflects = 1.0;
+    // The environment map, for env pixels and for traces that found nothing.
+    r.radiance = environmentRadiance(C.lighting, reflect(-V, N), roughness);
+    r.source = pixelClass == kPixelEnv ? kSourceEnvironment : kSourceFallback;
+    if (pixelClass == kPixelEnv) {
+        return r;
+    }
+
+    // A follower's traces are its quad leader's (glint/ray_generation_shared.h).
+    const PackedRay ray = rays[index];
+    const bool traced = ray.pixelFlags != kNoRay;
+    const ivec2 leader = traced ? ivec2(unpackRayPixel(ray.pixelFlags)) : p;
+    const bool ownRay = traced && (ray.pixelFlags & kRayReused) == 0u;
+
+    float confidence = 0.0;
+    vec3 sslrRadiance = vec3(0.0);
+    vec2 sslrHitUv = vec2(0.0);
+#if GLINT_INTEGRATE_SSLR
+    if (traced && (pixelClass == kPixelSslr || pixelClass == kPixelHybrid)) {
+        const vec4 radiance = texelFetch(sslrRadianceTexture, leader, 0);
+        const float c = texelFetch(sslrConfidenceTexture, leader, 0).x;
+        const vec2 hitUv = texelFetch(sslrHitTexture, leader, 0).xy;
+        // A non-finite result is no hit: the pixel falls through to the
+        // next source rather than carrying NaN into temporal accumulation.
+        if (radiance.a > 0.5 && isFinite(radiance.rgb) && isFinite(c) && isFinite(hitUv)) {
+            confidence = clamp(c, 0.0, 1.0);
+            sslrRadiance = radiance.rgb;
+            sslrHitUv = hitUv;
+        }
+#if GLINT_INTEGRATE_FEEDBACK
+        // The counters count traced rays: leaders only, once each.
+        if (ownRay && confidence >= C.confidenceThreshold) {
+            atomicAdd(sharedHits, 1u);
+        } else if (ownRay) {
+            atomicAdd(sharedMisses, 1u);
+        }
+#endif
+    }
+#endif
+
+    bool rtTraced = false;
+    vec3 rtRadiance = vec3(0.0);
+    float rtHitDistance = kMissHitDistance;
+#if GLINT_INTEGRATE_RT
+    if (traced && (pixelClass == kPixelHybrid || pixelClass == kPixelRt)) {
+        const vec4 radiance = texelFetch(rtRadianceTexture, leader, 0);
+        const float d = texelFetch(rtHitDistanceTexture, leader, 0).x;
+        rtTraced = radiance.a > 0.5 && isFinite(radiance.rgb);
+        rtRadiance = radiance.rgb;
+        // A follower takes its leader's ray length: the quad shares one ray,
+        // and its origins lie a pixel apart.
+        rtHitDistance = isFinite(d) ? clamp(d, 0.0, kMissHitDistance) : kMissHitDistance;
+    }
+#endif
+
+    // Full confidence: SSLR alone. Below it, the more confident trace: a
+    // ray-traced result is fully confident (its miss is the true
+    // environment), so RT wins where it traced; else whatever SSLR found;
+    // else the environment map (issue 5, Far Cry 6 talk).
+    bool useSslr = false;
+    if (confidence >= C.confidenceThreshold) {
+        useSslr = true;
+    } else if (rtTraced) {
+        r.radiance = rtRadiance;
+        r.hitDistance = rtHitDistance;
+        r.source = kSourceRt;
+    } else if (confidence > 0.0) {
+        useSslr = true;
+    }
+    if (useSslr) {
+        r.radiance = sslrRadiance;
+        r.source = kSourceSslr;
+        // The reflected point is the surface the depth buffer holds at the
+        // hit texel, measured from this pixel's own surface.
+        const ivec2 hitTexel = clamp(ivec2(floor(sslrHitUv * vec2(C.size))), ivec2(0), ivec2(C.size) - 1);
+        const float hitDepth = texelFetch(depthTexture, hitTexel, 0).x;
+        if (hitDepth > 0.0) {
+            const vec3 hitPosition = worldPosition(vec2(hitTexel) + 0.5, hitDepth);
+            r.hitDistance = min(length(hitPosition - position), kMissHitDistance);
+        }
+    }
+    return r;
+}
+
+void main() {
+    const uvec2 pixel = gl_GlobalInvocationID.xy;
+    const uint lane = gl_LocalInvocationIndex;
+    if (lane == 0u) {
+        sharedHits = 0u;
+        sharedMisses = 0u;
+    }
+    barrier();
+
+    if (pixel.x < C.size.x && pixel.y < C.size.y) {
+        const Reflection r = integratePixel(pixel);
+        const vec3 radiance = clamp(r.radiance, vec3(0.0), vec3(kMaxHalf));
+        const bool finite = isFinite(radiance) && isFinite(r.hitDistance);
+        const ivec2 p = ivec2(pixel);
+        imageStore(radianceImage, p, vec4(finite ? radiance : vec3(0.0), r.reflects));
+        imageStore(hitDistanceImage, p, vec4(finite ? r.hitDistance : kMissHitDistance));
+        imageStore(sourceImage, p, integrateSourceColour(r.source));
+    }
+    barrier();
+
+#if GLINT_INTEGRATE_FEEDBACK
+    // This frame's counts and, rotated into the previous half, the counts
+    // the feedback pass carried here from last frame (glint/feedback_shared.h).
+    // length(): the history pair keeps its size if the image is resized.
+    if (lane == 0u) {
+        const uint tile = gl_WorkGroupID.y * C.tiles.x + gl_WorkGroupID.x;
+        const uint carried = tile < uint(reprojected.length()) ? reprojected[tile] : 0u;
+        if (tile < uint(counters.length())) {
+            counters[tile] = rotateFeedback(carried, sharedHits, sharedMisses);
+        }
+    }
+#endif
+}
