@@ -1,0 +1,66 @@
+// Temporal accumulation of the reflections (passes/temporal.cpp,
+// shaders/temporal/*): the per-frame constants, shared by GLSL and C++.
+// One uniform buffer (scalar layout) serves both of the pass's shaders; it
+// holds four matrices, more than the 128 bytes of push constants every
+// device guarantees.
+//
+// History textures (ping-ponged by the graph across frames; their names
+// end in the image size, ".<width>x<height>"):
+//   temporal.radiance  RGBA32F; rgb: accumulated reflection radiance before
+//                      the spatial filter; a: history length in frames
+//                      (0: none)
+//   temporal.surface   RGBA16F; x: view depth (clip w) of the pixel's surface,
+//                      y: perceptual roughness, zw: octahedral world normal
+//                      (glint/packing.h's octEncode, unquantised); x = 0
+//                      where nothing reflects
+#ifndef GLINT_TEMPORAL_SHARED_H
+#define GLINT_TEMPORAL_SHARED_H
+
+#include "glint/shared.h"
+
+GLINT_BEGIN
+
+// 8x8 workgroups over the image.
+GLINT_CONST uint kTemporalGroupSize = 8u;
+
+// The spatial filter's largest radius in pixels (its loop bound).
+GLINT_CONST uint kTemporalMaxSpatialRadius = 4u;
+
+// Positions are reconstructed with the jittered matrices the depth was
+// rasterised with (exact points); motion uses the unjittered ones, as the
+// G-buffer's motion does (glint/gbuffer_shared.h).
+struct TemporalFrame {
+    mat4 inverseViewProjection;          // this frame, jittered
+    mat4 viewProjection;                 // this frame, unjittered
+    mat4 previousViewProjection;         // last frame, unjittered
+    mat4 previousInverseViewProjection;  // last frame, jittered
+    vec4 cameraPosition;                 // xyz, this frame
+    vec4 previousCameraPosition;         // xyz, last frame
+    uvec2 size;                          // pixels
+    uint resetHistory;                   // 1: ignore the history
+    uint neighbourhoodClamp;             // 1: variance clipping on
+    float maxHistoryFrames;
+    float clampGamma;
+    float planeTolerance;
+    float normalTolerance;               // smallest cosine between history and current normal
+    float roughnessTolerance;
+    float surfaceMotionRoughnessStart;
+    float surfaceMotionRoughnessEnd;
+    float maxRadiance;
+    uint spatialRadius;                  // 0: the spatial filter is off
+    float spatialRoughnessStart;
+    float spatialRoughnessEnd;
+    float spatialPlaneSigma;
+    float spatialNormalPower;
+    float spatialRoughnessSigma;
+    float pad0;
+    float pad1;
+};
+
+GLINT_END
+
+#ifdef __cplusplus
+static_assert(sizeof(glint::shader::TemporalFrame) == 4 * 64 + 2 * 16 + 80);
+#endif
+
+#endif

@@ -1,0 +1,310 @@
+#version 460
+// Reflection motion and temporal accumulation (passes/temporal.h), one
+// thread per pixel:
+//   1. sanitise this frame's radiance: NaN and Inf are dropped (the pixel
+//      takes its neighbours' mean), the rest is clamped to [0, maxRadiance]
+//      so nothing a half float cannot hold reaches the history;
+//   2. reflection motion: the reflected (virtual) point lies hitDistance
+//      behind the surface along the view ray; projected with last frame's
+//      view-projection it says where last frame saw this reflection
+//      (misses: the view direction alone, a point at infinity). Rough
+//      reflections are blurry and follow the surface instead: the two
+//      motions blend by roughness;
+//   3. history at each candidate, bilinear over four taps, each tap kept
+//      only if last frame's surface there lies on this pixel's plane with a
+//      similar normal and roughness (disocclusion and history rejection);
+//   4. variance clipping of the history in YCoCg over the 3x3 neighbourhood
+//      (Salvi, "An Excursion in Temporal Supersampling", GDC 2016; YCoCg,
+//      clipping towards the mean and the luma-compressed space as Karis,
+//      "High Quality Temporal Supersampling", SIGGRAPH 2014);
+//   5. an exponential moving average with weight 1 / history length, the
+//      length capped at maxHistoryFrames.
+#extension GL_GOOGLE_include_directive : require
+#extension GL_EXT_scalar_block_layout : require
+
+#include "glint/packing.h"
+#include "glint/ray_generation_shared.h"
+#include "glint/temporal_shared.h"
+#include "temporal_common.glsl"
+
+layout(local_size_x = 8, local_size_y = 8) in;
+
+layout(set = 0, binding = 1) uniform sampler2D depthTexture;
+layout(set = 0, binding = 2) uniform sampler2D normalTexture;
+layout(set = 0, binding = 3) uniform sampler2D roughnessMetalTexture;
+layout(set = 0, binding = 4) uniform sampler2D motionTexture;
+layout(set = 0, binding = 5) uniform sampler2D radianceTexture;
+layout(set = 0, binding = 6) uniform sampler2D hitDistanceTexture;
+layout(set = 0, binding = 7) uniform sampler2D previousRadianceTexture;
+layout(set = 0, binding = 8) uniform sampler2D previousSurfaceTexture;
+layout(set = 0, binding = 9, rgba32f) uniform writeonly image2D radianceHistory;
+layout(set = 0, binding = 10, rgba16f) uniform writeonly image2D surfaceHistory;
+// RG16F and R16F are not among the formats every device can store with a
+// format qualifier; the context enables shaderStorageImageWriteWithoutFormat.
+layout(set = 0, binding = 11) uniform writeonly image2D motionImage;
+layout(set = 0, binding = 12) uniform writeonly image2D lengthImage;
+
+vec3 rgbToYCoCg(vec3 c) {
+    return vec3(0.25 * c.r + 0.5 * c.g + 0.25 * c.b, 0.5 * c.r - 0.5 * c.b, -0.25 * c.r + 0.5 * c.g - 0.25 * c.b);
+}
+
+vec3 yCoCgToRgb(vec3 c) {
+    return vec3(c.x + c.y - c.z, c.x + c.z, c.x - c.y - c.z);
+}
+
+// The neighbourhood statistics and the clip work on c / (1 + luma(c))
+// (Karis 2014's "tonemap before resolve"): a firefly counts as at most 1
+// there, so one huge sample cannot drag its neighbours' boxes, and the
+// histories clipped into them, towards itself.
+float luma(vec3 c) { return dot(c, vec3(0.2126, 0.7152, 0.0722)); }
+vec3 compress(vec3 c) { return c / (1.0 + luma(c)); }
+vec3 expand(vec3 c) { return c / max(1.0 - luma(c), 1e-4); }
+
+// This frame's radiance at a texel, or false where it reflects nothing or
+// is not finite.
+bool currentRadiance(ivec2 texel, out vec3 radiance) {
+    const vec4 r = texelFetch(radianceTexture, texel, 0);
+    radiance = vec3(0.0);
+    if (!(r.a > 0.0) || !isFinite(r.rgb)) {
+        return false;
+    }
+    radiance = clamp(r.rgb, vec3(0.0), vec3(frame.maxRadiance));
+    return true;
+}
+
+// Where the previous camera's ray through the centre of `texel` meets view
+// depth `w`.
+vec3 previousPosition(ivec2 texel, float w) {
+    const vec2 ndc = (vec2(texel) + 0.5) / vec2(frame.size) * 2.0 - 1.0;
+    const vec4 near = frame.previousInverseViewProjection * vec4(ndc, 1.0, 1.0);
+    const vec3 camera = frame.previousCameraPosition.xyz;
+    const vec3 dir = near.xyz / near.w - camera;
+    const mat4 m = frame.previousViewProjection;
+    // w is linear along a ray from the camera (where it is 0).
+    const float wPerUnit = dot(vec3(m[0][3], m[1][3], m[2][3]), dir);
+    return camera + dir * (w / wPerUnit);
+}
+
+struct Pixel {
+    vec3 position;
+    vec3 normal;
+    float roughness;
+    float w;
+};
+
+// One history texel, or false where last frame saw another surface there:
+// off the plane (by more than planeTolerance of the view depth: a
+// disocclusion, or an object that moved across depth), turned away, of
+// another roughness, or holding nothing usable.
+bool historyTap(ivec2 texel, Pixel px, out vec4 radiance) {
+    radiance = vec4(0.0);
+    if (any(lessThan(texel, ivec2(0))) || any(greaterThanEqual(texel, ivec2(frame.size)))) {
+        return false;
+    }
+    const vec4 surface = texelFetch(previousSurfaceTexture, texel, 0);
+    radiance = texelFetch(previousRadianceTexture, texel, 0);
+    if (!(surface.x > 0.0) || !(radiance.a >= 1.0) || !isFinite(radiance.rgb) || !isFinite(surface.yzw)) {
+        return false;
+    }
+    const vec3 q = previousPosition(texel, surface.x);
+    if (!(abs(dot(q - px.position, px.normal)) <= frame.planeTolerance * px.w)) {
+        return false;
+    }
+    const vec3 n = octDecode(clamp(surface.zw, vec2(-1.0), vec2(1.0)));
+    if (dot(n, px.normal) < frame.normalTolerance) {
+        return false;
+    }
+    return abs(surface.y - px.roughness) <= frame.roughnessTolerance;
+}
+
+// Bilinear history at a continuous position (pixels), over the valid taps
+// only (renormalised): false when less than a hundredth of the footprint is
+// valid (as SVGF's reprojection does, Schied et al., HPG 2017).
+bool sampleHistory(vec2 position, Pixel px, out vec3 radiance, out float historyLength) {
+    radiance = vec3(0.0);
+    historyLength = 0.0;
+    if (!isFinite(position)) {
+        return false;
+    }
+    // Far outside the image: nothing to find, and the ivec conversion
+    // below must stay in range.
+    const vec2 size = vec2(frame.size);
+    if (any(lessThan(position, vec2(-1.0))) || any(greaterThan(position, size + 1.0))) {
+        return false;
+    }
+    const vec2 base = floor(position - 0.5);
+    const vec2 f = position - 0.5 - base;
+    float weightSum = 0.0;
+    for (int i = 0; i < 4; ++i) {
+        const ivec2 offset = ivec2(i & 1, i >> 1);
+        const float weight = (offset.x == 1 ? f.x : 1.0 - f.x) * (offset.y == 1 ? f.y : 1.0 - f.y);
+        vec4 tap;
+        if (weight > 0.0 && historyTap(ivec2(base) + offset, px, tap)) {
+            radiance += weight * tap.rgb;
+            historyLength += weight * tap.a;
+            weightSum += weight;
+        }
+    }
+    if (weightSum < 0.01) {
+        return false;
+    }
+    radiance /= weightSum;
+    historyLength /= weightSum;
+    return true;
+}
+
+// 0 below `start`, 1 from `end`, smooth between (smoothstep is undefined
+// for start >= end).
+float ramp(float x, float start, float end) {
+    if (x <= start) return 0.0;
+    if (x >= end) return 1.0;
+    return smoothstep(start, end, x);
+}
+
+void writeNothing(ivec2 p, vec2 motion) {
+    imageStore(radianceHistory, p, vec4(0.0));
+    imageStore(surfaceHistory, p, vec4(0.0));
+    imageStore(motionImage, p, vec4(motion, 0.0, 0.0));
+    imageStore(lengthImage, p, vec4(0.0));
+}
+
+void main() {
+    const ivec2 p = ivec2(gl_GlobalInvocationID.xy);
+    if (p.x >= int(frame.size.x) || p.y >= int(frame.size.y)) {
+        return;
+    }
+    const vec2 size = vec2(frame.size);
+    const vec2 centre = vec2(p) + 0.5;
+    vec2 surfaceMotion = texelFetch(motionTexture, p, 0).xy;
+    if (!isFinite(surfaceMotion)) {
+        surfaceMotion = vec2(0.0);
+    }
+    const float depth = texelFetch(depthTexture, p, 0).x;
+    const vec4 normalSample = texelFetch(normalTexture, p, 0);
+    const float reflectMask = texelFetch(radianceTexture, p, 0).a;
+    if (!(depth > 0.0) || !(normalSample.w > 0.0) || !(reflectMask > 0.0) || !isFinite(normalSample.xyz)) {
+        writeNothing(p, surfaceMotion);
+        return;
+    }
+
+    Pixel px;
+    px.position = worldPosition(frame.inverseViewProjection, centre, size, depth);
+    px.normal = normalize(normalSample.xyz);
+    px.roughness = texelFetch(roughnessMetalTexture, p, 0).r;
+    px.w = viewDepth(frame.viewProjection, px.position);
+
+    // 1. This frame's radiance and its neighbourhood's statistics.
+    vec3 current;
+    bool hasCurrent = currentRadiance(p, current);
+    vec3 sum = vec3(0.0);
+    vec3 sumSquares = vec3(0.0);
+    float count = 0.0;
+    for (int dy = -1; dy <= 1; ++dy) {
+        for (int dx = -1; dx <= 1; ++dx) {
+            const ivec2 q = p + ivec2(dx, dy);
+            if (any(lessThan(q, ivec2(0))) || any(greaterThanEqual(q, ivec2(frame.size)))) continue;
+            vec3 c;
+            if (!currentRadiance(q, c)) continue;
+            const vec3 y = rgbToYCoCg(compress(c));
+            sum += y;
+            sumSquares += y * y;
+            count += 1.0;
+        }
+    }
+    const vec3 mean = count > 0.0 ? sum / count : vec3(0.0);
+    const vec3 sigma = count > 0.0 ? sqrt(max(sumSquares / count - mean * mean, vec3(0.0))) : vec3(0.0);
+    if (!hasCurrent && count > 0.0) {
+        // A NaN or Inf sample: its neighbours' mean stands in for it.
+        current = clamp(expand(max(yCoCgToRgb(mean), vec3(0.0))), vec3(0.0), vec3(frame.maxRadiance));
+        hasCurrent = true;
+    }
+
+    // 2. Reflection motion through the virtual point.
+    const vec3 viewDir = normalize(px.position - frame.cameraPosition.xyz);
+    const float hitDistance = texelFetch(hitDistanceTexture, p, 0).x;
+    vec4 clip;
+    if (!(hitDistance < kMissHitDistance)) {
+        // At infinity (NaN lands here too): only the direction reprojects.
+        clip = frame.previousViewProjection * vec4(viewDir, 0.0);
+    } else {
+        clip = frame.previousViewProjection * vec4(px.position + viewDir * max(hitDistance, 0.0), 1.0);
+    }
+    // Motion runs between unjittered positions (the G-buffer's
+    // convention); every point of the view ray, the virtual one included,
+    // has the surface's unjittered position this frame.
+    const vec4 currentClip = frame.viewProjection * vec4(px.position, 1.0);
+    const vec2 unjittered = (currentClip.xy / currentClip.w * 0.5 + 0.5) * size;
+    // Behind last frame's camera the virtual point has no pixel.
+    const bool virtualValid = clip.w > 1e-6;
+    const vec2 virtualMotion = virtualValid ? (clip.xy / clip.w * 0.5 + 0.5) * size - unjittered : surfaceMotion;
+    const float surfaceWeight =
+        virtualValid ? ramp(px.roughness, frame.surfaceMotionRoughnessStart, frame.surfaceMotionRoughnessEnd) : 1.0;
+    const vec2 reflectionMotion = mix(virtualMotion, surfaceMotion, surfaceWeight);
+
+    // 3. History at both candidates, blended by roughness; either one alone
+    // where the other is rejected.
+    vec3 history = vec3(0.0);
+    float historyLength = 0.0;
+    bool hasHistory = false;
+    if (frame.resetHistory == 0u) {
+        vec3 virtualHistory = vec3(0.0), surfaceHistoryRadiance = vec3(0.0);
+        float virtualLength = 0.0, surfaceLength = 0.0;
+        bool virtualOk = false, surfaceOk = false;
+        if (surfaceWeight < 1.0) {
+            virtualOk = sampleHistory(centre + virtualMotion, px, virtualHistory, virtualLength);
+        }
+        if (surfaceWeight > 0.0 || !virtualOk) {
+            if (surfaceWeight < 1.0 && distance(virtualMotion, surfaceMotion) < 1e-3) {
+                // The same taps (a static camera, a mirror at rest).
+                surfaceOk = virtualOk;
+                surfaceHistoryRadiance = virtualHistory;
+                surfaceLength = virtualLength;
+            } else {
+                surfaceOk = sampleHistory(centre + surfaceMotion, px, surfaceHistoryRadiance, surfaceLength);
+            }
+        }
+        float wv = virtualOk ? 1.0 - surfaceWeight : 0.0;
+        float ws = surfaceOk ? surfaceWeight : 0.0;
+        if (virtualOk && !surfaceOk) wv = 1.0;
+        if (surfaceOk && !virtualOk) ws = 1.0;
+        if (wv + ws > 0.0) {
+            hasHistory = true;
+            history = (wv * virtualHistory + ws * surfaceHistoryRadiance) / (wv + ws);
+            // A count of frames: blending taps may leave it a hair off an
+            // integer, which a half-float store rounding towards zero (as
+            // Vulkan allows) would turn into a frame less every frame.
+            historyLength = max(floor((wv * virtualLength + ws * surfaceLength) / (wv + ws) + 0.5), 1.0);
+        }
+    }
+
+    // 4. Variance clipping: pull the history along the line to the mean
+    // until it lies inside mean +- gamma sigma.
+    if (hasHistory && frame.neighbourhoodClamp != 0u && count > 0.0) {
+        const vec3 extent = max(frame.clampGamma * sigma, vec3(1e-4));
+        const vec3 offset = rgbToYCoCg(compress(history)) - mean;
+        const vec3 units = abs(offset / extent);
+        const float m = max(units.x, max(units.y, units.z));
+        if (m > 1.0) {
+            history = clamp(expand(max(yCoCgToRgb(mean + offset / m), vec3(0.0))), vec3(0.0),
+                            vec3(frame.maxRadiance));
+        }
+    }
+
+    // 5. Accumulate.
+    vec3 result;
+    float newLength;
+    if (!hasCurrent) {
+        // Nothing finite anywhere near: keep the history as it is.
+        result = history;
+        newLength = hasHistory ? historyLength : 0.0;
+    } else {
+        newLength = hasHistory ? min(historyLength + 1.0, frame.maxHistoryFrames) : 1.0;
+        result = mix(history, current, 1.0 / max(newLength, 1.0));
+    }
+    result = clamp(result, vec3(0.0), vec3(frame.maxRadiance));
+
+    imageStore(radianceHistory, p, vec4(result, newLength));
+    imageStore(surfaceHistory, p, vec4(px.w, px.roughness, octEncode(px.normal)));
+    imageStore(motionImage, p, vec4(reflectionMotion, 0.0, 0.0));
+    imageStore(lengthImage, p, vec4(newLength));
+}

@@ -1,0 +1,82 @@
+#version 460
+// The spatial filter of the temporal pass (passes/temporal.h): an
+// edge-aware blur of the accumulated reflections, strong where the surface
+// is rough (its reflection is blurry anyway and its rays noisy) and off for
+// mirrors. A Gaussian over a (2r+1)^2 window, each tap weighted by how far
+// it lies off this pixel's plane, how far its normal turns away and how
+// different its roughness is (the cross-bilateral weights of SVGF, Schied
+// et al., HPG 2017, with a plane distance in place of a depth gradient).
+// It reads the history but writes only the resolved image: fed back into
+// the history it would blur again every frame.
+#extension GL_GOOGLE_include_directive : require
+#extension GL_EXT_scalar_block_layout : require
+
+#include "glint/temporal_shared.h"
+#include "temporal_common.glsl"
+
+layout(local_size_x = 8, local_size_y = 8) in;
+
+layout(set = 0, binding = 1) uniform sampler2D depthTexture;
+layout(set = 0, binding = 2) uniform sampler2D normalTexture;
+layout(set = 0, binding = 3) uniform sampler2D roughnessMetalTexture;
+layout(set = 0, binding = 4) uniform sampler2D accumulatedTexture;
+layout(set = 0, binding = 5, rgba16f) uniform writeonly image2D resolvedImage;
+
+float ramp(float x, float start, float end) {
+    if (x <= start) return 0.0;
+    if (x >= end) return 1.0;
+    return smoothstep(start, end, x);
+}
+
+void main() {
+    const ivec2 p = ivec2(gl_GlobalInvocationID.xy);
+    if (p.x >= int(frame.size.x) || p.y >= int(frame.size.y)) {
+        return;
+    }
+    const vec4 centre = texelFetch(accumulatedTexture, p, 0);
+    // No history length: nothing reflects here (or nothing finite yet).
+    if (!(centre.a > 0.0)) {
+        imageStore(resolvedImage, p, vec4(0.0));
+        return;
+    }
+    const float roughness = texelFetch(roughnessMetalTexture, p, 0).r;
+    const float strength = ramp(roughness, frame.spatialRoughnessStart, frame.spatialRoughnessEnd);
+    const int radius = int(min(frame.spatialRadius, kTemporalMaxSpatialRadius));
+    if (radius == 0 || strength <= 0.0) {
+        imageStore(resolvedImage, p, vec4(centre.rgb, 1.0));
+        return;
+    }
+    const vec2 size = vec2(frame.size);
+    const vec3 position = worldPosition(frame.inverseViewProjection, vec2(p) + 0.5, size,
+                                        texelFetch(depthTexture, p, 0).x);
+    const vec3 normal = normalize(texelFetch(normalTexture, p, 0).xyz);
+    const float w = viewDepth(frame.viewProjection, position);
+    // Sigma of half the radius (plus half a pixel) keeps the window's
+    // corners near zero weight.
+    const float sigma = 0.5 * float(radius) + 0.5;
+    vec3 sum = centre.rgb;
+    float weightSum = 1.0;
+    for (int dy = -radius; dy <= radius; ++dy) {
+        for (int dx = -radius; dx <= radius; ++dx) {
+            const ivec2 q = p + ivec2(dx, dy);
+            if ((dx == 0 && dy == 0) || any(lessThan(q, ivec2(0))) || any(greaterThanEqual(q, ivec2(frame.size)))) {
+                continue;
+            }
+            const vec4 tap = texelFetch(accumulatedTexture, q, 0);
+            const float depth = texelFetch(depthTexture, q, 0).x;
+            if (!(tap.a > 0.0) || !(depth > 0.0)) continue;
+            const vec3 tapPosition = worldPosition(frame.inverseViewProjection, vec2(q) + 0.5, size, depth);
+            const vec3 tapNormal = texelFetch(normalTexture, q, 0).xyz;
+            const float tapRoughness = texelFetch(roughnessMetalTexture, q, 0).r;
+            const float plane = abs(dot(tapPosition - position, normal)) / max(frame.spatialPlaneSigma * w, 1e-6);
+            const float weight = exp(-float(dx * dx + dy * dy) / (2.0 * sigma * sigma)) * exp(-plane) *
+                                 pow(max(dot(tapNormal, normal), 0.0), frame.spatialNormalPower) *
+                                 exp(-abs(tapRoughness - roughness) / max(frame.spatialRoughnessSigma, 1e-6));
+            if (weight > 0.0 && isFinite(tap.rgb)) {
+                sum += weight * tap.rgb;
+                weightSum += weight;
+            }
+        }
+    }
+    imageStore(resolvedImage, p, vec4(mix(centre.rgb, sum / weightSum, strength), 1.0));
+}
