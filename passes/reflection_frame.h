@@ -1,0 +1,147 @@
+#pragma once
+// The whole hybrid-reflections frame (issue 5, DESIGN.md section 3) wired
+// from the pass functions: what glint-render, the benchmark, the viewer and
+// the golden-image tests declare every frame, and the reference for an
+// engine that wires the passes into its own frame.
+//
+//   BVH update (async compute) -> G-buffer -> feedback -> ray generation
+//   -> SSLR -> ray-traced hits -> integrate -> temporal -> composite
+//
+// Each mode declares only what it uses: ssr has no BVH and no ray-traced
+// pass, rt no SSLR and no feedback.
+//
+//   passes::ReflectionRenderer renderer(ctx, scene, {});
+//   each frame (after scene::advanceScene and camera.advance):
+//     rg::Graph graph(executor.queueCaps());
+//     const passes::ReflectionFrame frame = renderer.addFrame(graph, camera, settings);
+//     rg::FrameResources resources;
+//     renderer.bind(resources, frame);
+//     executor.run(graph.compile(executor.compileOptions()), resources);
+
+#include "gpu/context.h"
+#include "gpu/pipeline.h"
+#include "graph/graph.h"
+#include "passes/bvh_update.h"
+#include "passes/composite.h"
+#include "passes/feedback.h"
+#include "passes/gbuffer.h"
+#include "passes/integrate.h"
+#include "passes/ray_generation.h"
+#include "passes/rt_trace.h"
+#include "passes/sslr.h"
+#include "passes/temporal.h"
+#include "scene/bvh_planner.h"
+#include "scene/camera.h"
+#include "scene/scene.h"
+
+#include <memory>
+#include <optional>
+#include <span>
+#include <string>
+#include <string_view>
+
+namespace glint::passes {
+
+std::string_view modeName(ReflectionMode mode);
+// "hybrid", "ssr" or "rt"; throws std::invalid_argument naming the value otherwise.
+ReflectionMode parseMode(std::string_view name);
+std::string_view backendName(RtBackend backend);
+// "auto", "query" or "pipeline"; throws std::invalid_argument otherwise.
+RtBackend parseBackend(std::string_view name);
+
+struct ReflectionRendererOptions {
+    uint32_t framesInFlight = 2;  // at least the executor's
+    RtBackend backend = RtBackend::Auto;
+    scene::BvhSettings bvh;
+    BvhUpdateOptions bvhUpdate;
+};
+
+struct ReflectionFrameSettings {
+    ReflectionMode mode = ReflectionMode::Hybrid;
+    GBufferSettings gbuffer;
+    RayGenerationSettings rays;  // rays.mode is taken from `mode`
+    SslrSettings sslr;
+    RtTraceSettings rt;          // rt.backend is the renderer's
+    FeedbackSettings feedback;
+    IntegrateSettings integrate;  // integrate.confidenceThreshold is taken from sslr
+    TemporalSettings temporal;
+    CompositeSettings composite;
+    // Empty or "final": the composited image; otherwise one of
+    // debugViewNames(), shown in `output` instead.
+    std::string debugView;
+    // Discards the temporal history (first frame, camera cut).
+    bool resetHistory = false;
+    // Declares a small pass counting pixel classes and traced rays into
+    // ReflectionFrame::counts (for stats).
+    bool countRays = false;
+};
+
+// Everything a frame declared, for debug views, readbacks and stats.
+struct ReflectionFrame {
+    ReflectionMode mode = ReflectionMode::Hybrid;
+    GBufferOutputs gbuffer;
+    std::optional<BvhUpdateOutputs> bvh;
+    std::optional<FeedbackOutputs> feedback;
+    RayGenerationOutputs rays;
+    std::optional<SslrOutputs> sslr;
+    std::optional<RtTraceOutputs> rt;
+    IntegrateOutputs integrate;
+    TemporalOutputs temporal;
+    CompositeOutputs output;  // RGBA8, sRGB-encoded: the image or the debug view
+    // When ReflectionFrameSettings::countRays: kReflectionCountWords uints,
+    // glint/reflection_frame_shared.h.
+    rg::Buffer counts;
+    uint32_t width = 0;
+    uint32_t height = 0;
+};
+
+// Names accepted by ReflectionFrameSettings::debugView.
+std::span<const std::string_view> debugViewNames();
+
+// The passes whose GPU time is the reflections' cost (ray generation
+// through temporal accumulation: issue 5's reflection_ms).
+bool isReflectionPass(std::string_view passName);
+
+class ReflectionRenderer {
+public:
+    // `scene` must outlive the renderer; see GBufferRenderer and BvhManager
+    // for what may change in it between frames.
+    ReflectionRenderer(gpu::Context& ctx, const scene::Scene& scene, const ReflectionRendererOptions& options = {});
+    ~ReflectionRenderer();
+    ReflectionRenderer(const ReflectionRenderer&) = delete;
+    ReflectionRenderer& operator=(const ReflectionRenderer&) = delete;
+
+    // Declares one frame seen through `camera` (its frameIndex drives all
+    // noise). Frames are declared and run one at a time, once each. The
+    // output is marked as the graph's output, so every frame compiles to
+    // the same passes whether or not the caller reads it back: the graph
+    // plans history images from this frame's own uses (graph.h).
+    ReflectionFrame addFrame(rg::Graph& graph, const scene::Camera& camera, const ReflectionFrameSettings& settings);
+    // Binds the frame's imports (the BVH's objects).
+    void bind(rg::FrameResources& resources, const ReflectionFrame& frame) const;
+
+    RtBackend backend() const { return rt_.backend(); }
+    const GBufferStats& gbufferStats() const { return gbuffer_.stats(); }
+    // Of the last frame that declared BVH work (none in ssr mode).
+    const scene::BvhStats& bvhPlanStats() const { return lastPlanStats_; }
+    const BvhGpuStats& bvhGpuStats() const { return bvh_.stats(); }
+
+private:
+    gpu::Context& ctx_;
+    const scene::Scene& scene_;
+    GBufferRenderer gbuffer_;
+    scene::BvhPlanner planner_;
+    BvhManager bvh_;
+    FeedbackPipelines feedback_;
+    RayGenerationPipelines rays_;
+    SslrPipelines sslr_;
+    RtTracePipelines rt_;
+    IntegratePipelines integrate_;
+    TemporalPipelines temporal_;
+    CompositePipelines composite_;
+    gpu::Pipeline tileView_;
+    gpu::Pipeline classCount_;
+    scene::BvhStats lastPlanStats_;
+};
+
+} // namespace glint::passes

@@ -1,0 +1,216 @@
+#include "common/reflection_run.h"
+
+#include "graph/executor.h"
+#include "graph/graph.h"
+#include "scene/animation.h"
+
+#include "glint/reflection_frame_shared.h"
+
+#include <nlohmann/json.hpp>
+#include <spdlog/spdlog.h>
+
+#include <glm/gtc/matrix_transform.hpp>
+
+#include <algorithm>
+#include <chrono>
+#include <cstring>
+#include <map>
+
+namespace glint::app {
+
+namespace {
+
+constexpr rg::BoundaryState kHostRead =
+    rg::BoundaryState::raw(VK_PIPELINE_STAGE_2_HOST_BIT, VK_ACCESS_2_HOST_READ_BIT, VK_IMAGE_LAYOUT_UNDEFINED);
+
+double median(std::vector<double> values) {
+    if (values.empty()) return 0.0;
+    std::sort(values.begin(), values.end());
+    const size_t n = values.size();
+    return n % 2 ? values[n / 2] : 0.5 * (values[n / 2 - 1] + values[n / 2]);
+}
+
+// Copies `source` (an image, or a buffer) into a host-visible import at the
+// end of the frame.
+void addCopyToHost(rg::Graph& graph, rg::FrameResources& resources, const gpu::Buffer& target, const char* name,
+                   rg::Texture image, rg::Buffer buffer, uint32_t width, uint32_t height) {
+    const rg::Buffer imported = graph.importBuffer(
+        name, {{target.size()}, rg::BoundaryState::of(rg::Access::TransferDst), kHostRead});
+    resources.bind(imported, target);
+    struct CopyData {
+        rg::Texture image;
+        rg::Buffer buffer;
+        rg::Buffer target;
+    };
+    const CopyData& copy = graph.addPass<CopyData>(
+        name, rg::Queue::Graphics,
+        [&](rg::Builder& b, CopyData& d) {
+            if (image.valid()) d.image = b.read(image, rg::Access::TransferSrc);
+            if (buffer.valid()) d.buffer = b.read(buffer, rg::Access::TransferSrc);
+            d.target = b.write(imported, rg::Access::TransferDst);
+        },
+        [width, height](const CopyData& d, rg::PassContext& pc) {
+            const gpu::Buffer& dst = pc.buffer(d.target);
+            if (d.image.valid()) {
+                VkBufferImageCopy region{};
+                region.imageSubresource = {VK_IMAGE_ASPECT_COLOR_BIT, 0, 0, 1};
+                region.imageExtent = {width, height, 1};
+                vkCmdCopyImageToBuffer(pc.cmd(), pc.image(d.image).handle(), VK_IMAGE_LAYOUT_TRANSFER_SRC_OPTIMAL,
+                                       dst.handle(), 1, &region);
+            } else {
+                const VkBufferCopy region{0, 0, dst.size()};
+                vkCmdCopyBuffer(pc.cmd(), pc.buffer(d.buffer).handle(), dst.handle(), 1, &region);
+            }
+        });
+    graph.markOutput(copy.target);
+}
+
+} // namespace
+
+scene::CameraPose cameraPoseAt(const scene::Scene& scene, const ReflectionRunOptions& options, uint32_t frame) {
+    const float seconds = options.startSeconds + float(frame) * options.frameSeconds;
+    if (scene.cameraPath.keys.size() != 1) {
+        return scene.cameraPath.evaluate(seconds);
+    }
+    // A quarter degree per frame around the view's target, about the up axis.
+    const scene::CameraPathKey& key = scene.cameraPath.keys.front();
+    const float angle = glm::radians(0.25f) * float(frame);
+    const glm::mat4 orbit = glm::rotate(glm::mat4(1.0f), angle, glm::vec3(0.0f, 1.0f, 0.0f));
+    scene::CameraPose pose;
+    pose.position = key.target + glm::vec3(orbit * glm::vec4(key.position - key.target, 0.0f));
+    pose.target = key.target;
+    return pose;
+}
+
+ReflectionRunResult runReflections(gpu::Context& ctx, scene::Scene& scene, const ReflectionRunOptions& options) {
+    if (options.frames == 0) throw std::invalid_argument("--frames must be at least 1");
+    rg::Executor executor(ctx, options.renderer.framesInFlight);
+    passes::ReflectionRenderer renderer(ctx, scene, options.renderer);
+
+    ReflectionRunResult result;
+    result.backend = renderer.backend();
+    const uint32_t w = options.width, h = options.height;
+    gpu::Buffer image(ctx, {VkDeviceSize(w) * h * 4, VK_BUFFER_USAGE_TRANSFER_DST_BIT, gpu::MemoryUsage::Readback,
+                            "glint.output_readback"});
+    gpu::Buffer counts(ctx, {shader::kReflectionCountWords * 4u, VK_BUFFER_USAGE_TRANSFER_DST_BIT,
+                             gpu::MemoryUsage::Readback, "glint.counts_readback"});
+
+    scene::Camera camera;
+    camera.resolution = {w, h};
+    camera.lens = scene.lens;
+    camera.jitter = options.jitter && options.frames > 1;
+
+    std::map<std::string, std::vector<double>> passTimes;
+    std::map<std::string, rg::Queue> passQueues;
+    std::vector<std::string> passOrder;
+    std::vector<double> reflectionTimes, totalTimes;
+    const auto collectTimings = [&] {
+        const std::vector<rg::PassTiming> timings = executor.timings();
+        double reflection = 0.0, total = 0.0;
+        bool any = false;
+        for (const rg::PassTiming& t : timings) {
+            if (!t.milliseconds) continue;
+            any = true;
+            if (!passTimes.count(t.name)) passOrder.push_back(t.name);
+            passTimes[t.name].push_back(*t.milliseconds);
+            passQueues[t.name] = t.queue;
+            total += *t.milliseconds;
+            if (passes::isReflectionPass(t.name)) reflection += *t.milliseconds;
+        }
+        if (any) {
+            reflectionTimes.push_back(reflection);
+            totalTimes.push_back(total);
+        }
+    };
+
+    const auto start = std::chrono::steady_clock::now();
+    auto lastReport = start;
+    for (uint32_t i = 0; i < options.frames; ++i) {
+        const scene::CameraPose pose = cameraPoseAt(scene, options, i);
+        if (i == 0) {
+            camera.reset(pose, 0);
+        } else {
+            camera.advance(pose, i);
+        }
+        scene::advanceScene(scene, options.startSeconds + float(i) * options.frameSeconds, &camera);
+
+        const bool last = i + 1 == options.frames;
+        passes::ReflectionFrameSettings settings = options.frame;
+        settings.resetHistory = i == 0;
+        settings.countRays = last;
+        rg::Graph graph(executor.queueCaps());
+        const passes::ReflectionFrame frame = renderer.addFrame(graph, camera, settings);
+        rg::FrameResources resources;
+        renderer.bind(resources, frame);
+        if (last) {
+            addCopyToHost(graph, resources, image, "readback.output", frame.output.color, {}, w, h);
+            addCopyToHost(graph, resources, counts, "readback.counts", {}, frame.counts, w, h);
+        }
+        executor.run(graph.compile(executor.compileOptions()), resources);
+        // Timings of the latest completed frame (the first frames in flight
+        // have none yet; the median absorbs a frame read twice).
+        if (i > 0) collectTimings();
+        if (frame.bvh) {
+            result.blasBuilt += renderer.bvhGpuStats().blasBuilds;
+            result.blasRebuilt += renderer.bvhGpuStats().blasRebuilds;
+        }
+
+        const auto now = std::chrono::steady_clock::now();
+        if (now - lastReport > std::chrono::seconds(2) && !last) {
+            spdlog::info("frame {}/{} ({:.1f} s)", i + 1, options.frames,
+                         std::chrono::duration<double>(now - start).count());
+            lastReport = now;
+        }
+    }
+    executor.waitIdle();
+    collectTimings();
+
+    for (const std::string& name : passOrder) {
+        result.passes.push_back({name, passQueues[name], median(passTimes[name])});
+    }
+    result.framesTimed = uint32_t(totalTimes.size());
+    if (!totalTimes.empty()) {
+        result.reflectionMs = median(reflectionTimes);
+        result.totalMs = median(totalTimes);
+    }
+    result.rgba.resize(size_t(w) * h * 4);
+    std::memcpy(result.rgba.data(), image.mapped(), result.rgba.size());
+    std::vector<uint32_t> words(shader::kReflectionCountWords);
+    std::memcpy(words.data(), counts.mapped(), words.size() * 4);
+    result.pixelClasses.assign(words.begin(), words.begin() + shader::kPixelClassCount);
+    result.sslrRays = words[shader::kCountSslrRays];
+    result.rtRays = words[shader::kCountRtRays];
+    result.tlasInstances = options.frame.mode == passes::ReflectionMode::Ssr ? 0 : renderer.bvhGpuStats().tlasInstances;
+    return result;
+}
+
+std::string statsJson(const gpu::Context& ctx, const ReflectionRunOptions& options, const ReflectionRunResult& r) {
+    using nlohmann::json;
+    json j;
+    j["device"] = ctx.caps().deviceName;
+    j["driver"] = ctx.caps().driverName + " " + ctx.caps().driverInfo;
+    j["mode"] = std::string(passes::modeName(options.frame.mode));
+    j["backend"] = options.frame.mode == passes::ReflectionMode::Ssr ? "none" : std::string(passes::backendName(r.backend));
+    j["size"] = {options.width, options.height};
+    j["frames"] = options.frames;
+    j["frames_timed"] = r.framesTimed;
+    json passList = json::array();
+    for (const PassTime& p : r.passes) {
+        passList.push_back({{"name", p.name},
+                            {"queue", p.queue == rg::Queue::AsyncCompute ? "async_compute" : "graphics"},
+                            {"gpu_ms", p.milliseconds}});
+    }
+    j["passes"] = passList;
+    j["reflection_ms"] = r.reflectionMs ? json(*r.reflectionMs) : json(nullptr);
+    j["total_ms"] = r.totalMs ? json(*r.totalMs) : json(nullptr);
+    j["rays"] = {{"sslr", r.sslrRays}, {"rt", r.rtRays}};
+    const double pixels = double(options.width) * options.height;
+    const auto share = [&](uint32_t c) { return c < r.pixelClasses.size() ? double(r.pixelClasses[c]) / pixels : 0.0; };
+    j["pixel_classes"] = {{"ssr", share(shader::kPixelSslr)}, {"hybrid", share(shader::kPixelHybrid)},
+                          {"rt", share(shader::kPixelRt)},    {"env", share(shader::kPixelEnv)},
+                          {"sky", share(shader::kPixelSky)}};
+    j["bvh"] = {{"blas_built", r.blasBuilt}, {"blas_rebuilt", r.blasRebuilt}, {"tlas_instances", r.tlasInstances}};
+    return j.dump(2) + "\n";
+}
+
+} // namespace glint::app

@@ -1,0 +1,65 @@
+#pragma once
+// Runs the reflection frame (passes/reflection_frame.h) over a camera path
+// and gathers what the samples report: the last frame's image, per-pass GPU
+// times (median over frames), ray and pixel-class counts, BVH stats.
+// Shared by glint-render and the benchmark.
+
+#include "gpu/context.h"
+#include "graph/types.h"
+#include "passes/reflection_frame.h"
+#include "scene/camera.h"
+#include "scene/scene.h"
+
+#include <optional>
+#include <string>
+#include <vector>
+
+namespace glint::app {
+
+struct ReflectionRunOptions {
+    uint32_t width = 256;
+    uint32_t height = 256;
+    uint32_t frames = 1;
+    float startSeconds = 0.0f;     // time on the scene's camera path of the first frame
+    float frameSeconds = 1.0f / 30.0f;
+    bool jitter = true;            // sub-pixel jitter (only with more than one frame)
+    passes::ReflectionRendererOptions renderer;
+    passes::ReflectionFrameSettings frame;
+};
+
+struct PassTime {
+    std::string name;
+    rg::Queue queue = rg::Queue::Graphics;
+    double milliseconds = 0.0;  // median over the frames measured
+};
+
+struct ReflectionRunResult {
+    std::vector<uint8_t> rgba;  // the last frame's output, width x height x 4, sRGB-encoded
+    std::vector<PassTime> passes;
+    std::optional<double> reflectionMs;  // median per-frame sum of the reflection passes
+    std::optional<double> totalMs;       // median per-frame sum of all passes
+    uint32_t framesTimed = 0;
+    // The last frame's counts (glint/reflection_frame_shared.h).
+    uint64_t sslrRays = 0;
+    uint64_t rtRays = 0;
+    std::vector<uint64_t> pixelClasses;  // per shader::kPixel*
+    // BVH work over all frames, and the last frame's TLAS.
+    uint64_t blasBuilt = 0;
+    uint64_t blasRebuilt = 0;
+    uint32_t tlasInstances = 0;
+    passes::RtBackend backend = passes::RtBackend::Auto;
+};
+
+// Frame i's camera: along the scene's path from startSeconds; a path of one
+// key (a glTF file's framing view) becomes a slow orbit around its target,
+// so temporal passes and motion vectors are exercised deterministically.
+scene::CameraPose cameraPoseAt(const scene::Scene& scene, const ReflectionRunOptions& options, uint32_t frame);
+
+// Renders options.frames frames of `scene` (which it animates).
+ReflectionRunResult runReflections(gpu::Context& ctx, scene::Scene& scene, const ReflectionRunOptions& options);
+
+// The stats JSON of issue 5 (device, mode, size, frames, passes,
+// reflection_ms, rays, pixel_classes, bvh).
+std::string statsJson(const gpu::Context& ctx, const ReflectionRunOptions& options, const ReflectionRunResult& result);
+
+} // namespace glint::app
