@@ -111,7 +111,8 @@ RtTracePipelines::RtTracePipelines(gpu::Context& ctx, RtBackend backend)
       // Every read is a texelFetch; the sampler only completes the combined
       // descriptors.
       nearest_(ctx, {VK_FILTER_NEAREST, VK_SAMPLER_MIPMAP_MODE_NEAREST, VK_SAMPLER_ADDRESS_MODE_CLAMP_TO_EDGE, 0.0f,
-                     "rt_trace.nearest"}) {
+                     "rt_trace.nearest"}),
+      clearer_(ctx) {
     VkPhysicalDeviceProperties properties{};
     vkGetPhysicalDeviceProperties(ctx.physicalDevice(), &properties);
     subPixelPrecisionBits_ = properties.limits.subPixelPrecisionBits;
@@ -215,19 +216,17 @@ RtTraceOutputs addRtTracePass(rg::Graph& graph, RtTracePipelines& pipelines, con
         [&](rg::Builder& b, ClearData& d) {
             const auto texture = [&](const char* name, VkFormat format) {
                 return b.write(b.createTexture(name, {.width = gbuf.width, .height = gbuf.height, .format = format}),
-                               rg::Access::TransferDst);
+                               rg::Access::StorageWrite);
             };
             d.radiance = texture("rt_trace.radiance", kRtRadianceFormat);
             d.hitDistance = texture("rt_trace.hit_distance", kRtHitDistanceFormat);
             d.constants = b.write(b.createBuffer("rt_trace.constants", {sizeof(shader::RtTraceConstants)}),
                                   rg::Access::TransferDst);
         },
-        [constants](const ClearData& d, rg::PassContext& pc) {
+        [&pipelines, constants](const ClearData& d, rg::PassContext& pc) {
             vkCmdUpdateBuffer(pc.cmd(), pc.buffer(d.constants).handle(), 0, sizeof(constants), &constants);
-            const VkClearColorValue zero{};
-            const VkImageSubresourceRange range{VK_IMAGE_ASPECT_COLOR_BIT, 0, 1, 0, 1};
             for (const rg::Texture t : {d.radiance, d.hitDistance}) {
-                vkCmdClearColorImage(pc.cmd(), pc.image(t).handle(), pc.layout(t), &zero, 1, &range);
+                pipelines.clearer_.clear(pc, t);
             }
         });
 

@@ -34,6 +34,7 @@
 #include "graph/graph.h"
 #include "passes/bvh_update.h"
 #include "passes/gbuffer.h"
+#include "passes/image_clear.h"
 #include "scene/camera.h"
 
 #include "glint/gbuffer_shared.h"
@@ -138,6 +139,7 @@ private:
     std::optional<gpu::Pipeline> pipeline_;
     std::optional<gpu::ShaderBindingTable> sbt_;
     gpu::Sampler nearest_;
+    ImageClearer clearer_;
 };
 
 // The rasteriser's share of a reconstructed G-buffer position's error

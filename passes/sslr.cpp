@@ -47,7 +47,8 @@ SslrPipelines::SslrPipelines(gpu::Context& ctx)
       // Every read is a texelFetch; the sampler only completes the combined
       // descriptor.
       nearest_(ctx, {VK_FILTER_NEAREST, VK_SAMPLER_MIPMAP_MODE_NEAREST, VK_SAMPLER_ADDRESS_MODE_CLAMP_TO_EDGE, 0.0f,
-                     "sslr.nearest"}) {}
+                     "sslr.nearest"}),
+      clearer_(ctx) {}
 
 SslrOutputs addSslrPass(rg::Graph& graph, SslrPipelines& pipelines, const SslrInputs& inputs,
                         const SslrSettings& settings) {
@@ -76,17 +77,15 @@ SslrOutputs addSslrPass(rg::Graph& graph, SslrPipelines& pipelines, const SslrIn
         [&](rg::Builder& b, ClearData& d) {
             const auto texture = [&](const char* name, VkFormat format) {
                 return b.write(b.createTexture(name, {.width = gbuf.width, .height = gbuf.height, .format = format}),
-                               rg::Access::TransferDst);
+                               rg::Access::StorageWrite);
             };
             d.radiance = texture("sslr.radiance", kSslrRadianceFormat);
             d.confidence = texture("sslr.confidence", kSslrConfidenceFormat);
             d.hitDebug = texture("sslr.hit_debug", kSslrHitDebugFormat);
         },
-        [](const ClearData& d, rg::PassContext& pc) {
-            const VkClearColorValue zero{};
-            const VkImageSubresourceRange range{VK_IMAGE_ASPECT_COLOR_BIT, 0, 1, 0, 1};
+        [&pipelines](const ClearData& d, rg::PassContext& pc) {
             for (const rg::Texture t : {d.radiance, d.confidence, d.hitDebug}) {
-                vkCmdClearColorImage(pc.cmd(), pc.image(t).handle(), pc.layout(t), &zero, 1, &range);
+                pipelines.clearer_.clear(pc, t);
             }
         });
 

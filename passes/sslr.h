@@ -19,6 +19,7 @@
 #include "gpu/resources.h"
 #include "graph/graph.h"
 #include "passes/gbuffer.h"
+#include "passes/image_clear.h"
 #include "passes/ray_generation.h"
 
 #include <glm/glm.hpp>
@@ -84,6 +85,7 @@ private:
     gpu::Context& ctx_;
     gpu::Pipeline trace_;
     gpu::Sampler nearest_;
+    ImageClearer clearer_;
 };
 
 // Declares the pass (see the top of this file) on the graphics queue.

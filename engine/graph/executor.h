@@ -101,6 +101,7 @@ struct PassTiming {
     std::string name;
     Queue queue = Queue::Graphics;
     std::optional<double> milliseconds;  // none where the queue has no timestamps
+    uint64_t frame = 0;                  // the run() it belongs to, counted from 0
 };
 
 struct ExecutorStats {

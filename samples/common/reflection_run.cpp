@@ -2,6 +2,7 @@
 
 #include "graph/executor.h"
 #include "graph/graph.h"
+#include "graph/verify.h"
 #include "scene/animation.h"
 
 #include "glint/reflection_frame_shared.h"
@@ -12,6 +13,8 @@
 #include <glm/gtc/matrix_transform.hpp>
 
 #include <algorithm>
+#include <array>
+#include <cmath>
 #include <chrono>
 #include <cstring>
 #include <map>
@@ -65,7 +68,81 @@ void addCopyToHost(rg::Graph& graph, rg::FrameResources& resources, const gpu::B
     graph.markOutput(copy.target);
 }
 
+// Each parameter: its name, the field, and where it lives.
+struct ParameterSlot {
+    Parameter parameter;
+    float* (*floatField)(ReflectionRunOptions&);
+    uint32_t* (*uintField)(ReflectionRunOptions&);
+};
+
+const std::array<ParameterSlot, 9> kParameters = {{
+    {{"sslr_threshold", "SslrSettings::confidenceThreshold"},
+     [](ReflectionRunOptions& o) { return &o.frame.sslr.confidenceThreshold; }, nullptr},
+    {{"sslr_steps", "SslrSettings::linearSteps"}, nullptr,
+     [](ReflectionRunOptions& o) { return &o.frame.sslr.linearSteps; }},
+    {{"sslr_thickness", "SslrSettings::thickness"},
+     [](ReflectionRunOptions& o) { return &o.frame.sslr.thickness; }, nullptr},
+    {{"roughness_cutoff", "RayGenerationSettings::roughnessCutoff"},
+     [](ReflectionRunOptions& o) { return &o.frame.rays.roughnessCutoff; }, nullptr},
+    {{"reuse_roughness", "RayGenerationSettings::reuseRoughness (samples per quad: 1 above it, 4 below)"},
+     [](ReflectionRunOptions& o) { return &o.frame.rays.reuseRoughness; }, nullptr},
+    {{"rt_near_distance", "RayGenerationSettings::rtMaxDistance"},
+     [](ReflectionRunOptions& o) { return &o.frame.rays.rtMaxDistance; }, nullptr},
+    {{"sslr_far_distance", "RayGenerationSettings::sslrMinDistance"},
+     [](ReflectionRunOptions& o) { return &o.frame.rays.sslrMinDistance; }, nullptr},
+    {{"bvh_radius", "BvhSettings::radius"}, [](ReflectionRunOptions& o) { return &o.renderer.bvh.radius; }, nullptr},
+    {{"rt_max_distance", "RtTraceSettings::maxDistance"},
+     [](ReflectionRunOptions& o) { return &o.frame.rt.maxDistance; }, nullptr},
+}};
+
+const ParameterSlot& findParameter(std::string_view name) {
+    for (const ParameterSlot& slot : kParameters) {
+        if (slot.parameter.name == name) return slot;
+    }
+    std::string names;
+    for (const ParameterSlot& slot : kParameters) names += (names.empty() ? "" : ", ") + std::string(slot.parameter.name);
+    throw std::invalid_argument("unknown parameter '" + std::string(name) + "' (" + names + ")");
+}
+
 } // namespace
+
+std::span<const Parameter> parameters() {
+    static const std::vector<Parameter> list = [] {
+        std::vector<Parameter> out;
+        for (const ParameterSlot& slot : kParameters) out.push_back(slot.parameter);
+        return out;
+    }();
+    return list;
+}
+
+void setParameter(ReflectionRunOptions& options, std::string_view name, std::string_view value) {
+    const ParameterSlot& slot = findParameter(name);
+    const std::string text(value);
+    size_t used = 0;
+    double v = 0.0;
+    try {
+        v = std::stod(text, &used);
+    } catch (const std::exception&) {
+        used = 0;
+    }
+    if (used == 0 || used != text.size() || !std::isfinite(v) || v < 0.0) {
+        throw std::invalid_argument("parameter " + std::string(name) + "=" + text + ": not a non-negative number");
+    }
+    if (slot.uintField) {
+        if (v != std::floor(v) || v < 1.0 || v > 4096.0) {
+            throw std::invalid_argument("parameter " + std::string(name) + "=" + text + ": not an integer in 1..4096");
+        }
+        *slot.uintField(options) = uint32_t(v);
+    } else {
+        *slot.floatField(options) = float(v);
+    }
+}
+
+double getParameter(const ReflectionRunOptions& options, std::string_view name) {
+    const ParameterSlot& slot = findParameter(name);
+    auto& o = const_cast<ReflectionRunOptions&>(options);  // the accessors are shared with setParameter
+    return slot.uintField ? double(*slot.uintField(o)) : double(*slot.floatField(o));
+}
 
 scene::CameraPose cameraPoseAt(const scene::Scene& scene, const ReflectionRunOptions& options, uint32_t frame) {
     const float seconds = options.startSeconds + float(frame) * options.frameSeconds;
@@ -104,8 +181,11 @@ ReflectionRunResult runReflections(gpu::Context& ctx, scene::Scene& scene, const
     std::map<std::string, rg::Queue> passQueues;
     std::vector<std::string> passOrder;
     std::vector<double> reflectionTimes, totalTimes;
+    std::optional<uint64_t> lastTimed;
     const auto collectTimings = [&] {
         const std::vector<rg::PassTiming> timings = executor.timings();
+        if (timings.empty() || (lastTimed && timings.front().frame == *lastTimed)) return;
+        lastTimed = timings.front().frame;
         double reflection = 0.0, total = 0.0;
         bool any = false;
         for (const rg::PassTiming& t : timings) {
@@ -146,10 +226,24 @@ ReflectionRunResult runReflections(gpu::Context& ctx, scene::Scene& scene, const
             addCopyToHost(graph, resources, image, "readback.output", frame.output.color, {}, w, h);
             addCopyToHost(graph, resources, counts, "readback.counts", {}, frame.counts, w, h);
         }
-        executor.run(graph.compile(executor.compileOptions()), resources);
-        // Timings of the latest completed frame (the first frames in flight
-        // have none yet; the median absorbs a frame read twice).
-        if (i > 0) collectTimings();
+        const rg::Plan plan = graph.compile(executor.compileOptions());
+        // Under --validate the plan's own checker runs too: the validation
+        // layer does not see hazards between dispatches' shader writes or
+        // around acceleration-structure builds (graph/verify.h).
+        if (ctx.validationEnabled()) {
+            const rg::VerifyReport report = rg::verify(plan);
+            if (!report.ok()) throw std::runtime_error("render graph plan of frame " + std::to_string(i) + ": " + report.text());
+        }
+        executor.run(plan, resources);
+        // Every frame's pass times: waiting here serialises frames on the
+        // host but not the GPU work inside a frame (the async BVH build
+        // still overlaps the G-buffer), and the times are GPU timestamps.
+        // The first frame (history and transient set-up, first BLAS builds)
+        // is not timed.
+        if (options.timeEveryFrame) {
+            executor.waitIdle();
+            if (i > 0) collectTimings();
+        }
         if (frame.bvh) {
             result.blasBuilt += renderer.bvhGpuStats().blasBuilds;
             result.blasRebuilt += renderer.bvhGpuStats().blasRebuilds;
@@ -163,7 +257,7 @@ ReflectionRunResult runReflections(gpu::Context& ctx, scene::Scene& scene, const
         }
     }
     executor.waitIdle();
-    collectTimings();
+    if (options.frames == 1 || !options.timeEveryFrame) collectTimings();
 
     for (const std::string& name : passOrder) {
         result.passes.push_back({name, passQueues[name], median(passTimes[name])});

@@ -11,6 +11,8 @@
 #include "scene/scene.h"
 
 #include <optional>
+#include <span>
+#include <string_view>
 #include <string>
 #include <vector>
 
@@ -23,6 +25,9 @@ struct ReflectionRunOptions {
     float startSeconds = 0.0f;     // time on the scene's camera path of the first frame
     float frameSeconds = 1.0f / 30.0f;
     bool jitter = true;            // sub-pixel jitter (only with more than one frame)
+    // Waits for each frame and reads its pass times (else only the last
+    // frame's are read).
+    bool timeEveryFrame = true;
     passes::ReflectionRendererOptions renderer;
     passes::ReflectionFrameSettings frame;
 };
@@ -54,6 +59,19 @@ struct ReflectionRunResult {
 // key (a glTF file's framing view) becomes a slow orbit around its target,
 // so temporal passes and motion vectors are exercised deterministically.
 scene::CameraPose cameraPoseAt(const scene::Scene& scene, const ReflectionRunOptions& options, uint32_t frame);
+
+// The tunable parameters by name (glint-render --set NAME=VALUE, the
+// benchmark's sweeps): what each means is documented at its settings field.
+struct Parameter {
+    std::string_view name;
+    std::string_view field;  // the settings field it sets, for --help
+};
+std::span<const Parameter> parameters();
+// Sets one parameter; throws std::invalid_argument naming the parameter and
+// the value when either is not accepted.
+void setParameter(ReflectionRunOptions& options, std::string_view name, std::string_view value);
+// The parameter's current value.
+double getParameter(const ReflectionRunOptions& options, std::string_view name);
 
 // Renders options.frames frames of `scene` (which it animates).
 ReflectionRunResult runReflections(gpu::Context& ctx, scene::Scene& scene, const ReflectionRunOptions& options);

@@ -12,6 +12,7 @@
 
 #include <spdlog/spdlog.h>
 
+#include <algorithm>
 #include <cmath>
 #include <filesystem>
 #include <fstream>
@@ -23,7 +24,8 @@ namespace {
 constexpr const char* kUsage =
     "usage: glint-render [--scene plaza|hard-cases|smoke|FILE.gltf|FILE.glb] [--mode hybrid|ssr|rt]\n"
     "                    [--size WxH|N] [--frames N] [--out IMAGE.png] [--debug-view NAME] [--stats FILE.json]\n"
-    "                    [--backend auto|query|pipeline] [--time SECONDS] [--list-debug-views] [--validate]";
+    "                    [--backend auto|query|pipeline] [--time SECONDS] [--set NAME=VALUE[,NAME=VALUE...]]\n"
+    "                    [--list-debug-views] [--list-parameters] [--validate]";
 
 // "W", "WxH": 1..8192 each.
 std::pair<uint32_t, uint32_t> parseSize(const std::string& text) {
@@ -78,8 +80,14 @@ int renderSmoke(gpu::Context& ctx, const std::filesystem::path& outDir, uint32_t
 int main(int argc, char** argv) {
     return app::runMain("glint-render", [&] {
         app::Args args(argc, argv, kUsage,
-                       {"scene", "mode", "size", "frames", "out", "debug-view", "stats", "backend", "time"},
-                       {"list-debug-views"});
+                       {"scene", "mode", "size", "frames", "out", "debug-view", "stats", "backend", "time", "set"},
+                       {"list-debug-views", "list-parameters"});
+        if (args.has("list-parameters")) {
+            for (const app::Parameter& p : app::parameters()) {
+                std::printf("%-18.*s %.*s\n", int(p.name.size()), p.name.data(), int(p.field.size()), p.field.data());
+            }
+            return 0;
+        }
         if (args.has("list-debug-views")) {
             for (const std::string_view name : passes::debugViewNames()) std::printf("%.*s\n", int(name.size()), name.data());
             return 0;
@@ -98,6 +106,20 @@ int main(int argc, char** argv) {
             options.renderer.backend = passes::parseBackend(args.get("backend", "auto"));
         } catch (const std::invalid_argument& e) {
             throw std::runtime_error(std::string("--mode/--backend: ") + e.what());
+        }
+        // --set a=1,b=2: the tunable parameters (--list-parameters).
+        const std::string sets = args.get("set", "");
+        for (size_t start = 0; start < sets.size();) {
+            const size_t end = std::min(sets.find(',', start), sets.size());
+            const std::string item = sets.substr(start, end - start);
+            const size_t eq = item.find('=');
+            if (eq == std::string::npos) throw std::runtime_error("--set " + item + ": expected NAME=VALUE");
+            try {
+                app::setParameter(options, item.substr(0, eq), item.substr(eq + 1));
+            } catch (const std::invalid_argument& e) {
+                throw std::runtime_error(std::string("--set: ") + e.what());
+            }
+            start = end + 1;
         }
         options.frame.debugView = args.get("debug-view", "");
         if (!options.frame.debugView.empty()) {
