@@ -479,9 +479,12 @@ Expected expect(const Frame& f, const Traces& t, const Presence& present, const 
             e.hitDistance = glm::length(floorPoint(texel.x, texel.y) - floorPoint(x, y));
             e.hasSslrHit = true;
             // The floor's distance changes by (distance^2 * d ndc.y) per row;
-            // 1/256 pixel of snapping is 2/(256 kSize) in NDC.
+            // 1/256 pixel of snapping is 2/(256 kSize) in NDC, at the hit
+            // and at the reflecting pixel itself (the horizon rows are
+            // ~80 units away: 0.4 units per 1/256 pixel there).
             const float hitDepth = glm::length(floorPoint(texel.x, texel.y));
-            e.hitDistanceSlack = hitDepth * hitDepth * 2.0f / (256.0f * float(kSize));
+            const float ownDepth = glm::length(floorPoint(x, y));
+            e.hitDistanceSlack = (hitDepth * hitDepth + ownDepth * ownDepth) * 2.0f / (256.0f * float(kSize));
         }
     }
     return e;
