@@ -182,6 +182,7 @@ ReflectionRunResult runReflections(gpu::Context& ctx, scene::Scene& scene, const
     std::vector<std::string> passOrder;
     std::vector<double> reflectionTimes, totalTimes;
     std::optional<uint64_t> lastTimed;
+    std::vector<double> wallTimes;
     const auto collectTimings = [&] {
         const std::vector<rg::PassTiming> timings = executor.timings();
         if (timings.empty() || (lastTimed && timings.front().frame == *lastTimed)) return;
@@ -226,6 +227,7 @@ ReflectionRunResult runReflections(gpu::Context& ctx, scene::Scene& scene, const
             addCopyToHost(graph, resources, image, "readback.output", frame.output.color, {}, w, h);
             addCopyToHost(graph, resources, counts, "readback.counts", {}, frame.counts, w, h);
         }
+        const auto frameStart = std::chrono::steady_clock::now();
         const rg::Plan plan = graph.compile(executor.compileOptions());
         // Under --validate the plan's own checker runs too: the validation
         // layer does not see hazards between dispatches' shader writes or
@@ -242,7 +244,11 @@ ReflectionRunResult runReflections(gpu::Context& ctx, scene::Scene& scene, const
         // is not timed.
         if (options.timeEveryFrame) {
             executor.waitIdle();
-            if (i > 0) collectTimings();
+            if (i > 0) {
+                collectTimings();
+                wallTimes.push_back(
+                    std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - frameStart).count());
+            }
         }
         if (frame.bvh) {
             result.blasBuilt += renderer.bvhGpuStats().blasBuilds;
@@ -263,6 +269,7 @@ ReflectionRunResult runReflections(gpu::Context& ctx, scene::Scene& scene, const
         result.passes.push_back({name, passQueues[name], median(passTimes[name])});
     }
     result.framesTimed = uint32_t(totalTimes.size());
+    if (!wallTimes.empty()) result.frameWallMs = median(wallTimes);
     if (!totalTimes.empty()) {
         result.reflectionMs = median(reflectionTimes);
         result.totalMs = median(totalTimes);
@@ -297,6 +304,7 @@ std::string statsJson(const gpu::Context& ctx, const ReflectionRunOptions& optio
     j["passes"] = passList;
     j["reflection_ms"] = r.reflectionMs ? json(*r.reflectionMs) : json(nullptr);
     j["total_ms"] = r.totalMs ? json(*r.totalMs) : json(nullptr);
+    j["frame_wall_ms"] = r.frameWallMs ? json(*r.frameWallMs) : json(nullptr);
     j["rays"] = {{"sslr", r.sslrRays}, {"rt", r.rtRays}};
     const double pixels = double(options.width) * options.height;
     const auto share = [&](uint32_t c) { return c < r.pixelClasses.size() ? double(r.pixelClasses[c]) / pixels : 0.0; };

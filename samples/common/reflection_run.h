@@ -44,6 +44,10 @@ struct ReflectionRunResult {
     std::optional<double> reflectionMs;  // median per-frame sum of the reflection passes
     std::optional<double> totalMs;       // median per-frame sum of all passes
     uint32_t framesTimed = 0;
+    // Median host time from declaring a frame to its completion. On a CPU
+    // device (lavapipe) it is the frame's cost: there, GPU timestamps do
+    // not cover compute dispatches (an SSLR pass 30x longer read the same).
+    std::optional<double> frameWallMs;
     // The last frame's counts (glint/reflection_frame_shared.h).
     uint64_t sslrRays = 0;
     uint64_t rtRays = 0;

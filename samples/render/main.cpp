@@ -153,8 +153,10 @@ int main(int argc, char** argv) {
                          p.queue == rg::Queue::AsyncCompute ? " (async compute)" : "");
         }
         if (result.reflectionMs) {
-            spdlog::info("reflections {:.3f} ms, frame {:.3f} ms GPU (median of {} frames); rays: {} SSLR, {} RT",
-                         *result.reflectionMs, *result.totalMs, result.framesTimed, result.sslrRays, result.rtRays);
+            spdlog::info("reflections {:.3f} ms, frame {:.3f} ms GPU, {:.3f} ms wall (median of {} frames); rays: {} "
+                         "SSLR, {} RT",
+                         *result.reflectionMs, *result.totalMs, result.frameWallMs.value_or(0.0), result.framesTimed,
+                         result.sslrRays, result.rtRays);
         }
         if (args.has("stats")) {
             const std::filesystem::path statsPath = args.get("stats", "");
