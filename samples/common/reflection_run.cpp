@@ -11,12 +11,14 @@
 #include <spdlog/spdlog.h>
 
 #include <glm/gtc/matrix_transform.hpp>
+#include <glm/gtc/packing.hpp>
 
 #include <algorithm>
 #include <array>
 #include <cmath>
 #include <chrono>
 #include <cstring>
+#include <limits>
 #include <map>
 
 namespace glint::app {
@@ -159,7 +161,50 @@ scene::CameraPose cameraPoseAt(const scene::Scene& scene, const ReflectionRunOpt
     return pose;
 }
 
-ReflectionRunResult runReflections(gpu::Context& ctx, scene::Scene& scene, const ReflectionRunOptions& options) {
+namespace {
+
+// The reference's settings on top of the caller's (see ReferenceOptions).
+ReflectionRunOptions referenceSettings(const ReflectionRunOptions& in) {
+    ReflectionRunOptions o = in;
+    const ReferenceOptions& r = in.reference;
+    if (r.checkEvery == 0 || r.minFrames == 0 || r.maxFrames < r.minFrames || r.maxFrames > 2048 ||
+        !(r.tolerance > 0.0)) {
+        throw std::invalid_argument("reference: need 0 < tolerance, checkEvery >= 1, 1 <= minFrames <= maxFrames <= 2048");
+    }
+    o.frames = r.maxFrames;
+    o.jitter = false;
+    o.frame.mode = passes::ReflectionMode::Rt;
+    o.frame.rays.reuse = false;
+    o.frame.rays.roughnessCutoff = 1.0f;  // rough pixels are traced too: the environment is an approximation
+    o.renderer.bvh.radius = std::numeric_limits<float>::max();
+    o.renderer.bvh.longRangeRadius = std::numeric_limits<float>::max();
+    o.frame.rt.maxDistance = 1e30f;
+    o.frame.temporal.maxHistoryFrames = float(r.maxFrames);
+    o.frame.temporal.neighbourhoodClamp = false;
+    o.frame.temporal.spatialRadius = 0;
+    o.frame.debugView.clear();
+    return o;
+}
+
+// Mean of the reflected radiance (rgb summed) over the pixels that reflect.
+double meanReflection(const gpu::Buffer& resolved, uint32_t pixels) {
+    const auto halves = resolved.mappedSpan<const uint16_t>();
+    double sum = 0.0;
+    uint64_t n = 0;
+    for (uint32_t p = 0; p < pixels; ++p) {
+        if (glm::unpackHalf1x16(halves[p * 4 + 3]) < 0.5f) continue;
+        sum += double(glm::unpackHalf1x16(halves[p * 4])) + glm::unpackHalf1x16(halves[p * 4 + 1]) +
+               glm::unpackHalf1x16(halves[p * 4 + 2]);
+        ++n;
+    }
+    return n ? sum / double(n) : 0.0;
+}
+
+} // namespace
+
+ReflectionRunResult runReflections(gpu::Context& ctx, scene::Scene& scene, const ReflectionRunOptions& requested) {
+    const bool reference = requested.reference.enabled;
+    const ReflectionRunOptions options = reference ? referenceSettings(requested) : requested;
     if (options.frames == 0) throw std::invalid_argument("--frames must be at least 1");
     rg::Executor executor(ctx, options.renderer.framesInFlight);
     passes::ReflectionRenderer renderer(ctx, scene, options.renderer);
@@ -171,6 +216,13 @@ ReflectionRunResult runReflections(gpu::Context& ctx, scene::Scene& scene, const
                             "glint.output_readback"});
     gpu::Buffer counts(ctx, {shader::kReflectionCountWords * 4u, VK_BUFFER_USAGE_TRANSFER_DST_BIT,
                              gpu::MemoryUsage::Readback, "glint.counts_readback"});
+    gpu::Buffer resolved;
+    if (reference) {
+        resolved = gpu::Buffer(ctx, {VkDeviceSize(w) * h * 8, VK_BUFFER_USAGE_TRANSFER_DST_BIT,
+                                     gpu::MemoryUsage::Readback, "glint.reference_readback"});
+    }
+    std::optional<double> previousMean;
+    const uint64_t frameBase = reference ? uint64_t(options.reference.seed) << 20 : 0;
 
     scene::Camera camera;
     camera.resolution = {w, h};
@@ -207,15 +259,19 @@ ReflectionRunResult runReflections(gpu::Context& ctx, scene::Scene& scene, const
     const auto start = std::chrono::steady_clock::now();
     auto lastReport = start;
     for (uint32_t i = 0; i < options.frames; ++i) {
-        const scene::CameraPose pose = cameraPoseAt(scene, options, i);
+        // The reference stands still: one pose, one scene time; only the
+        // frame index (the noise) moves.
+        const scene::CameraPose pose = cameraPoseAt(scene, options, reference ? 0 : i);
         if (i == 0) {
-            camera.reset(pose, 0);
+            camera.reset(pose, frameBase);
         } else {
-            camera.advance(pose, i);
+            camera.advance(pose, frameBase + i);
         }
-        scene::advanceScene(scene, options.startSeconds + float(i) * options.frameSeconds, &camera);
+        scene::advanceScene(scene, options.startSeconds + (reference ? 0.0f : float(i) * options.frameSeconds),
+                            &camera);
 
-        const bool last = i + 1 == options.frames;
+        const bool check = reference && (i + 1) % options.reference.checkEvery == 0;
+        const bool last = i + 1 == options.frames || check;
         passes::ReflectionFrameSettings settings = options.frame;
         settings.resetHistory = i == 0;
         settings.countRays = last;
@@ -226,6 +282,9 @@ ReflectionRunResult runReflections(gpu::Context& ctx, scene::Scene& scene, const
         if (last) {
             addCopyToHost(graph, resources, image, "readback.output", frame.output.color, {}, w, h);
             addCopyToHost(graph, resources, counts, "readback.counts", {}, frame.counts, w, h);
+        }
+        if (check) {
+            addCopyToHost(graph, resources, resolved, "readback.resolved", frame.temporal.resolved, {}, w, h);
         }
         const auto frameStart = std::chrono::steady_clock::now();
         const rg::Plan plan = graph.compile(executor.compileOptions());
@@ -255,12 +314,37 @@ ReflectionRunResult runReflections(gpu::Context& ctx, scene::Scene& scene, const
             result.blasRebuilt += renderer.bvhGpuStats().blasRebuilds;
         }
 
+        result.framesRun = i + 1;
+        if (check) {
+            executor.waitIdle();
+            const double mean = meanReflection(resolved, w * h);
+            if (previousMean) {
+                result.lastChange = std::abs(mean - *previousMean) / std::max(std::abs(mean), 1e-6);
+                spdlog::debug("reference: {} frames, mean {:.6f}, change {:.2e}", i + 1, mean, result.lastChange);
+                if (i + 1 >= options.reference.minFrames && result.lastChange < options.reference.tolerance) {
+                    result.converged = true;
+                    break;
+                }
+            }
+            previousMean = mean;
+        }
+
         const auto now = std::chrono::steady_clock::now();
-        if (now - lastReport > std::chrono::seconds(2) && !last) {
-            spdlog::info("frame {}/{} ({:.1f} s)", i + 1, options.frames,
-                         std::chrono::duration<double>(now - start).count());
+        if (now - lastReport > std::chrono::seconds(2) && i + 1 != options.frames) {
+            if (reference) {
+                spdlog::info("reference: {} frames, last change {:.2e} (tolerance {:.1e})", i + 1, result.lastChange,
+                             options.reference.tolerance);
+            } else {
+                spdlog::info("frame {}/{} ({:.1f} s)", i + 1, options.frames,
+                             std::chrono::duration<double>(now - start).count());
+            }
             lastReport = now;
         }
+    }
+    if (reference) {
+        spdlog::info("reference: {} after {} frames (last change {:.2e}, tolerance {:.1e})",
+                     result.converged ? "converged" : "stopped at the frame limit", result.framesRun,
+                     result.lastChange, options.reference.tolerance);
     }
     executor.waitIdle();
     if (options.frames == 1 || !options.timeEveryFrame) collectTimings();
@@ -290,10 +374,17 @@ std::string statsJson(const gpu::Context& ctx, const ReflectionRunOptions& optio
     json j;
     j["device"] = ctx.caps().deviceName;
     j["driver"] = ctx.caps().driverName + " " + ctx.caps().driverInfo;
-    j["mode"] = std::string(passes::modeName(options.frame.mode));
+    j["mode"] = options.reference.enabled ? std::string("reference") : std::string(passes::modeName(options.frame.mode));
+    if (options.reference.enabled) {
+        j["reference"] = {{"frames", r.framesRun},
+                          {"converged", r.converged},
+                          {"last_change", r.lastChange},
+                          {"tolerance", options.reference.tolerance},
+                          {"seed", options.reference.seed}};
+    }
     j["backend"] = options.frame.mode == passes::ReflectionMode::Ssr ? "none" : std::string(passes::backendName(r.backend));
     j["size"] = {options.width, options.height};
-    j["frames"] = options.frames;
+    j["frames"] = options.reference.enabled ? r.framesRun : options.frames;
     j["frames_timed"] = r.framesTimed;
     json passList = json::array();
     for (const PassTime& p : r.passes) {

@@ -18,6 +18,27 @@
 
 namespace glint::app {
 
+// Issue 6's reference: every reflection ray traced (rt mode, no quad reuse,
+// no roughness cutoff, unbounded BVH radius and ray length), one new
+// sample per pixel per frame from a still camera without jitter,
+// accumulated without reprojection or clamping (the temporal pass with an
+// unbounded history and no spatial filter) until the image's mean
+// reflected radiance changes by less than `tolerance` (relative) over
+// `checkEvery` frames, through the same G-buffer and composite.
+// Deterministic for a seed: the noise follows the frame index, which
+// starts at seed << 20.
+struct ReferenceOptions {
+    bool enabled = false;
+    // The mean converges long before single pixels do: the floor of 128
+    // frames keeps per-pixel noise of the glossy pixels down (their
+    // standard error falls as 1/sqrt(frames)).
+    double tolerance = 2e-4;
+    uint32_t checkEvery = 16;
+    uint32_t minFrames = 128;
+    uint32_t maxFrames = 2048;  // the history length is kept in half floats: exact up to 2048
+    uint32_t seed = 0;
+};
+
 struct ReflectionRunOptions {
     uint32_t width = 256;
     uint32_t height = 256;
@@ -30,6 +51,7 @@ struct ReflectionRunOptions {
     bool timeEveryFrame = true;
     passes::ReflectionRendererOptions renderer;
     passes::ReflectionFrameSettings frame;
+    ReferenceOptions reference;  // when enabled, `frames` and `mode` are ignored
 };
 
 struct PassTime {
@@ -57,6 +79,11 @@ struct ReflectionRunResult {
     uint64_t blasRebuilt = 0;
     uint32_t tlasInstances = 0;
     passes::RtBackend backend = passes::RtBackend::Auto;
+    // Reference runs: frames accumulated, whether the tolerance was met
+    // (else maxFrames stopped it), and the last relative change measured.
+    uint32_t framesRun = 0;
+    bool converged = false;
+    double lastChange = 0.0;
 };
 
 // Frame i's camera: along the scene's path from startSeconds; a path of one

@@ -22,9 +22,10 @@ using namespace glint;
 namespace {
 
 constexpr const char* kUsage =
-    "usage: glint-render [--scene plaza|hard-cases|smoke|FILE.gltf|FILE.glb] [--mode hybrid|ssr|rt]\n"
+    "usage: glint-render [--scene plaza|hard-cases|smoke|FILE.gltf|FILE.glb] [--mode hybrid|ssr|rt|reference]\n"
     "                    [--size WxH|N] [--frames N] [--out IMAGE.png] [--debug-view NAME] [--stats FILE.json]\n"
     "                    [--backend auto|query|pipeline] [--time SECONDS] [--set NAME=VALUE[,NAME=VALUE...]]\n"
+    "                    [--tolerance REL] [--seed N] [--max-frames N] (reference mode)\n"
     "                    [--list-debug-views] [--list-parameters] [--validate]";
 
 // "W", "WxH": 1..8192 each.
@@ -80,7 +81,8 @@ int renderSmoke(gpu::Context& ctx, const std::filesystem::path& outDir, uint32_t
 int main(int argc, char** argv) {
     return app::runMain("glint-render", [&] {
         app::Args args(argc, argv, kUsage,
-                       {"scene", "mode", "size", "frames", "out", "debug-view", "stats", "backend", "time", "set"},
+                       {"scene", "mode", "size", "frames", "out", "debug-view", "stats", "backend", "time", "set", "tolerance",
+                        "seed", "max-frames"},
                        {"list-debug-views", "list-parameters"});
         if (args.has("list-parameters")) {
             for (const app::Parameter& p : app::parameters()) {
@@ -101,8 +103,23 @@ int main(int argc, char** argv) {
         options.width = width;
         options.height = height;
         options.frames = frames;
+        const std::string modeText = args.get("mode", "hybrid");
+        if (modeText == "reference") {
+            options.reference.enabled = true;
+            const std::string tolerance = args.get("tolerance", std::to_string(options.reference.tolerance));
+            try {
+                options.reference.tolerance = std::stod(tolerance);
+            } catch (const std::exception&) {
+                options.reference.tolerance = 0.0;
+            }
+            if (!(options.reference.tolerance > 0.0) || !std::isfinite(options.reference.tolerance)) {
+                throw std::runtime_error("--tolerance " + tolerance + ": not a positive number");
+            }
+            options.reference.seed = args.getUint("seed", 0);
+            options.reference.maxFrames = args.getUint("max-frames", options.reference.maxFrames);
+        }
         try {
-            options.frame.mode = passes::parseMode(args.get("mode", "hybrid"));
+            options.frame.mode = passes::parseMode(modeText == "reference" ? "rt" : modeText);
             options.renderer.backend = passes::parseBackend(args.get("backend", "auto"));
         } catch (const std::invalid_argument& e) {
             throw std::runtime_error(std::string("--mode/--backend: ") + e.what());
@@ -134,8 +151,8 @@ int main(int argc, char** argv) {
         // past the puddles (the path starts behind a palm trunk).
         options.startSeconds = parseSeconds(args.get("time", sceneName == "plaza" ? "3" : "0"));
 
-        const std::string defaultOut = "build/out/" + std::filesystem::path(sceneName).stem().string() + "_" +
-                                       std::string(passes::modeName(options.frame.mode)) + ".png";
+        const std::string defaultOut =
+            "build/out/" + std::filesystem::path(sceneName).stem().string() + "_" + modeText + ".png";
         const std::filesystem::path out = args.get("out", defaultOut);
 
         gpu::Context ctx(args.contextOptions());
@@ -143,8 +160,13 @@ int main(int argc, char** argv) {
             return renderSmoke(ctx, out.extension() == ".png" ? out.parent_path() : out, width, height);
         }
         scene::Scene scene = scene::loadScene(sceneName);
-        spdlog::info("{}: {} mode, {}x{}, {} frame{}", scene.name, passes::modeName(options.frame.mode), width, height,
-                     frames, frames == 1 ? "" : "s");
+        if (options.reference.enabled) {
+            spdlog::info("{}: reference, {}x{}, until the mean changes by less than {} (at most {} frames)", scene.name,
+                         width, height, options.reference.tolerance, options.reference.maxFrames);
+        } else {
+            spdlog::info("{}: {} mode, {}x{}, {} frame{}", scene.name, passes::modeName(options.frame.mode), width,
+                         height, frames, frames == 1 ? "" : "s");
+        }
         const app::ReflectionRunResult result = app::runReflections(ctx, scene, options);
         app::writePng(out.string(), width, height, result.rgba);
 
