@@ -659,6 +659,17 @@ Scene buildPlaza() {
         {12.0f, {6.0f, 1.7f, -14.0f}, {26.0f, 2.0f, -10.0f}}, {15.0f, {14.0f, 1.7f, -2.0f}, {26.0f, 3.0f, 20.0f}},
         {18.0f, {8.0f, 1.7f, 10.0f}, {0.0f, 1.0f, 0.0f}},     {20.0f, {0.0f, 1.7f, 18.0f}, {0.0f, 1.2f, 0.0f}},
     };
+    // Presets (glint-render --camera): points of the path, and one low over
+    // the mirror puddles where reflections dominate the image.
+    const auto pathView = [&](const char* name, float seconds) {
+        const CameraPose pose = s.cameraPath.evaluate(seconds);
+        s.views.push_back({name, s.lens, pose.position, pose.target});
+    };
+    pathView("entrance", 0.0f);
+    pathView("puddles", 3.0f);
+    pathView("street", 9.0f);
+    pathView("far-buildings", 12.0f);
+    s.views.push_back({"puddle-low", s.lens, {-4.0f, 0.4f, 9.0f}, {-4.0f, 0.0f, -10.0f}});
     return std::move(b.scene);
 }
 
@@ -773,6 +784,10 @@ Scene buildHardCases() {
         {7.0f, o + glm::vec3(0.3f, 0.3f, -12.0f), o + glm::vec3(0.3f, 0.25f, -100.0f)},  // grazing the floor
         {10.0f, o + glm::vec3(-1.6f, 1.0f, -20.0f), o + glm::vec3(1.9f, 1.0f, -60.0f)},  // grazing a wall
     };
+    for (const auto& [name, seconds] : {std::pair{"corridor", 0.0f}, {"grazing-floor", 7.0f}, {"grazing-wall", 10.0f}}) {
+        const CameraPose pose = s.cameraPath.evaluate(seconds);
+        s.views.push_back({name, s.lens, pose.position, pose.target});
+    }
     return std::move(b.scene);
 }
 

@@ -1143,26 +1143,38 @@ private:
         sunFound_ = true;
     }
 
+    // Every usable perspective camera becomes a named view; the first is
+    // also the scene's suggested view.
     void cameraFromNode(const tinygltf::Node& src, const glm::mat4& world) {
-        if (cameraFound_ || src.camera < 0 || model_.cameras[size_t(src.camera)].type != "perspective") {
+        if (src.camera < 0 || model_.cameras[size_t(src.camera)].type != "perspective") {
             return;
         }
-        const tinygltf::PerspectiveCamera& p = model_.cameras[size_t(src.camera)].perspective;
+        const tinygltf::Camera& camera = model_.cameras[size_t(src.camera)];
+        const tinygltf::PerspectiveCamera& p = camera.perspective;
         constexpr double kLargest = 1e30;  // keeps the float conversions defined
         if (!(p.yfov > 0.0 && p.yfov < 3.1) || !(p.znear > 0.0 && p.znear < kLargest) ||
             !(p.zfar >= 0.0 && p.zfar < kLargest)) {
             return;  // unusable; the loader frames the scene instead
         }
-        scene_.lens.verticalFovRadians = float(p.yfov);
-        scene_.lens.nearPlane = float(p.znear);
-        scene_.lens.farPlane = p.zfar > p.znear ? float(p.zfar) : kInfiniteFar;
         const glm::vec3 position(world[3]);
         const glm::vec3 forward = -glm::vec3(world[2]);
-        if (!(glm::length(forward) > 0.0f)) {
+        if (!(glm::length(forward) > 0.0f) || !std::isfinite(position.x + position.y + position.z)) {
             return;
         }
-        scene_.cameraPath.keys = {{0.0f, position, position + glm::normalize(forward)}};
-        cameraFound_ = true;
+        SceneView view;
+        view.name = !camera.name.empty() ? camera.name
+                    : !src.name.empty()  ? src.name
+                                         : "camera " + std::to_string(scene_.views.size());
+        view.lens.verticalFovRadians = float(p.yfov);
+        view.lens.nearPlane = float(p.znear);
+        view.lens.farPlane = p.zfar > p.znear ? float(p.zfar) : kInfiniteFar;
+        view.position = position;
+        view.target = position + glm::normalize(forward);
+        scene_.views.push_back(view);
+        if (!cameraFound_) {
+            useView(scene_, view);
+            cameraFound_ = true;
+        }
     }
 
     const tinygltf::Model& model_;

@@ -182,6 +182,29 @@ glm::vec3 equirectDirection(const glm::vec2& uv) {
 // Scene queries
 // ---------------------------------------------------------------------------
 
+const SceneView& findView(const Scene& scene, std::string_view nameOrIndex) {
+    for (const SceneView& v : scene.views) {
+        if (v.name == nameOrIndex) return v;
+    }
+    const std::string text(nameOrIndex);
+    if (!text.empty() && text.find_first_not_of("0123456789") == std::string::npos && text.size() < 10) {
+        const size_t index = std::stoul(text);
+        if (index < scene.views.size()) return scene.views[index];
+    }
+    std::string names;
+    for (size_t i = 0; i < scene.views.size(); ++i) {
+        names += (i ? ", " : "") + std::to_string(i) + " '" + scene.views[i].name + "'";
+    }
+    throw SceneError(scene.name, "camera '" + text + "'",
+                     scene.views.empty() ? "the scene has no cameras" : "no such camera (available: " + names + ")");
+}
+
+void useView(Scene& scene, const SceneView& view) {
+    const SceneView copy = view;  // `view` may live in scene.views
+    scene.lens = copy.lens;
+    scene.cameraPath.keys = {{0.0f, copy.position, copy.target}};
+}
+
 uint64_t meshTriangleCount(const Scene& scene) {
     uint64_t n = 0;
     for (const Mesh& m : scene.meshes) {

@@ -17,6 +17,7 @@
 #include <limits>
 #include <optional>
 #include <string>
+#include <string_view>
 #include <vector>
 
 namespace glint::scene {
@@ -281,6 +282,13 @@ glm::vec3 equirectDirection(const glm::vec2& uv);
 // The scene
 // ---------------------------------------------------------------------------
 
+struct SceneView {
+    std::string name;
+    Lens lens;
+    glm::vec3 position{0.0f};
+    glm::vec3 target{0.0f, 0.0f, -1.0f};
+};
+
 struct Scene {
     std::string name;  // file or built-in scene name; errors name it
 
@@ -308,9 +316,18 @@ struct Scene {
     // A suggested view: the lens and a path (one key for a still camera).
     Lens lens;
     CameraPath cameraPath;
+    // Named viewpoints: a glTF file's perspective camera nodes in document
+    // order, or a built-in scene's presets (glint-render --camera).
+    std::vector<SceneView> views;
 
     double time = 0.0;  // seconds, set by advanceScene
 };
+
+// The view `nameOrIndex` names (a view's name, or its index in decimal);
+// throws SceneError naming the scene and listing the views otherwise.
+const SceneView& findView(const Scene& scene, std::string_view nameOrIndex);
+// Makes `view` the scene's suggested view: its lens and a one-key path.
+void useView(Scene& scene, const SceneView& view);
 
 // Triangles of all meshes at LOD 0, each mesh once.
 uint64_t meshTriangleCount(const Scene& scene);

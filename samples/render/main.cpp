@@ -24,7 +24,8 @@ namespace {
 constexpr const char* kUsage =
     "usage: glint-render [--scene plaza|hard-cases|smoke|FILE.gltf|FILE.glb] [--mode hybrid|ssr|rt|reference]\n"
     "                    [--size WxH|N] [--frames N] [--out IMAGE.png] [--debug-view NAME] [--stats FILE.json]\n"
-    "                    [--backend auto|query|pipeline] [--time SECONDS] [--set NAME=VALUE[,NAME=VALUE...]]\n"
+    "                    [--backend auto|query|pipeline] [--time SECONDS] [--camera NAME|INDEX]\n"
+    "                    [--set NAME=VALUE[,NAME=VALUE...]]\n"
     "                    [--tolerance REL] [--seed N] [--max-frames N] (reference mode)\n"
     "                    [--list-debug-views] [--list-parameters] [--validate]";
 
@@ -82,7 +83,7 @@ int main(int argc, char** argv) {
     return app::runMain("glint-render", [&] {
         app::Args args(argc, argv, kUsage,
                        {"scene", "mode", "size", "frames", "out", "debug-view", "stats", "backend", "time", "set", "tolerance",
-                        "seed", "max-frames"},
+                        "seed", "max-frames", "camera"},
                        {"list-debug-views", "list-parameters"});
         if (args.has("list-parameters")) {
             for (const app::Parameter& p : app::parameters()) {
@@ -160,6 +161,13 @@ int main(int argc, char** argv) {
             return renderSmoke(ctx, out.extension() == ".png" ? out.parent_path() : out, width, height);
         }
         scene::Scene scene = scene::loadScene(sceneName);
+        // --camera: a glTF camera or a built-in preset, held still (frames
+        // beyond the first orbit it slowly); without it, a file's first
+        // camera or framing view, or a built-in scene's path.
+        if (args.has("camera")) {
+            scene::useView(scene, scene::findView(scene, args.get("camera", "")));
+            if (!args.has("time")) options.startSeconds = 0.0f;
+        }
         if (options.reference.enabled) {
             spdlog::info("{}: reference, {}x{}, until the mean changes by less than {} (at most {} frames)", scene.name,
                          width, height, options.reference.tolerance, options.reference.maxFrames);

@@ -181,6 +181,21 @@ TEST_CASE("hard-cases sits 10^4 m out with thin walls, degenerate triangles and 
                       [](const Material& m) { return m.roughnessFactor == 1.0f; }));
 }
 
+TEST_CASE("built-in scenes name their camera presets") {
+    const Scene plaza = makePlaza();
+    for (const char* name : {"entrance", "puddles", "street", "far-buildings", "puddle-low"}) {
+        CAPTURE(name);
+        const SceneView& v = findView(plaza, name);
+        CHECK(glm::length(v.target - v.position) > 0.1f);
+        CHECK(v.lens.verticalFovRadians == plaza.lens.verticalFovRadians);
+    }
+    // The "puddles" preset is the path at 3 s, glint-render's default view.
+    CHECK(glm::length(findView(plaza, "puddles").position - plaza.cameraPath.evaluate(3.0f).position) < 1e-6f);
+    const Scene hard = makeHardCases();
+    CHECK(findView(hard, "grazing-floor").position.x > 9000.0f);
+    CHECK_THROWS_AS(findView(hard, "99"), SceneError);
+}
+
 TEST_CASE("built-in scenes are the same on every build") {
     CHECK(positionHash(makePlaza()) == positionHash(makePlaza()));
     CHECK(positionHash(makeHardCases()) == positionHash(makeHardCases()));

@@ -369,8 +369,13 @@ TEST_CASE("a file's first perspective camera becomes the scene's view; without o
     std::filesystem::copy_file(scenesDir() / "Box/Box.gltf", dir / "framed.gltf");
     std::filesystem::copy_file(scenesDir() / "Box/Box0.bin", dir / "Box0.bin");
     Json doc = readJson(scenesDir() / "Box/Box.gltf");
-    doc["cameras"] = {{{"type", "perspective"}, {"perspective", {{"yfov", 0.8}, {"znear", 0.05}}}}};
+    doc["cameras"] = {{{"type", "perspective"}, {"perspective", {{"yfov", 0.8}, {"znear", 0.05}}}},
+                      {{"type", "perspective"}, {"name", "top"}, {"perspective", {{"yfov", 0.5}, {"znear", 0.1}}}}};
     doc["nodes"].push_back({{"camera", 0}, {"translation", {0.0, 1.0, 6.0}}});
+    doc["scenes"][0]["nodes"].push_back(doc["nodes"].size() - 1);
+    // Looking straight down: the node's -Z rotated onto -Y.
+    doc["nodes"].push_back(
+        {{"camera", 1}, {"translation", {0.0, 9.0, 0.0}}, {"rotation", {-0.7071068, 0.0, 0.0, 0.7071068}}});
     doc["scenes"][0]["nodes"].push_back(doc["nodes"].size() - 1);
     writeText(dir / "camera.gltf", doc.dump());
 
@@ -381,6 +386,22 @@ TEST_CASE("a file's first perspective camera becomes the scene's view; without o
     const CameraPose pose = withCamera.cameraPath.evaluate(0.0f);
     CHECK(pose.position == glm::vec3(0, 1, 6));
     CHECK(glm::length(glm::normalize(pose.target - pose.position) - glm::vec3(0, 0, -1)) < 1e-6f);
+
+    // Every camera is a named view, by name or index (glint-render --camera).
+    REQUIRE(withCamera.views.size() == 2);
+    CHECK(withCamera.views[0].name == "camera 0");
+    const SceneView& top = findView(withCamera, "top");
+    CHECK(&top == &findView(withCamera, "1"));
+    CHECK(top.lens.verticalFovRadians == doctest::Approx(0.5f));
+    CHECK(top.position == glm::vec3(0, 9, 0));
+    CHECK(glm::length(glm::normalize(top.target - top.position) - glm::vec3(0, -1, 0)) < 1e-6f);
+    CHECK_THROWS_WITH_AS(findView(withCamera, "side"), doctest::Contains("no such camera (available: 0 'camera 0', 1 'top')"),
+                         SceneError);
+    Scene moved = withCamera;
+    useView(moved, top);
+    CHECK(moved.cameraPath.keys.size() == 1);
+    CHECK(moved.cameraPath.evaluate(0.0f).position == glm::vec3(0, 9, 0));
+    CHECK(moved.lens.verticalFovRadians == doctest::Approx(0.5f));
 
     const Scene framed = loadGltf(dir / "framed.gltf");
     const CameraPose view = framed.cameraPath.evaluate(0.0f);
