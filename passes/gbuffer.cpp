@@ -15,6 +15,7 @@
 #include <bit>
 #include <cmath>
 #include <cstring>
+#include <limits>
 #include <string>
 
 namespace glint::passes {
@@ -23,13 +24,37 @@ namespace {
 
 constexpr VkShaderStageFlags kRasterStages = VK_SHADER_STAGE_VERTEX_BIT | VK_SHADER_STAGE_FRAGMENT_BIT;
 
-// Bindings of shaders/gbuffer/gbuffer_common.glsl, shared by both pipelines.
-std::vector<gpu::Binding> gbufferBindings() {
+// Bindings of shaders/gbuffer/gbuffer_common.glsl, shared by every pipeline.
+std::vector<gpu::Binding> geometryBindings() {
     std::vector<gpu::Binding> bindings;
     for (uint32_t b = 0; b < 5; ++b) {
         bindings.push_back({b, VK_DESCRIPTOR_TYPE_STORAGE_BUFFER, kRasterStages});
     }
     return bindings;
+}
+
+// The G-buffer's pipelines add the shadow map (shaders/gbuffer/shadow.glsl);
+// the shadow map's own pipeline cannot bind what it renders.
+constexpr uint32_t kShadowMapBinding = 5;
+std::vector<gpu::Binding> gbufferBindings() {
+    std::vector<gpu::Binding> bindings = geometryBindings();
+    bindings.push_back({kShadowMapBinding, VK_DESCRIPTOR_TYPE_COMBINED_IMAGE_SAMPLER, VK_SHADER_STAGE_FRAGMENT_BIT});
+    return bindings;
+}
+
+// Shadows fade out over the last tenth of SunShadowSettings::maxDistance.
+constexpr float kShadowFadeStart = 0.9f;
+// Texels added on each side of the fitted square: the filter reaches two
+// texels beyond a lookup, the normal offset moves lookups by up to one and
+// snapping the centre to whole texels moves the square by up to half.
+constexpr uint32_t kShadowBorderTexels = 4;
+
+// `extent` rounded up to a multiple of 1/32 of its enclosing power of two:
+// bounds that change a little (animated instances) keep the same texel size
+// most frames, and a changing texel size is what makes shadow edges swim.
+float quantiseExtent(float extent) {
+    const float step = std::exp2(std::ceil(std::log2(extent)) - 5.0f);
+    return std::ceil(extent / step) * step;
 }
 
 // Colour attachments in the order of the fragment shaders' outputs.
@@ -44,6 +69,122 @@ VkDeviceSize grownCapacity(VkDeviceSize needed) {
 }
 
 } // namespace
+
+shader::GBufferShadow fitSunShadow(const scene::Scene& scene, const scene::Camera& camera,
+                                   const SunShadowSettings& settings) {
+    shader::GBufferShadow fit{};
+    fit.viewProjection = glm::mat4(1.0f);
+    fit.texelWorldSize = 1.0f;
+    fit.depthRange = 1.0f;
+    fit.resolution = 1;
+    if (!settings.enabled || settings.resolution == 0) return fit;
+
+    // Everything that can cast: every instance's bounds this frame (skinned
+    // ones over their whole palette).
+    scene::Aabb casters;
+    for (const scene::Instance& inst : scene.instances) {
+        if (inst.mesh < scene.meshes.size() && !scene.meshes[inst.mesh].lods.empty()) {
+            casters.extend(scene::instanceBounds(scene, inst));
+        }
+    }
+    const glm::vec3 toSun = glm::normalize(scene.sun.directionToLight);
+    if (casters.empty() || !std::isfinite(toSun.x + toSun.y + toSun.z)) return fit;
+
+    // The sun's frame: rays travel along `forward`; `right` and `up` span
+    // the map. Any basis works (the pipelines cull nothing); this one keeps
+    // the map's axes still while the sun is.
+    const glm::vec3 forward = -toSun;
+    const glm::vec3 reference = std::abs(forward.y) < 0.99f ? glm::vec3(0, 1, 0) : glm::vec3(1, 0, 0);
+    const glm::vec3 right = glm::normalize(glm::cross(forward, reference));
+    const glm::vec3 up = glm::cross(right, forward);
+
+    glm::vec3 lightMin(std::numeric_limits<float>::max());
+    glm::vec3 lightMax(-std::numeric_limits<float>::max());
+    for (int c = 0; c < 8; ++c) {
+        const glm::vec3 corner((c & 1) ? casters.max.x : casters.min.x, (c & 2) ? casters.max.y : casters.min.y,
+                               (c & 4) ? casters.max.z : casters.min.z);
+        const glm::vec3 l(glm::dot(corner, right), glm::dot(corner, up), glm::dot(corner, forward));
+        lightMin = glm::min(lightMin, l);
+        lightMax = glm::max(lightMax, l);
+    }
+
+    // The camera's view up to maxDistance, as its bounding sphere: the
+    // sphere's size depends only on the lens, so turning the camera never
+    // changes the texel size (Valient, "Stable Rendering of Cascaded Shadow
+    // Maps", ShaderX6). For the slice [n, f] of a frustum whose corner rays
+    // have squared slope k2, the sphere through both caps' corners is
+    // centred at (n + f)(1 + k2) / 2 along the view axis, or at the far cap
+    // when that lies beyond it.
+    const float tanX = 1.0f / std::max(std::abs(camera.projection[0][0]), 1e-6f);
+    const float tanY = 1.0f / std::max(std::abs(camera.projection[1][1]), 1e-6f);
+    const float k2 = tanX * tanX + tanY * tanY;
+    const float nearDistance = std::max(camera.lens.nearPlane, 0.0f);
+    const float farDistance = std::max(std::min(settings.maxDistance, camera.lens.farPlane), nearDistance + 1e-3f);
+    float centreDistance = 0.5f * (nearDistance + farDistance) * (1.0f + k2);
+    float radius = 0.0f;
+    if (centreDistance >= farDistance) {
+        centreDistance = farDistance;
+        radius = farDistance * std::sqrt(k2);
+    } else {
+        radius = std::sqrt((farDistance - centreDistance) * (farDistance - centreDistance) +
+                           farDistance * farDistance * k2);
+    }
+    const glm::vec3 viewForward = -glm::vec3(glm::inverse(camera.view)[2]);
+    const glm::vec3 viewCentre = camera.position + glm::normalize(viewForward) * centreDistance;
+
+    const float res = float(settings.resolution);
+    const float border = res / std::max(res - 2.0f * float(kShadowBorderTexels), 1.0f);
+    const float sceneExtent =
+        quantiseExtent(std::max(std::max(lightMax.x - lightMin.x, lightMax.y - lightMin.y), 1e-3f));
+    const float viewExtent = 2.0f * radius;
+    glm::vec2 centre;
+    float extent;
+    if (sceneExtent <= viewExtent) {
+        // The whole scene fits in less: use it, and never fade.
+        extent = sceneExtent * border;
+        centre = 0.5f * (glm::vec2(lightMin) + glm::vec2(lightMax));
+        fit.fadeStart = fit.fadeEnd = 0.0f;
+    } else {
+        extent = viewExtent * border;
+        centre = {glm::dot(viewCentre, right), glm::dot(viewCentre, up)};
+        fit.fadeStart = kShadowFadeStart * farDistance;
+        fit.fadeEnd = farDistance;
+    }
+    // Whole texels: the texel grid stays fixed in the world as the centre
+    // moves, so a static edge covers the same texels every frame.
+    const float texel = extent / res;
+    centre = glm::round(centre / texel) * texel;
+
+    // Depth along the rays over all casters, padded so nothing touches the
+    // clip planes. Reversed: 1 nearest the sun (glint/gbuffer_shared.h).
+    const float pad = 0.01f * (lightMax.z - lightMin.z) + 4.0f * texel;
+    const float depthNear = lightMin.z - pad;
+    const float depthFar = lightMax.z + pad;
+    const float depthRange = depthFar - depthNear;
+
+    const float half = 0.5f * extent;
+    glm::mat4 m(0.0f);  // m[column][row]
+    for (int i = 0; i < 3; ++i) {
+        m[i][0] = right[i] / half;
+        m[i][1] = up[i] / half;
+        m[i][2] = -forward[i] / depthRange;
+    }
+    m[3][0] = -centre.x / half;
+    m[3][1] = -centre.y / half;
+    m[3][2] = depthFar / depthRange;
+    m[3][3] = 1.0f;
+
+    fit.viewProjection = m;
+    fit.texelWorldSize = texel;
+    fit.depthRange = depthRange;
+    fit.constantBias = settings.constantBias;
+    fit.slopeBias = settings.slopeBias;
+    fit.normalOffset = settings.normalOffset;
+    fit.maxSlope = settings.maxSlope;
+    fit.resolution = settings.resolution;
+    fit.enabled = 1;
+    return fit;
+}
 
 // One LOD-0 geometry in the shared vertex and index buffers.
 struct GBufferRenderer::DrawRange {
@@ -97,6 +238,21 @@ GBufferRenderer::GBufferRenderer(gpu::Context& ctx, const scene::Scene& scene, u
     sky.depthWrite = false;
     sky.name = "gbuffer.sky";
     skyPipeline_ = gpu::createGraphicsPipeline(ctx, sky);
+
+    gpu::GraphicsPipelineDesc shadow;
+    shadow.vertexShader = "gbuffer/shadow.vert";
+    shadow.fragmentShader = "gbuffer/shadow.frag";
+    shadow.bindings = geometryBindings();
+    shadow.pushConstantBytes = sizeof(shader::GBufferDraw);
+    // Open and double-sided geometry casts from both sides, as the
+    // G-buffer draws it and as the shadow rays of the RT hits see it.
+    shadow.cullMode = VK_CULL_MODE_NONE;
+    shadow.depthFormat = kGBufferShadowMapFormat;
+    shadow.name = "gbuffer.shadow_map";
+    shadowPipeline_ = gpu::createGraphicsPipeline(ctx, shadow);
+
+    nearest_ = gpu::Sampler(ctx, {VK_FILTER_NEAREST, VK_SAMPLER_MIPMAP_MODE_NEAREST,
+                                  VK_SAMPLER_ADDRESS_MODE_CLAMP_TO_EDGE, 0.0f, "gbuffer.nearest"});
 
     // Every mesh's LOD 0 into one vertex and one index buffer: one binding
     // for the whole frame, draws differ only in their ranges.
@@ -176,6 +332,8 @@ std::shared_ptr<GBufferRenderer::FrameWork> GBufferRenderer::prepare(const GBuff
     f.size = glm::vec2(camera.resolution);
 
     f.lighting = sceneLighting(scene_, settings.lighting);
+    f.shadow = fitSunShadow(scene_, camera, settings.shadow);
+    stats_.shadow = f.shadow;
 
     work->instances.reserve(scene_.instances.size());
     for (const scene::Instance& inst : scene_.instances) {
@@ -197,8 +355,7 @@ std::shared_ptr<GBufferRenderer::FrameWork> GBufferRenderer::prepare(const GBuff
     return work;
 }
 
-void GBufferRenderer::record(const FrameWork& work, rg::PassContext& pc, const GBufferOutputs& targets) {
-    const VkCommandBuffer cmd = pc.cmd();
+void GBufferRenderer::upload(const FrameWork& work) {
     FrameSlot& slot = *slots_[work.slot];
 
     // Host writes before the submit are visible to the device without a
@@ -219,6 +376,59 @@ void GBufferRenderer::record(const FrameWork& work, rg::PassContext& pc, const G
         std::memcpy(slot.previousJoints.mapped(), work.previousJoints.data(),
                     work.previousJoints.size() * sizeof(glm::mat4));
     }
+}
+
+void GBufferRenderer::recordShadowMap(const FrameWork& work, rg::PassContext& pc, rg::Texture shadowMap) {
+    // The frame's first pass (always declared; the G-buffer reads its
+    // output, so it records first) fills the buffers both passes read.
+    upload(work);
+    const VkCommandBuffer cmd = pc.cmd();
+    FrameSlot& slot = *slots_[work.slot];
+    const uint32_t size = pc.image(shadowMap).desc().width;
+
+    // Cleared to 0, the far end of the reversed depth: no caster.
+    VkRenderingAttachmentInfo depth{VK_STRUCTURE_TYPE_RENDERING_ATTACHMENT_INFO};
+    depth.imageView = pc.view(shadowMap);
+    depth.imageLayout = VK_IMAGE_LAYOUT_ATTACHMENT_OPTIMAL;
+    depth.loadOp = VK_ATTACHMENT_LOAD_OP_CLEAR;
+    depth.storeOp = VK_ATTACHMENT_STORE_OP_STORE;
+    depth.clearValue.depthStencil = {0.0f, 0};
+    VkRenderingInfo rendering{VK_STRUCTURE_TYPE_RENDERING_INFO};
+    rendering.renderArea = {{0, 0}, {size, size}};
+    rendering.layerCount = 1;
+    rendering.pDepthAttachment = &depth;
+    vkCmdBeginRendering(cmd, &rendering);
+
+    stats_.shadowDraws = 0;
+    if (work.frame.shadow.enabled != 0) {
+        const VkViewport viewport{0.0f, 0.0f, float(size), float(size), 0.0f, 1.0f};
+        const VkRect2D scissor{{0, 0}, {size, size}};
+        vkCmdSetViewport(cmd, 0, 1, &viewport);
+        vkCmdSetScissor(cmd, 0, 1, &scissor);
+        shadowPipeline_.bind(cmd);
+        gpu::PushDescriptors(shadowPipeline_)
+            .storageBuffer(0, slot.frame)
+            .storageBuffer(1, slot.instances)
+            .storageBuffer(2, vertices_)
+            .storageBuffer(3, slot.joints)
+            .storageBuffer(4, slot.previousJoints)
+            .push(ctx_, cmd);
+        vkCmdBindIndexBuffer(cmd, indices_.handle(), 0, VK_INDEX_TYPE_UINT32);
+        for (size_t i = 0; i < work.instances.size(); ++i) {
+            for (const DrawRange& range : meshDraws_.at(work.meshes[i])) {
+                if (range.indexCount == 0) continue;
+                shadowPipeline_.pushConstants(cmd, shader::GBufferDraw{uint32_t(i), 0u});
+                vkCmdDrawIndexed(cmd, range.indexCount, 1, range.firstIndex, range.vertexOffset, 0);
+                ++stats_.shadowDraws;
+            }
+        }
+    }
+    vkCmdEndRendering(cmd);
+}
+
+void GBufferRenderer::record(const FrameWork& work, rg::PassContext& pc, const GBufferOutputs& targets) {
+    const VkCommandBuffer cmd = pc.cmd();
+    FrameSlot& slot = *slots_[work.slot];
 
     // Load-op clears: depth 0 is the reversed-Z far plane; zero normal w and
     // albedo mark "no surface" for the passes that read them.
@@ -262,6 +472,8 @@ void GBufferRenderer::record(const FrameWork& work, rg::PassContext& pc, const G
             .storageBuffer(2, vertices_)
             .storageBuffer(3, slot.joints)
             .storageBuffer(4, slot.previousJoints)
+            .sampledImage(kShadowMapBinding, pc.view(targets.shadowMap), nearest_.handle(),
+                          pc.layout(targets.shadowMap))
             .push(ctx_, cmd);
     };
 
@@ -298,6 +510,23 @@ GBufferOutputs addGBufferPass(rg::Graph& graph, GBufferRenderer& renderer, const
     }
     std::shared_ptr<GBufferRenderer::FrameWork> work = renderer.prepare(inputs, settings);
 
+    // With shadows off the map is one cleared texel: the G-buffer's
+    // pipelines keep one layout and the frame one shape.
+    const uint32_t shadowSize = work->frame.shadow.enabled != 0 ? work->frame.shadow.resolution : 1u;
+    struct ShadowData {
+        rg::Texture map;
+    };
+    const ShadowData& shadow = graph.addPass<ShadowData>(
+        "shadow_map", rg::Queue::Graphics,
+        [&](rg::Builder& b, ShadowData& d) {
+            b.setPipeline(rg::Pipeline::Raster);
+            d.map = b.write(b.createTexture("gbuffer.shadow_map", {.width = shadowSize,
+                                                                    .height = shadowSize,
+                                                                    .format = kGBufferShadowMapFormat}),
+                            rg::Access::DepthWrite);
+        },
+        [&renderer, work](const ShadowData& d, rg::PassContext& pc) { renderer.recordShadowMap(*work, pc, d.map); });
+
     const GBufferOutputs& out = graph.addPass<GBufferOutputs>(
         "gbuffer", rg::Queue::Graphics,
         [&](rg::Builder& b, GBufferOutputs& d) {
@@ -312,8 +541,10 @@ GBufferOutputs addGBufferPass(rg::Graph& graph, GBufferRenderer& renderer, const
                 target("gbuffer.roughness_metal", kGBufferRoughnessMetalFormat, rg::Access::ColorAttachment);
             d.motion = target("gbuffer.motion", kGBufferMotionFormat, rg::Access::ColorAttachment);
             d.lit = target("gbuffer.lit", kGBufferLitFormat, rg::Access::ColorAttachment);
+            d.shadowMap = b.read(shadow.map, rg::Access::SampledRead);
             d.width = width;
             d.height = height;
+            d.shadowResolution = shadowSize;
         },
         [&renderer, work](const GBufferOutputs& d, rg::PassContext& pc) { renderer.record(*work, pc, d); });
     return out;

@@ -13,11 +13,19 @@
 //     ... passes reading gbuf.depth, gbuf.lit, ... ...
 //     executor.run(graph.compile(executor.compileOptions()));
 //
-// Lighting in this step: the sun without shadows (the shadow ray arrives
-// with the ray-traced hit pass, which shares glint/brdf.glsl) plus diffuse
-// light from the procedural sky. Materials are sampled at the vertices on
-// the CPU (scene::surfaceAtVertex, as the BVH's packed primitives are), so
-// textures contribute at vertex rate and normal maps not at all.
+// Lighting: the sun, shadowed by a shadow map, plus diffuse light from the
+// procedural sky, with glint/brdf.glsl as the ray-traced hits light (their
+// sun visibility comes from a shadow ray, so a surface seen directly, in
+// SSLR and in an RT reflection is shadowed alike). The shadow map is a
+// pass of its own ("shadow_map", graphics queue, before "gbuffer"): an
+// orthographic depth-only raster along the sun's rays of every instance's
+// LOD 0, the G-buffer's own vertex buffer and skinning, fitted to the
+// camera's view up to a distance or to the whole scene where that is
+// smaller, on a world-fixed texel grid so it does not shimmer as the camera
+// moves. It needs no BVH, so every mode and device gets the same shadows.
+// Materials are sampled at the vertices on the CPU (scene::surfaceAtVertex,
+// as the BVH's packed primitives are), so textures contribute at vertex
+// rate and normal maps not at all.
 
 #include "gpu/context.h"
 #include "gpu/pipeline.h"
@@ -40,10 +48,45 @@ inline constexpr VkFormat kGBufferAlbedoFormat = VK_FORMAT_R8G8B8A8_SRGB;
 inline constexpr VkFormat kGBufferRoughnessMetalFormat = VK_FORMAT_R8G8B8A8_UNORM;
 inline constexpr VkFormat kGBufferMotionFormat = VK_FORMAT_R16G16_SFLOAT;
 inline constexpr VkFormat kGBufferLitFormat = VK_FORMAT_R16G16B16A16_SFLOAT;
+// Reversed like the camera's depth; conventions in glint/gbuffer_shared.h.
+inline constexpr VkFormat kGBufferShadowMapFormat = VK_FORMAT_D32_SFLOAT;
 
 struct GBufferInputs {
     // This and last frame's matrices; its resolution is the G-buffer's size.
     scene::Camera camera;
+};
+
+// The sun's shadow map. Biases are in shadow texels (the world size of one
+// texel of this frame's fit), so they keep working when the resolution,
+// the distance or the scene's size change the texel. The defaults keep the
+// tests' floor free of acne under a 10- and a 45-degree sun
+// (tests/gpu/gbuffer_test.cpp) with the smallest bias the filter's reach
+// asks for (see slopeBias).
+struct SunShadowSettings {
+    // Off: the sun is unshadowed (the map shrinks to one cleared texel).
+    bool enabled = true;
+    // Texels per side of the square map. 2048 gives about 6 cm texels over
+    // the default 60 m view on a 60-degree 3:2 lens (the view's bounding
+    // sphere is 125 m across).
+    uint32_t resolution = 2048;
+    // The map covers the camera's view up to this distance (or the whole
+    // scene where that is smaller); shadows fade out over the last tenth.
+    // 60 m reaches the buildings around the plaza from its camera path.
+    float maxDistance = 60.0f;
+    // Constant receiver bias along the sun's rays: float rounding and
+    // curved surfaces between texel centres.
+    float constantBias = 0.5f;
+    // Times tan(angle between normal and sun): the filter compares texels up
+    // to two away, across which a tilted surface's own depth changes by
+    // tan(angle) each.
+    float slopeBias = 2.0f;
+    // Along the normal, times sin(that angle): the surface moves off itself
+    // rather than only deeper, which removes acne at grazing sun with less
+    // detachment than depth bias alone.
+    float normalOffset = 1.0f;
+    // The tangent's clamp: 10 is 84 degrees from the normal, beyond which
+    // the sun's cosine is below 0.1 and more bias would only detach shadows.
+    float maxSlope = 10.0f;
 };
 
 struct GBufferSettings {
@@ -53,6 +96,8 @@ struct GBufferSettings {
     // Fill uncovered pixels with the sky's radiance in the lit colour; off,
     // they keep the clear value (zero).
     bool drawSky = true;
+    // The sun's shadows in the lit colour.
+    SunShadowSettings shadow;
 };
 
 struct GBufferOutputs {
@@ -62,14 +107,21 @@ struct GBufferOutputs {
     rg::Texture roughnessMetal;  // kGBufferRoughnessMetalFormat
     rg::Texture motion;          // kGBufferMotionFormat
     rg::Texture lit;             // kGBufferLitFormat
+    // kGBufferShadowMapFormat, shadowResolution texels square (1 with
+    // shadows off), written by the "shadow_map" pass; for debug views.
+    rg::Texture shadowMap;
     uint32_t width = 0;
     uint32_t height = 0;
+    uint32_t shadowResolution = 0;
 };
 
 struct GBufferStats {
     uint64_t frame = 0;           // addGBufferPass calls so far
     uint32_t draws = 0;           // this frame: vkCmdDrawIndexed calls
     uint64_t triangles = 0;       // this frame
+    uint32_t shadowDraws = 0;     // this frame, into the shadow map
+    // This frame's shadow map fit (enabled = 0 with shadows off).
+    shader::GBufferShadow shadow{};
     uint64_t geometryBytes = 0;   // the uploaded vertex and index buffers
 };
 
@@ -96,6 +148,10 @@ private:
     struct FrameWork;
 
     std::shared_ptr<FrameWork> prepare(const GBufferInputs& inputs, const GBufferSettings& settings);
+    // Writes the frame's host buffers; the shadow map pass, the frame's
+    // first, calls it.
+    void upload(const FrameWork& work);
+    void recordShadowMap(const FrameWork& work, rg::PassContext& pc, rg::Texture shadowMap);
     void record(const FrameWork& work, rg::PassContext& pc, const GBufferOutputs& targets);
     void ensureCapacity(gpu::Buffer& buffer, VkDeviceSize bytes, const char* name);
 
@@ -105,6 +161,8 @@ private:
     uint64_t frame_ = 0;
     gpu::Pipeline surfacePipeline_;
     gpu::Pipeline skyPipeline_;
+    gpu::Pipeline shadowPipeline_;
+    gpu::Sampler nearest_;  // completes the shadow map's descriptor; reads are texelFetch
     gpu::Buffer vertices_;  // GBufferVertex, every geometry of every mesh's LOD 0
     gpu::Buffer indices_;
     std::vector<std::vector<DrawRange>> meshDraws_;  // per mesh: its LOD-0 geometries
@@ -112,9 +170,19 @@ private:
     GBufferStats stats_;
 };
 
-// Declares the G-buffer pass (see the top of this file). Frames are declared
-// and run one at a time, once each: the renderer's per-frame host buffers
-// count frames by these calls.
+// The shadow map's fit for `camera` (glint/gbuffer_shared.h's GBufferShadow):
+// an orthographic view along the sun's rays whose depth range holds every
+// instance's world bounds (so casters outside the view still cast), whose
+// square covers the bounding sphere of the camera's view up to
+// settings.maxDistance, or the scene's bounds seen from the sun where those
+// are smaller, centred on whole texels. enabled = 0 with shadows off or
+// nothing to cast.
+shader::GBufferShadow fitSunShadow(const scene::Scene& scene, const scene::Camera& camera,
+                                   const SunShadowSettings& settings);
+
+// Declares the shadow map and G-buffer passes (see the top of this file).
+// Frames are declared and run one at a time, once each: the renderer's
+// per-frame host buffers count frames by these calls.
 GBufferOutputs addGBufferPass(rg::Graph& graph, GBufferRenderer& renderer, const GBufferInputs& inputs,
                               const GBufferSettings& settings = {});
 

@@ -1,10 +1,12 @@
 #version 460
 // G-buffer surface: writes the attributes and lights the surface with the
-// unified lighting (glint/brdf.glsl). The sun is unshadowed in this pass.
+// unified lighting (glint/brdf.glsl), the sun shadowed by the shadow map
+// (shadow.glsl) as the ray-traced hits are by their shadow rays.
 #extension GL_GOOGLE_include_directive : require
 
 #include "gbuffer_common.glsl"
 #include "glint/brdf.glsl"
+#include "shadow.glsl"
 
 layout(location = 0) in vec3 inWorldPosition;
 layout(location = 1) in vec3 inNormal;
@@ -46,5 +48,5 @@ void main() {
     // A vertex behind last frame's camera has w <= 0: no motion is better
     // than a wild one.
     outMotion = inPreviousClip.w > 0.0 ? pixelOf(inPreviousClip) - pixelOf(inClip) : vec2(0.0);
-    outLit = vec4(shadeSurface(frame.lighting, s, toViewer, 1.0), 1.0);
+    outLit = vec4(shadeSurface(frame.lighting, s, toViewer, sunShadowVisibility(inWorldPosition, n)), 1.0);
 }

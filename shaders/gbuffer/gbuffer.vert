@@ -14,20 +14,6 @@ layout(location = 3) out vec3 outMaterial;  // roughness, metallic, reflectance
 layout(location = 4) out vec4 outClip;      // unjittered, this frame
 layout(location = 5) out vec4 outPreviousClip;
 
-// Linear blend skinning with the same guards as the BVH's pack pass: zero
-// weights and joints past the instance's skin contribute nothing.
-mat4 skinMatrix(GBufferVertex v, GBufferInstance inst, bool previous) {
-    const uint joint[4] = uint[4](v.joints.x & 0xFFFFu, v.joints.x >> 16u, v.joints.y & 0xFFFFu, v.joints.y >> 16u);
-    mat4 m = mat4(0.0);
-    for (int k = 0; k < 4; ++k) {
-        if (v.weights[k] > 0.0 && joint[k] < inst.jointCount) {
-            const uint j = inst.jointOffset + joint[k];
-            m += v.weights[k] * (previous ? previousJoints[j] : joints[j]);
-        }
-    }
-    return m;
-}
-
 void main() {
     const GBufferVertex v = vertices[gl_VertexIndex];
     const GBufferInstance inst = instances[draw.instance];

@@ -10,7 +10,18 @@
 //                  unjittered: history lookup = pixel + motion
 //   lit            radiance of the opaque scene (sun + diffuse ambient; no
 //                  specular ambient: the reflection passes add that), a = 1;
-//                  the sky's radiance with a = 0 where nothing was drawn
+//                  the sky's radiance with a = 0 where nothing was drawn.
+//                  The sun term is shadowed by the shadow map below; the
+//                  ambient term never is (the ray-traced hits light the same
+//                  way, their sun visibility from a shadow ray).
+//   shadowMap      the sun's shadow map (its own pass before the G-buffer):
+//                  D32_SFLOAT, square, an orthographic view along the sun's
+//                  rays. Reversed like the camera's depth: 1 at the side
+//                  facing the sun, 0 at the far side, cleared to 0 (nothing
+//                  casts there); each texel keeps the occluder nearest the
+//                  sun (GREATER_OR_EQUAL). Its world -> clip matrix and
+//                  scale are GBufferShadow below. With shadows off it is
+//                  one texel, cleared, and no pixel reads it.
 #ifndef GLINT_GBUFFER_SHARED_H
 #define GLINT_GBUFFER_SHARED_H
 
@@ -54,6 +65,29 @@ struct SceneLighting {
     vec4 skyGround;
 };
 
+// The sun's shadow map this frame (passes/gbuffer.cpp fits it; the
+// fragment shader filters it, shaders/gbuffer/shadow.glsl). 112 bytes.
+// Biases are in shadow texels (texelWorldSize world units each), so they
+// hold whatever resolution and fit the map has.
+struct GBufferShadow {
+    // World -> shadow clip: x, y in [-1, 1] across the map (texel centres
+    // on a world-fixed grid: the centre is snapped to whole texels), z the
+    // reversed depth (1 nearest the sun), w = 1.
+    mat4 viewProjection;
+    float texelWorldSize;  // world units per texel, both axes
+    float depthRange;      // world units along the sun's rays per unit of depth
+    float constantBias;    // texels along the sun's rays
+    float slopeBias;       // texels times tan(angle between normal and sun)
+    float normalOffset;    // texels along the normal, times sin(that angle)
+    float maxSlope;        // clamp of that tangent
+    float fadeStart;       // camera distance where shadows start fading out
+    float fadeEnd;         // and where they are gone; not above fadeStart: no fade
+    uint resolution;       // texels per side
+    uint enabled;          // 0: the sun is unshadowed, the map is not read
+    uint pad0;
+    uint pad1;
+};
+
 // Per-frame constants (binding 0).
 struct GBufferFrame {
     mat4 jitteredViewProjection;   // rasterisation
@@ -64,6 +98,7 @@ struct GBufferFrame {
     vec2 size;                     // pixels
     vec2 pad;
     SceneLighting lighting;
+    GBufferShadow shadow;
 };
 
 // Push constants of one draw (8 bytes).
@@ -78,6 +113,7 @@ GLINT_END
 static_assert(sizeof(glint::shader::GBufferVertex) == 72);
 static_assert(sizeof(glint::shader::GBufferInstance) == 144);
 static_assert(sizeof(glint::shader::GBufferDraw) == 8);
+static_assert(sizeof(glint::shader::GBufferShadow) == 112);
 #endif
 
 #endif
