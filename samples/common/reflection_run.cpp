@@ -217,7 +217,7 @@ ReflectionRunResult runReflections(gpu::Context& ctx, scene::Scene& scene, const
     gpu::Buffer counts(ctx, {shader::kReflectionCountWords * 4u, VK_BUFFER_USAGE_TRANSFER_DST_BIT,
                              gpu::MemoryUsage::Readback, "glint.counts_readback"});
     gpu::Buffer resolved;
-    if (reference) {
+    if (reference || options.readResolved) {
         resolved = gpu::Buffer(ctx, {VkDeviceSize(w) * h * 8, VK_BUFFER_USAGE_TRANSFER_DST_BIT,
                                      gpu::MemoryUsage::Readback, "glint.reference_readback"});
     }
@@ -283,7 +283,7 @@ ReflectionRunResult runReflections(gpu::Context& ctx, scene::Scene& scene, const
             addCopyToHost(graph, resources, image, "readback.output", frame.output.color, {}, w, h);
             addCopyToHost(graph, resources, counts, "readback.counts", {}, frame.counts, w, h);
         }
-        if (check) {
+        if (check || (last && options.readResolved)) {
             addCopyToHost(graph, resources, resolved, "readback.resolved", frame.temporal.resolved, {}, w, h);
         }
         const auto frameStart = std::chrono::steady_clock::now();
@@ -360,6 +360,11 @@ ReflectionRunResult runReflections(gpu::Context& ctx, scene::Scene& scene, const
     }
     result.rgba.resize(size_t(w) * h * 4);
     std::memcpy(result.rgba.data(), image.mapped(), result.rgba.size());
+    if (options.readResolved) {
+        const auto halves = resolved.mappedSpan<const uint16_t>();
+        result.resolved.resize(size_t(w) * h * 4);
+        for (size_t k = 0; k < result.resolved.size(); ++k) result.resolved[k] = glm::unpackHalf1x16(halves[k]);
+    }
     std::vector<uint32_t> words(shader::kReflectionCountWords);
     std::memcpy(words.data(), counts.mapped(), words.size() * 4);
     result.pixelClasses.assign(words.begin(), words.begin() + shader::kPixelClassCount);

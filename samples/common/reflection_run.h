@@ -49,6 +49,10 @@ struct ReflectionRunOptions {
     // Waits for each frame and reads its pass times (else only the last
     // frame's are read).
     bool timeEveryFrame = true;
+    // Also reads back the last frame's resolved reflections (the temporal
+    // pass's output) into ReflectionRunResult::resolved: the benchmark
+    // measures the reflection term's error on it, before the composite.
+    bool readResolved = false;
     passes::ReflectionRendererOptions renderer;
     passes::ReflectionFrameSettings frame;
     ReferenceOptions reference;  // when enabled, `frames` and `mode` are ignored
@@ -62,6 +66,10 @@ struct PassTime {
 
 struct ReflectionRunResult {
     std::vector<uint8_t> rgba;  // the last frame's output, width x height x 4, sRGB-encoded
+    // With ReflectionRunOptions::readResolved: the last frame's resolved
+    // reflections, width x height x 4 floats, linear radiance (a > 0 where
+    // the pixel has a reflection, else all zero).
+    std::vector<float> resolved;
     std::vector<PassTime> passes;
     std::optional<double> reflectionMs;  // median per-frame sum of the reflection passes
     std::optional<double> totalMs;       // median per-frame sum of all passes

@@ -1,0 +1,440 @@
+// glint-bench (issue 6): what each reflection setting costs and what it
+// loses. Renders the converged reference once, then every mode with its
+// defaults and sweeps of the main parameters over the same camera path,
+// and reports per-pass GPU time (median over frames; on a CPU device the
+// frame's host time too), ray counts and the error of the last frame
+// against the reference (FLIP, relMSE, PSNR, SSIM) on the final image and on
+// the resolved reflection term. Writes a table on stdout, CSV, JSON and a
+// time-against-error plot with the Pareto front.
+//
+// The reference is rendered where the measured runs end: at the pose and
+// scene time of their last frame (a still camera path holding that pose),
+// because a test configuration's last frame is what is compared and the
+// reference's camera stands still.
+
+#include "bench/report.h"
+#include "common/app.h"
+#include "common/reflection_run.h"
+#include "metrics/error_map.h"
+#include "metrics/flip.h"
+#include "metrics/image.h"
+#include "metrics/pixel_metrics.h"
+#include "scene/builtin_scenes.h"
+
+#include <spdlog/spdlog.h>
+
+#include <algorithm>
+#include <array>
+#include <chrono>
+#include <cmath>
+#include <cstdio>
+#include <ctime>
+#include <filesystem>
+#include <memory>
+
+using namespace glint;
+
+namespace {
+
+constexpr const char* kUsage =
+    "usage: glint-bench [--scene plaza|hard-cases|FILE.gltf|FILE.glb] [--frames N] [--size WxH|N]\n"
+    "                   [--modes hybrid,ssr,rt] [--sweep-modes hybrid[,ssr,rt]|\"\"] [--quick]\n"
+    "                   [--out-dir DIR] [--csv FILE] [--json FILE] [--plot FILE.png]\n"
+    "                   [--time SECONDS] [--ppd N] [--backend auto|query|pipeline]\n"
+    "                   [--reference-max-frames N] [--warmup-frames N] [--jitter] [--validate]\n"
+    "  Renders the converged reference at the pose of the runs' last frame, then each of --modes with\n"
+    "  defaults and the parameter sweeps (in the --sweep-modes where the parameter means something),\n"
+    "  N frames (default 16) each, and compares each run's last frame with the reference.\n"
+    "  --size defaults to 256x256 on a CPU device and 1920x1080 on a GPU. --warmup-frames (default 60 on\n"
+    "  a GPU, 0 on a CPU device): untimed frames of each configuration before its measured run.\n"
+    "  --csv/--json/--plot default to DIR/<scene>_bench.{csv,json,png}; DIR (default build/bench) also\n"
+    "  gets the reference, each mode's default image, its FLIP map, and both reflection terms\n"
+    "  (*_reflections.png, tonemapped as the \"resolved\" debug view).";
+
+// One parameter sweep. Values equal to the default are skipped (the mode's
+// default row has them). `modes` are those where the parameter changes the
+// image: the threshold only decides between SSLR and RT (hybrid), the step
+// count needs SSLR (hybrid, ssr), the BVH radius a ray tracer (hybrid, rt);
+// the roughness cutoff and quad sharing are ray generation's (every mode).
+struct Sweep {
+    std::string_view param;
+    std::vector<double> values;
+    std::vector<double> quickValues;
+    std::array<bool, 3> modes;  // passes::ReflectionMode order: hybrid, ssr, rt
+};
+
+const std::array<Sweep, 5> kSweeps = {{
+    // The talk's 0.9 (default) bracketed from "trust SSLR often" to "almost never".
+    {"sslr_threshold", {0.5, 0.7, 0.8, 0.95, 0.99}, {0.7}, {true, false, false}},
+    // FidelityFX's 0.22 (default): lower sends more pixels to the environment, higher traces more.
+    {"roughness_cutoff", {0.1, 0.15, 0.3, 0.5}, {0.5}, {true, true, true}},
+    // 64 linear steps (default) against fewer and more.
+    {"sslr_steps", {16, 32, 96, 128}, {16}, {true, true, false}},
+    // Samples per quad: quads at or above this roughness share one ray. 0: every traced quad
+    // shares (1 sample per quad); 1 (above any traced roughness): none does (4 per quad).
+    {"reuse_roughness", {0.0, 0.05, 0.15, 1.0}, {0.0}, {true, true, true}},
+    // The talk's 100 (default) around the camera; smaller radii drop distant BLASes.
+    {"bvh_radius", {10, 25, 50, 200}, {25}, {true, false, true}},
+}};
+
+// "W", "WxH": 1..8192 each (as glint-render).
+std::pair<uint32_t, uint32_t> parseSize(const std::string& text) {
+    const auto number = [&](const std::string& part) {
+        size_t used = 0;
+        unsigned long v = 0;
+        try {
+            v = std::stoul(part, &used);
+        } catch (const std::exception&) {
+            used = 0;
+        }
+        if (used == 0 || used != part.size() || v == 0 || v > 8192) {
+            throw std::runtime_error("--size " + text + ": expected N or WxH with 1..8192 pixels each");
+        }
+        return uint32_t(v);
+    };
+    const size_t x = text.find('x');
+    if (x == std::string::npos) {
+        const uint32_t n = number(text);
+        return {n, n};
+    }
+    return {number(text.substr(0, x)), number(text.substr(x + 1))};
+}
+
+double parsePositive(const std::string& flag, const std::string& text, bool allowZero) {
+    try {
+        size_t used = 0;
+        const double v = std::stod(text, &used);
+        if (used == text.size() && std::isfinite(v) && (v > 0.0 || (allowZero && v == 0.0))) return v;
+    } catch (const std::exception&) {
+    }
+    throw std::runtime_error("--" + flag + " " + text + ": not a " + (allowZero ? "non-negative" : "positive") +
+                             " number");
+}
+
+std::vector<passes::ReflectionMode> parseModes(const std::string& flag, const std::string& text) {
+    std::vector<passes::ReflectionMode> modes;
+    if (text.empty()) return modes;  // --sweep-modes "": no sweeps
+    for (size_t start = 0; start <= text.size();) {
+        const size_t end = std::min(text.find(',', start), text.size());
+        try {
+            const passes::ReflectionMode m = passes::parseMode(text.substr(start, end - start));
+            if (std::find(modes.begin(), modes.end(), m) == modes.end()) modes.push_back(m);
+        } catch (const std::invalid_argument& e) {
+            throw std::runtime_error("--" + flag + ": " + e.what());
+        }
+        start = end + 1;
+    }
+    return modes;
+}
+
+// The commit: git at run time (right after new commits without a
+// reconfigure), else the one CMake saw, else "unknown".
+std::string gitCommit() {
+    std::string out;
+    const std::string command =
+        std::string("git -C '") + GLINT_SOURCE_DIR + "' describe --always --dirty --abbrev=12 2>/dev/null";
+    if (FILE* pipe = popen(command.c_str(), "r")) {
+        char buffer[128];
+        while (std::fgets(buffer, sizeof buffer, pipe)) out += buffer;
+        const int rc = pclose(pipe);
+        while (!out.empty() && (out.back() == '\n' || out.back() == '\r')) out.pop_back();
+        if (rc == 0 && !out.empty()) return out;
+    }
+    const std::string configured = GLINT_CONFIGURED_COMMIT;
+    return configured.empty() ? "unknown" : configured + " (at configure time)";
+}
+
+std::string utcNow() {
+    const std::time_t now = std::time(nullptr);
+    std::tm tm{};
+    gmtime_r(&now, &tm);
+    char buffer[32];
+    std::strftime(buffer, sizeof buffer, "%Y-%m-%dT%H:%M:%SZ", &tm);
+    return buffer;
+}
+
+// Khronos PBR Neutral, as shaders/composite/tonemap.glsl (the "resolved"
+// debug view's operator): LDR-FLIP, PSNR and SSIM need display values in
+// [0, 1], and these are the ones the debug view shows.
+glm::vec3 tonemapNeutral(glm::vec3 c) {
+    c = glm::max(c, glm::vec3(0.0f));
+    const float startCompression = 0.8f - 0.04f;
+    const float desaturation = 0.15f;
+    const float x = std::min(c.r, std::min(c.g, c.b));
+    const float offset = x < 0.08f ? x - 6.25f * x * x : 0.04f;
+    c -= offset;
+    const float peak = std::max(c.r, std::max(c.g, c.b));
+    if (peak >= startCompression) {
+        const float d = 1.0f - startCompression;
+        const float newPeak = 1.0f - d * d / (peak + d - startCompression);
+        c *= newPeak / peak;
+        const float g = 1.0f - 1.0f / (desaturation * (peak - newPeak) + 1.0f);
+        c = glm::mix(c, glm::vec3(newPeak), g);
+    }
+    return glm::clamp(c, glm::vec3(0.0f), glm::vec3(1.0f));
+}
+
+// The resolved reflection term (RGBA floats) as two images: the linear
+// radiance for relMSE (made for HDR radiance) and its tonemapped display
+// values for FLIP, PSNR and SSIM. Pixels without a reflection are black.
+struct ReflectionTerm {
+    metrics::Image radiance;
+    metrics::Image display;
+};
+
+ReflectionTerm reflectionTerm(const std::vector<float>& rgba, uint32_t width, uint32_t height, float exposure,
+                              const std::string& name) {
+    ReflectionTerm t;
+    t.radiance = {width, height, {}, name + " (reflection radiance)"};
+    t.display = {width, height, {}, name + " (reflection, tonemapped)"};
+    t.radiance.linear.resize(size_t(width) * height);
+    t.display.linear.resize(size_t(width) * height);
+    for (size_t p = 0; p < t.radiance.linear.size(); ++p) {
+        glm::vec3 c(rgba[p * 4], rgba[p * 4 + 1], rgba[p * 4 + 2]);
+        if (!(rgba[p * 4 + 3] > 0.0f) || !std::isfinite(c.r + c.g + c.b)) c = glm::vec3(0.0f);
+        t.radiance.linear[p] = c;
+        t.display.linear[p] = tonemapNeutral(c * exposure);
+    }
+    return t;
+}
+
+// A display image (linear, [0, 1]) as the RGBA8 sRGB that writePng takes.
+std::vector<uint8_t> toSrgb8(const metrics::Image& image) {
+    std::vector<uint8_t> rgba(image.linear.size() * 4, 255);
+    for (size_t p = 0; p < image.linear.size(); ++p) {
+        for (int c = 0; c < 3; ++c) {
+            rgba[p * 4 + c] = uint8_t(std::lround(metrics::linearToSrgb(image.linear[p][c]) * 255.0f));
+        }
+    }
+    return rgba;
+}
+
+bench::ErrorMetrics measure(const metrics::Image& reference, const metrics::Image& test, double ppd,
+                            const metrics::Image* referenceRadiance = nullptr,
+                            const metrics::Image* testRadiance = nullptr) {
+    bench::ErrorMetrics m;
+    m.flipMean = metrics::flip(reference, test, ppd).stats.mean;
+    m.relMse = referenceRadiance ? metrics::relMse(*referenceRadiance, *testRadiance) : metrics::relMse(reference, test);
+    m.psnr = metrics::psnr(reference, test);
+    m.ssim = metrics::ssim(reference, test);
+    return m;
+}
+
+struct Configuration {
+    passes::ReflectionMode mode;
+    std::string param;  // bench::kDefaultParam or a parameter name
+    double value = 0.0;
+};
+
+} // namespace
+
+int main(int argc, char** argv) {
+    return app::runMain("glint-bench", [&] {
+        const app::Args args(argc, argv, kUsage,
+                             {"scene", "frames", "size", "modes", "sweep-modes", "out-dir", "csv", "json", "plot",
+                              "time", "ppd", "backend", "reference-max-frames", "warmup-frames"},
+                             {"quick", "jitter"});
+        const std::string sceneName = args.get("scene", "plaza");
+        const uint32_t frames = args.getUint("frames", 16);
+        if (frames == 0) throw std::runtime_error("--frames 0: must be at least 1");
+        const bool quick = args.has("quick");
+        const std::vector<passes::ReflectionMode> modes = parseModes("modes", args.get("modes", "hybrid,ssr,rt"));
+        if (modes.empty()) throw std::runtime_error("--modes: name at least one of hybrid, ssr, rt");
+        const std::vector<passes::ReflectionMode> sweepModes = parseModes("sweep-modes", args.get("sweep-modes", "hybrid"));
+        const double ppd = args.has("ppd") ? parsePositive("ppd", args.get("ppd", ""), false) : metrics::kDefaultPpd;
+        const std::filesystem::path outDir = args.get("out-dir", "build/bench");
+        const std::string stem = std::filesystem::path(sceneName).stem().string();
+        const std::filesystem::path csvPath = args.get("csv", (outDir / (stem + "_bench.csv")).string());
+        const std::filesystem::path jsonPath = args.get("json", (outDir / (stem + "_bench.json")).string());
+        const std::filesystem::path plotPath = args.get("plot", (outDir / (stem + "_bench.png")).string());
+
+        gpu::Context ctx(args.contextOptions());
+        const bool cpuDevice = ctx.caps().deviceType == VK_PHYSICAL_DEVICE_TYPE_CPU;
+        const auto [width, height] =
+            parseSize(args.get("size", cpuDevice ? "256x256" : "1920x1080"));
+        scene::Scene scene = scene::loadScene(sceneName);
+
+        app::ReflectionRunOptions base;
+        base.width = width;
+        base.height = height;
+        base.frames = frames;
+        base.readResolved = true;
+        // The reference's still camera has no sub-pixel jitter, and nothing
+        // in the frame resolves the jitter of the opaque image (no TAA): a
+        // jittered last frame would add up to half a pixel of edge error to
+        // every configuration alike and hide the reflections' differences.
+        // --jitter measures with it.
+        base.jitter = args.has("jitter");
+        // As glint-render: 3 s along the plaza's path looks down the plaza past the puddles.
+        base.startSeconds = float(parsePositive("time", args.get("time", sceneName == "plaza" ? "3" : "0"), true));
+        try {
+            base.renderer.backend = passes::parseBackend(args.get("backend", "auto"));
+        } catch (const std::invalid_argument& e) {
+            throw std::runtime_error(std::string("--backend: ") + e.what());
+        }
+        const float exposure = base.frame.composite.exposure;
+        // A CPU device has no GPU clocks to raise (and a warm-up would double
+        // its long runs); a GPU gets about a second of load at 1080p.
+        const uint32_t warmupFrames = args.getUint("warmup-frames", cpuDevice ? 0 : 60);
+
+        // Every configuration, so progress can say "k of n".
+        std::vector<Configuration> configurations;
+        for (const passes::ReflectionMode mode : modes) configurations.push_back({mode, std::string(bench::kDefaultParam)});
+        for (const Sweep& sweep : kSweeps) {
+            for (const passes::ReflectionMode mode : modes) {
+                if (!sweep.modes[size_t(mode)]) continue;
+                if (std::find(sweepModes.begin(), sweepModes.end(), mode) == sweepModes.end()) continue;
+                const double defaultValue = app::getParameter(base, sweep.param);
+                for (const double v : quick ? sweep.quickValues : sweep.values) {
+                    if (float(v) == float(defaultValue)) continue;
+                    configurations.push_back({mode, std::string(sweep.param), v});
+                }
+            }
+        }
+        spdlog::info("{}: {}x{}, {} frames from {} s, {} configurations on {} ({})", scene.name, width, height,
+                     frames, base.startSeconds, configurations.size(), ctx.caps().deviceName,
+                     gpu::deviceTypeName(ctx.caps().deviceType));
+        const auto benchStart = std::chrono::steady_clock::now();
+        const auto elapsed = [&] {
+            return std::chrono::duration<double>(std::chrono::steady_clock::now() - benchStart).count();
+        };
+
+        // 1. The reference at the last measured frame's pose and scene time:
+        // a still camera path that holds that pose (CameraPath::evaluate
+        // returns the first key exactly at or before its time), restored after.
+        const float lastSeconds = base.startSeconds + float(frames - 1) * base.frameSeconds;
+        const scene::CameraPose lastPose = app::cameraPoseAt(scene, base, frames - 1);
+        app::ReflectionRunOptions referenceOptions = base;
+        referenceOptions.reference.enabled = true;
+        referenceOptions.startSeconds = lastSeconds;
+        if (args.has("reference-max-frames")) {
+            const uint32_t maxFrames = args.getUint("reference-max-frames", 0);
+            if (maxFrames == 0 || maxFrames > 2048) {
+                throw std::runtime_error("--reference-max-frames: expected 1..2048");
+            }
+            referenceOptions.reference.maxFrames = maxFrames;
+            referenceOptions.reference.minFrames = std::min(referenceOptions.reference.minFrames, maxFrames);
+            referenceOptions.reference.checkEvery = std::min(referenceOptions.reference.checkEvery, maxFrames);
+        }
+        const scene::CameraPath path = scene.cameraPath;
+        scene.cameraPath.keys = {{lastSeconds, lastPose.position, lastPose.target},
+                                 {lastSeconds + 1.0f, lastPose.position, lastPose.target}};
+        spdlog::info("reference: {}x{} at the pose of frame {} ({:.3f} s)", width, height, frames - 1, lastSeconds);
+        app::ReflectionRunResult reference;
+        try {
+            reference = app::runReflections(ctx, scene, referenceOptions);
+        } catch (...) {
+            scene.cameraPath = path;
+            throw;
+        }
+        scene.cameraPath = path;
+        const metrics::Image referenceImage = metrics::imageFromSrgb8(width, height, reference.rgba, 4, "reference");
+        const ReflectionTerm referenceTerm = reflectionTerm(reference.resolved, width, height, exposure, "reference");
+        app::writePng((outDir / (stem + "_reference.png")).string(), width, height, reference.rgba);
+        app::writePng((outDir / (stem + "_reference_reflections.png")).string(), width, height,
+                      toSrgb8(referenceTerm.display));
+        spdlog::info("reference: {} frames ({}) in {:.1f} s", reference.framesRun,
+                     reference.converged ? "converged" : "frame limit", elapsed());
+
+        // 2. Every configuration over the same path.
+        std::vector<bench::Row> rows;
+        for (size_t k = 0; k < configurations.size(); ++k) {
+            const Configuration& c = configurations[k];
+            app::ReflectionRunOptions options = base;
+            options.frame.mode = c.mode;
+            const bool baseline = c.param == bench::kDefaultParam;
+            if (!baseline) app::setParameter(options, c.param, bench::formatValue(c.value));
+            const std::string modeName(passes::modeName(c.mode));
+            const std::string what =
+                baseline ? modeName + " defaults" : modeName + " " + c.param + "=" + bench::formatValue(c.value);
+
+            if (warmupFrames > 0) {
+                // Untimed frames of the same configuration right before the
+                // measured ones: while the metrics run on the CPU the GPU
+                // idles and drops its clocks, and 16 frames are too few to
+                // raise them again (H200, 1080p: the same configuration read
+                // 0.8 or 3.4 ms of reflections from one run to the next).
+                app::ReflectionRunOptions warmup = options;
+                warmup.frames = warmupFrames;
+                warmup.readResolved = false;
+                warmup.timeEveryFrame = false;
+                app::runReflections(ctx, scene, warmup);
+            }
+            const app::ReflectionRunResult result = app::runReflections(ctx, scene, options);
+            const metrics::Image image = metrics::imageFromSrgb8(width, height, result.rgba, 4, what);
+            const ReflectionTerm term = reflectionTerm(result.resolved, width, height, exposure, what);
+
+            bench::Row row;
+            row.scene = stem;
+            row.mode = modeName;
+            row.param = c.param;
+            if (!baseline) row.value = app::getParameter(options, c.param);
+            row.width = width;
+            row.height = height;
+            row.reflectionMs = result.reflectionMs;
+            row.totalMs = result.totalMs;
+            row.frameWallMs = result.frameWallMs;
+            row.sslrRays = result.sslrRays;
+            row.rtRays = result.rtRays;
+            row.image = measure(referenceImage, image, ppd);
+            row.reflection =
+                measure(referenceTerm.display, term.display, ppd, &referenceTerm.radiance, &term.radiance);
+            rows.push_back(row);
+            if (baseline) {
+                app::writePng((outDir / (stem + "_" + modeName + ".png")).string(), width, height, result.rgba);
+                app::writePng((outDir / (stem + "_" + modeName + "_reflections.png")).string(), width, height,
+                              toSrgb8(term.display));
+                const metrics::FlipResult f = metrics::flip(referenceImage, image, ppd);
+                metrics::writeErrorMap(outDir / (stem + "_" + modeName + "_flip.png"), f.errorMap, width, height);
+            }
+            spdlog::info("[{}/{}] {}: reflections {:.3f} ms GPU, frame {:.2f} ms wall, {} RT rays, FLIP {:.4f} "
+                         "(reflections {:.4f}) ({:.0f} s)",
+                         k + 1, configurations.size(), what, result.reflectionMs.value_or(0.0),
+                         result.frameWallMs.value_or(0.0), result.rtRays, row.image.flipMean,
+                         row.reflection.flipMean, elapsed());
+        }
+
+        // 3. The report.
+        std::fputs(bench::toTable(rows).c_str(), stdout);
+        std::fflush(stdout);
+
+        bench::RunInfo info;
+        info.device = ctx.caps().deviceName;
+        info.deviceType = gpu::deviceTypeName(ctx.caps().deviceType);
+        info.driver = ctx.caps().driverName + " " + ctx.caps().driverInfo;
+        info.date = utcNow();
+        info.commit = gitCommit();
+        info.scene = stem;
+        info.width = width;
+        info.height = height;
+        info.frames = frames;
+        info.startSeconds = base.startSeconds;
+        info.jitter = base.jitter;
+        info.warmupFrames = warmupFrames;
+        info.ppd = ppd;
+        info.relMseEpsilon = metrics::kRelMseEpsilon;
+        // GPU timestamps on lavapipe miss compute dispatches (README
+        // "Results"): there the frame's host time is its cost.
+        info.timeAxis = cpuDevice ? "frame_wall_ms" : "reflection_ms";
+        info.referenceFrames = reference.framesRun;
+        info.referenceConverged = reference.converged;
+        info.referenceLastChange = reference.lastChange;
+        info.referenceTolerance = referenceOptions.reference.tolerance;
+
+        bench::writeText(csvPath, bench::toCsv(rows));
+        spdlog::info("wrote {}", csvPath.string());
+        bench::writeText(jsonPath, bench::toJson(info, rows));
+        spdlog::info("wrote {}", jsonPath.string());
+        bench::PlotOptions plot;
+        plot.title = stem + " " + std::to_string(width) + "x" + std::to_string(height) + ", " + std::to_string(frames) +
+                     " frames, " + info.device + ", " + info.date.substr(0, 10);
+        plot.xLabel = cpuDevice ? "frame_wall_ms (host time per frame, median)"
+                                : "reflection_ms (GPU time of the reflection passes, median)";
+        plot.yLabel = "FLIP mean against the reference (final image)";
+        bench::writePlot(plotPath, bench::plotPoints(rows, cpuDevice), plot);
+        spdlog::info("wrote {} ({:.0f} s in all)", plotPath.string(), elapsed());
+
+        ctx.waitIdle();
+        return app::validationClean(ctx) ? 0 : 2;
+    });
+}

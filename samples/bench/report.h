@@ -1,0 +1,142 @@
+#pragma once
+// glint-bench's report (issue 6): the rows it measures, the table, CSV and
+// JSON it writes, the Pareto front of time against error, and the plot.
+// Pure CPU code with no Vulkan, so the tests check the schema and the plot
+// without a device.
+
+#include <cstdint>
+#include <filesystem>
+#include <optional>
+#include <span>
+#include <string>
+#include <string_view>
+#include <vector>
+
+namespace glint::bench {
+
+// The CSV header issue 6 specifies, column for column. The metric columns
+// are the final image's; the reflection term's go to the JSON only.
+inline constexpr std::string_view kCsvHeader =
+    "scene,mode,param,value,width,height,reflection_ms,total_ms,rt_rays,flip_mean,relmse,psnr,ssim";
+
+// The baseline row of each mode has this as its param (and no value).
+inline constexpr std::string_view kDefaultParam = "default";
+
+// One image against the reference (engine/metrics).
+struct ErrorMetrics {
+    double flipMean = 0.0;  // LDR-FLIP mean at the run's pixels per degree
+    double relMse = 0.0;    // epsilon metrics::kRelMseEpsilon
+    double psnr = 0.0;      // dB; +inf for identical images
+    double ssim = 0.0;
+};
+
+// One configuration: a mode with defaults, or one parameter changed.
+struct Row {
+    std::string scene;
+    std::string mode;                  // hybrid, ssr, rt
+    std::string param{kDefaultParam};  // a parameter name (app::parameters()) or "default"
+    std::optional<double> value;       // the parameter's value; none on default rows
+    uint32_t width = 0;
+    uint32_t height = 0;
+    std::optional<double> reflectionMs;  // median GPU time of the reflection passes
+    std::optional<double> totalMs;       // median GPU time of all passes
+    std::optional<double> frameWallMs;   // median host time of a frame (a CPU device's real cost)
+    uint64_t sslrRays = 0;               // last frame
+    uint64_t rtRays = 0;                 // last frame
+    ErrorMetrics image;       // the final image against the reference's
+    ErrorMetrics reflection;  // the resolved reflection term against the reference's
+};
+
+// What the JSON says about the run as a whole.
+struct RunInfo {
+    std::string device;
+    std::string deviceType;  // "cpu", "discrete-gpu", ...
+    std::string driver;
+    std::string date;    // ISO 8601, UTC
+    std::string commit;  // "unknown" when neither git nor the build knew it
+    std::string scene;
+    uint32_t width = 0;
+    uint32_t height = 0;
+    uint32_t frames = 0;
+    double startSeconds = 0.0;
+    bool jitter = false;  // sub-pixel jitter in the measured runs (the reference has none)
+    uint32_t warmupFrames = 0;  // untimed frames before each measured run
+    double ppd = 0.0;
+    double relMseEpsilon = 0.0;
+    std::string timeAxis;       // "reflection_ms" or "frame_wall_ms": what the plot's x is
+    uint32_t referenceFrames = 0;
+    bool referenceConverged = false;
+    double referenceLastChange = 0.0;
+    double referenceTolerance = 0.0;
+};
+
+// ---- Text outputs ----------------------------------------------------------
+
+// The value column: shortest text that reads back as the same float
+// setParameter stores ("0.9", "64"); empty on default rows.
+std::string formatValue(const std::optional<double>& value);
+
+// kCsvHeader, then one line per row. Missing times are empty cells; PSNR of
+// identical images is "inf" (std::stod reads both back).
+std::string toCsv(std::span<const Row> rows);
+
+// {info..., "rows": [every CSV column + frame_wall_ms, sslr_rays and
+// "reflection": {flip_mean, relmse, psnr, ssim}]}; missing or infinite
+// numbers are null (JSON has no infinity).
+std::string toJson(const RunInfo& info, std::span<const Row> rows);
+
+// A fixed-width table for stdout: every row, times and both error sets.
+std::string toTable(std::span<const Row> rows);
+
+// ---- Pareto front ----------------------------------------------------------
+
+struct Point {
+    double x = 0.0;  // cost (time)
+    double y = 0.0;  // error
+};
+
+// Indices of the non-dominated points when both coordinates are minimised
+// (no other point is at most as large in both and smaller in one), in
+// increasing x. Points with a non-finite coordinate take no part; of equal
+// points only the first is kept.
+std::vector<size_t> paretoFront(std::span<const Point> points);
+
+// ---- Plot ------------------------------------------------------------------
+
+struct PlotPoint {
+    Point at;
+    std::string series;  // the legend entry (a mode)
+    std::string label;   // shown beside points on the front ("sslr_steps=32")
+    bool baseline = false;  // drawn larger: a mode's default settings
+};
+
+struct PlotOptions {
+    uint32_t width = 960;
+    uint32_t height = 640;
+    std::string title;
+    std::string xLabel;
+    std::string yLabel;
+};
+
+// Rows as plot points: x is frame_wall_ms when `wallTime`, else
+// reflection_ms; y is the final image's FLIP mean. Rows without that time
+// are left out.
+std::vector<PlotPoint> plotPoints(std::span<const Row> rows, bool wallTime);
+
+// Time against error: points coloured by series, the Pareto front as a line
+// through the non-dominated points, axes with tick labels and a legend
+// (stb_easy_font). RGBA8, options.width x options.height, top row first.
+std::vector<uint8_t> renderPlot(std::span<const PlotPoint> points, const PlotOptions& options);
+
+// renderPlot written as a PNG; creates the folder, throws
+// std::runtime_error naming the file on failure.
+void writePlot(const std::filesystem::path& path, std::span<const PlotPoint> points, const PlotOptions& options);
+
+// Tick positions for an axis over [lo, hi]: multiples of 1, 2 or 5 x 10^k,
+// about `target` of them, all inside [lo, hi].
+std::vector<double> niceTicks(double lo, double hi, int target = 5);
+
+// Writes `text` to `path`, creating the folder; throws naming the file.
+void writeText(const std::filesystem::path& path, std::string_view text);
+
+} // namespace glint::bench

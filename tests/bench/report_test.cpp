@@ -1,0 +1,196 @@
+// glint-bench's report (samples/bench/report.h): the CSV schema issue 6
+// specifies, the Pareto front, and the plot, all without a GPU.
+
+#include "bench/report.h"
+
+#include <doctest/doctest.h>
+#include <stb_image.h>
+
+#include <cmath>
+#include <limits>
+#include <sstream>
+#include <string>
+#include <vector>
+
+using namespace glint::bench;
+
+namespace {
+
+std::vector<std::string> split(const std::string& line, char separator) {
+    std::vector<std::string> cells;
+    std::string cell;
+    std::istringstream in(line);
+    while (std::getline(in, cell, separator)) cells.push_back(cell);
+    if (!line.empty() && line.back() == separator) cells.push_back("");
+    return cells;
+}
+
+std::vector<std::string> lines(const std::string& text) {
+    std::vector<std::string> out;
+    std::string line;
+    std::istringstream in(text);
+    while (std::getline(in, line)) out.push_back(line);
+    return out;
+}
+
+Row makeRow(const std::string& mode, const std::string& param, std::optional<double> value, double ms, double flip) {
+    Row r;
+    r.scene = "plaza";
+    r.mode = mode;
+    r.param = param;
+    r.value = value;
+    r.width = 64;
+    r.height = 48;
+    r.reflectionMs = ms;
+    r.totalMs = ms * 3.0;
+    r.frameWallMs = ms * 10.0;
+    r.rtRays = 1234;
+    r.image = {flip, 0.5, 30.0, 0.9};
+    r.reflection = {flip * 2.0, 1.5, 20.0, 0.8};
+    return r;
+}
+
+} // namespace
+
+TEST_CASE("the CSV has issue 6's header and one parseable row per configuration") {
+    const std::vector<Row> rows = {makeRow("hybrid", "default", std::nullopt, 1.0, 0.05),
+                                   makeRow("ssr", "default", std::nullopt, 0.5, 0.09),
+                                   makeRow("hybrid", "sslr_threshold", 0.7f, 0.8, 0.06),
+                                   makeRow("hybrid", "sslr_steps", 32.0, 0.9, 0.055)};
+    const std::vector<std::string> out = lines(toCsv(rows));
+    REQUIRE(out.size() == rows.size() + 1);
+    CHECK(out[0] == "scene,mode,param,value,width,height,reflection_ms,total_ms,rt_rays,flip_mean,relmse,psnr,ssim");
+    for (size_t i = 0; i < rows.size(); ++i) {
+        const std::vector<std::string> cells = split(out[i + 1], ',');
+        REQUIRE(cells.size() == 13);
+        CHECK(cells[0] == "plaza");
+        CHECK(cells[1] == rows[i].mode);
+        CHECK(cells[2] == rows[i].param);
+        // Every numeric column reads back whole; the value is empty only on default rows.
+        for (size_t c = 4; c < cells.size(); ++c) {
+            size_t used = 0;
+            const double v = std::stod(cells[c], &used);
+            CHECK_MESSAGE(used == cells[c].size(), "column ", c, ": ", cells[c]);
+            CHECK(std::isfinite(v));
+        }
+        if (rows[i].param == "default") {
+            CHECK(cells[3].empty());
+        } else {
+            CHECK(std::stod(cells[3]) == doctest::Approx(*rows[i].value));
+        }
+    }
+    // A parameter stored as a float prints as typed, not as its double expansion.
+    CHECK(split(out[3], ',')[3] == "0.7");
+    CHECK(split(out[4], ',')[3] == "32");
+    CHECK(std::stod(split(out[1], ',')[9]) == doctest::Approx(0.05));
+}
+
+TEST_CASE("parameter values print as typed: whole numbers without exponents, floats without float noise") {
+    CHECK(formatValue(std::nullopt).empty());
+    CHECK(formatValue(10.0) == "10");
+    CHECK(formatValue(200.0) == "200");
+    CHECK(formatValue(0.0) == "0");
+    CHECK(formatValue(double(0.95f)) == "0.95");
+    CHECK(formatValue(double(0.22f)) == "0.22");
+}
+
+TEST_CASE("the CSV writes a missing time as an empty cell and identical images' PSNR as inf") {
+    Row r = makeRow("rt", "default", std::nullopt, 1.0, 0.0);
+    r.reflectionMs.reset();
+    r.image.psnr = std::numeric_limits<double>::infinity();
+    const std::vector<std::string> cells = split(lines(toCsv(std::vector<Row>{r}))[1], ',');
+    REQUIRE(cells.size() == 13);
+    CHECK(cells[6].empty());
+    CHECK(cells[11] == "inf");
+    CHECK(std::isinf(std::stod(cells[11])));
+}
+
+TEST_CASE("the JSON holds the CSV's rows plus the reflection term and the run's provenance") {
+    RunInfo info;
+    info.device = "llvmpipe";
+    info.commit = "abc";
+    info.date = "2026-11-22T00:00:00Z";
+    Row r = makeRow("hybrid", "default", std::nullopt, 1.0, 0.05);
+    r.image.psnr = std::numeric_limits<double>::infinity();
+    const std::string json = toJson(info, std::vector<Row>{r});
+    for (const char* key : {"\"device\"", "\"driver\"", "\"date\"", "\"commit\"", "\"rows\"", "\"frame_wall_ms\"",
+                            "\"reflection\"", "\"flip_mean\"", "\"rt_rays\"", "\"reflection_ms\""}) {
+        CHECK_MESSAGE(json.find(key) != std::string::npos, key);
+    }
+    CHECK(json.find("\"psnr\": null") != std::string::npos);  // JSON has no infinity
+}
+
+TEST_CASE("the Pareto front keeps exactly the non-dominated points, cheapest first") {
+    // (time, error): 0 and 2 and 4 trade off; 1 is beaten by 0 (slower and
+    // worse), 3 by 2; 5 ties 2 in time but is worse; 6 has no time.
+    const std::vector<Point> points = {{1.0, 0.30}, {1.5, 0.35}, {2.0, 0.10}, {3.0, 0.20},
+                                       {4.0, 0.05}, {2.0, 0.15}, {std::nan(""), 0.01}};
+    CHECK(paretoFront(points) == std::vector<size_t>{0, 2, 4});
+}
+
+TEST_CASE("the Pareto front of a single point, of equal points and of none") {
+    CHECK(paretoFront(std::vector<Point>{{1.0, 1.0}}) == std::vector<size_t>{0});
+    CHECK(paretoFront(std::vector<Point>{{1.0, 1.0}, {1.0, 1.0}}) == std::vector<size_t>{0});
+    CHECK(paretoFront(std::vector<Point>{}).empty());
+    // Cheaper and better dominates everything: a front of one.
+    CHECK(paretoFront(std::vector<Point>{{2.0, 0.5}, {0.5, 0.1}, {1.0, 0.2}}) == std::vector<size_t>{1});
+}
+
+TEST_CASE("axis ticks are round numbers inside the range") {
+    const std::vector<double> t = niceTicks(0.0, 1.0, 5);
+    REQUIRE(t.size() == 6);
+    CHECK(t.front() == 0.0);
+    CHECK(t[1] == doctest::Approx(0.2));
+    CHECK(t.back() == doctest::Approx(1.0));
+    for (const double v : niceTicks(0.013, 0.087, 4)) {
+        CHECK(v >= 0.013);
+        CHECK(v <= 0.087);
+    }
+}
+
+TEST_CASE("the plot is written at the requested size with something drawn on it") {
+    const std::vector<Row> rows = {makeRow("hybrid", "default", std::nullopt, 1.0, 0.05),
+                                   makeRow("ssr", "default", std::nullopt, 0.5, 0.09),
+                                   makeRow("rt", "default", std::nullopt, 1.2, 0.04),
+                                   makeRow("hybrid", "sslr_steps", 32.0, 0.9, 0.055)};
+    const std::vector<PlotPoint> points = plotPoints(rows, false);
+    REQUIRE(points.size() == 4);
+    CHECK(points[0].at.x == 1.0);
+    CHECK(points[3].label == "sslr_steps=32");
+    CHECK(plotPoints(rows, true)[0].at.x == 10.0);
+
+    for (const auto& [w, h] : {std::pair<uint32_t, uint32_t>{800, 500}, {123, 77}}) {
+        PlotOptions options;
+        options.width = w;
+        options.height = h;
+        options.title = "plaza 64x48";
+        options.xLabel = "reflection_ms";
+        options.yLabel = "FLIP mean";
+        // Relative: ctest runs the suite in its build folder.
+        const std::string path = "test-out/bench/plot_" + std::to_string(w) + ".png";
+        writePlot(path, points, options);
+        int rw = 0, rh = 0, channels = 0;
+        unsigned char* data = stbi_load(path.c_str(), &rw, &rh, &channels, 4);
+        REQUIRE(data != nullptr);
+        CHECK(rw == int(w));
+        CHECK(rh == int(h));
+        // Points in their mode's colour (hybrid purple) and dark text both made it.
+        bool purple = false, dark = false;
+        for (int i = 0; i < rw * rh; ++i) {
+            const unsigned char* p = data + i * 4;
+            purple |= p[0] == 150 && p[1] == 50 && p[2] == 200;
+            dark |= p[0] == 0 && p[1] == 0 && p[2] == 0;
+        }
+        stbi_image_free(data);
+        CHECK(purple);
+        CHECK(dark);
+    }
+}
+
+TEST_CASE("an empty plot still has axes") {
+    PlotOptions options;
+    options.width = 64;
+    options.height = 32;
+    const std::vector<uint8_t> rgba = renderPlot({}, options);
+    CHECK(rgba.size() == 64u * 32u * 4u);
+}

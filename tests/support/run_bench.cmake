@@ -1,0 +1,47 @@
+# Runs glint-bench (BENCH) as a quick smoke test: --quick on the plaza, tiny
+# and short, validation on, writing CSV, JSON and plot under OUT. Checks the
+# exit code, that the three files exist, the CSV header issue 6 specifies,
+# a row per configuration (three mode defaults and the quick sweeps), and
+# the JSON's provenance keys.
+cmake_policy(SET CMP0054 NEW)
+file(REMOVE ${OUT}/bench.csv ${OUT}/bench.json ${OUT}/bench.png)
+execute_process(COMMAND ${BENCH} --validate --scene plaza --quick --size 64x48 --frames 3
+                        --reference-max-frames 64 --out-dir ${OUT}
+                        --csv ${OUT}/bench.csv --json ${OUT}/bench.json --plot ${OUT}/bench.png
+                RESULT_VARIABLE rc)
+if(NOT rc EQUAL 0)
+  message(FATAL_ERROR "glint-bench exited with ${rc}")
+endif()
+foreach(f bench.csv bench.json bench.png)
+  if(NOT EXISTS ${OUT}/${f})
+    message(FATAL_ERROR "glint-bench did not write ${OUT}/${f}")
+  endif()
+endforeach()
+file(STRINGS ${OUT}/bench.csv lines)
+list(GET lines 0 header)
+set(expected "scene,mode,param,value,width,height,reflection_ms,total_ms,rt_rays,flip_mean,relmse,psnr,ssim")
+if(NOT header STREQUAL expected)
+  message(FATAL_ERROR "${OUT}/bench.csv: header '${header}', expected '${expected}'")
+endif()
+list(LENGTH lines count)
+math(EXPR rows "${count} - 1")
+if(rows LESS 8)
+  message(FATAL_ERROR "${OUT}/bench.csv: ${rows} rows, expected 3 mode defaults and 5 quick sweeps")
+endif()
+foreach(mode hybrid ssr rt)
+  if(NOT "${lines}" MATCHES "plaza,${mode},default,,64,48,")
+    message(FATAL_ERROR "${OUT}/bench.csv: no default row for ${mode}")
+  endif()
+endforeach()
+file(READ ${OUT}/bench.json json)
+foreach(key device driver date commit rows)
+  string(JSON value ERROR_VARIABLE err GET "${json}" ${key})
+  if(err)
+    message(FATAL_ERROR "${OUT}/bench.json: no '${key}': ${err}")
+  endif()
+endforeach()
+string(JSON jrows LENGTH "${json}" rows)
+if(NOT jrows EQUAL rows)
+  message(FATAL_ERROR "${OUT}/bench.json: ${jrows} rows, the CSV has ${rows}")
+endif()
+message(STATUS "glint-bench: ${rows} configurations")
