@@ -8,6 +8,7 @@
 
 #include "glint/bvh_shared.h"
 #include "glint/packing.h"
+#include "glint/particles_shared.h"
 
 #include <algorithm>
 #include <bit>
@@ -33,6 +34,7 @@ uint64_t grownCapacity(uint64_t needed, uint64_t minimum) {
 constexpr uint64_t kMinScratchBytes = 64 * 1024;
 constexpr uint32_t kMinTlasInstances = 64;
 constexpr uint32_t kMinOffsetEntries = 256;
+constexpr uint32_t kMinParticles = 64;
 
 VkPipelineStageFlags2 traceStages(const gpu::Capabilities& caps) {
     VkPipelineStageFlags2 stages = VK_PIPELINE_STAGE_2_COMPUTE_SHADER_BIT;
@@ -102,6 +104,14 @@ struct BvhManager::FrameWork {
     std::optional<gpu::AccelBuild> tlasBuild;
     std::shared_ptr<gpu::Buffer> poolCopySource;  // the outgrown pool, copied into the new one first
     VkDeviceSize poolCopyBytes = 0;
+    // Particles: empty without (then nothing below is recorded).
+    std::vector<shader::ParticleData> particles;
+    shader::ParticleBillboardParams billboard{};
+    std::optional<gpu::AccelBuild> particleBlasBuild;
+    std::optional<gpu::AccelBuild> particleTlasBuild;
+    VkAccelerationStructureInstanceKHR particleInstance{};
+    VkDeviceSize particleBlasScratchOffset = 0;  // beside the BLAS builds
+    VkDeviceSize particleTlasScratchOffset = 0;  // beside the TLAS build
 };
 
 template <class T> void BvhManager::retire(T&& object) {
@@ -131,6 +141,13 @@ BvhManager::BvhManager(gpu::Context& ctx, const scene::Scene& scene, uint32_t fr
                {5, VK_DESCRIPTOR_TYPE_STORAGE_BUFFER, cs}},
               sizeof(shader::BvhPackParams),
               "bvh.pack_primitives"});
+    particleQuadsPipeline_ = gpu::createComputePipeline(
+        ctx, {"bvh/particle_quads.comp",
+              {{0, VK_DESCRIPTOR_TYPE_STORAGE_BUFFER, cs}, {1, VK_DESCRIPTOR_TYPE_STORAGE_BUFFER, cs}},
+              sizeof(shader::ParticleBillboardParams),
+              "bvh.particle_quads"});
+    particleStaging_.resize(framesInFlight_);
+    particleInstances_.resize(framesInFlight_);
     offsetStaging_.resize(framesInFlight_);
     instanceBuffers_.resize(framesInFlight_);
     jointPalettes_.resize(framesInFlight_);
@@ -151,6 +168,10 @@ void BvhManager::bind(rg::FrameResources& resources, const BvhUpdateOutputs& out
     resources.bind(outputs.tlas, *tlas_);
     resources.bind(outputs.primitivePool, pool_);
     resources.bind(outputs.primitiveOffsets, offsets_);
+    if (outputs.particleTlas.valid()) {
+        resources.bind(outputs.particleTlas, *particleTlas_);
+        resources.bind(outputs.particles, particleData_);
+    }
 }
 
 // ---------------------------------------------------------------------------
@@ -304,7 +325,95 @@ void BvhManager::ensureJointPalette(size_t matrices) {
 // The frame: CPU decisions, then recording
 // ---------------------------------------------------------------------------
 
-std::shared_ptr<BvhManager::FrameWork> BvhManager::prepare(const scene::BvhPlan& plan) {
+void BvhManager::prepareParticles(const scene::BvhPlan& plan, const scene::Camera& camera, FrameWork& work) {
+    const uint32_t count = uint32_t(std::min(plan.particleCount, uint32_t(scene_.particles.size())));
+    if (count == 0) return;
+    if (count > particleCapacity_) {
+        particleCapacity_ = uint32_t(grownCapacity(count, kMinParticles));
+        const VkDeviceSize dataBytes = VkDeviceSize(particleCapacity_) * sizeof(shader::ParticleData);
+        const auto replace = [&](gpu::Buffer& buffer, const gpu::BufferDesc& desc) {
+            if (buffer) retire(std::move(buffer));
+            buffer = gpu::Buffer(ctx_, desc);
+        };
+        replace(particleData_, {dataBytes, VK_BUFFER_USAGE_STORAGE_BUFFER_BIT | VK_BUFFER_USAGE_TRANSFER_DST_BIT,
+                                gpu::MemoryUsage::DeviceLocal, "bvh.particles", true});
+        for (gpu::Buffer& staging : particleStaging_) {
+            replace(staging, {dataBytes, VK_BUFFER_USAGE_TRANSFER_SRC_BIT, gpu::MemoryUsage::Upload,
+                              "bvh.particles.staging", true});
+        }
+        replace(particleQuads_, {VkDeviceSize(particleCapacity_) * shader::kParticleQuadVertices * sizeof(glm::vec3),
+                                 VK_BUFFER_USAGE_STORAGE_BUFFER_BIT | kBuildInput, gpu::MemoryUsage::DeviceLocal,
+                                 "bvh.particle_quads", true});
+        for (gpu::Buffer& instances : particleInstances_) {
+            if (!instances) {
+                instances = gpu::Buffer(ctx_, {sizeof(VkAccelerationStructureInstanceKHR), kBuildInput,
+                                               gpu::MemoryUsage::Upload, "bvh.particle_tlas_instance", true});
+            }
+        }
+        // Sized for the capacity: a build of fewer quads fits (Vulkan only
+        // asks the structure to be as large as the size query for at least
+        // as many primitives).
+        gpu::TriangleGeometry sizing;
+        sizing.vertices = particleQuads_.address();
+        sizing.vertexCount = particleCapacity_ * shader::kParticleQuadVertices;
+        sizing.triangleCount = particleCapacity_ * 2;
+        sizing.opaque = false;
+        const gpu::AccelBuild blasSizing = gpu::AccelBuild::bottomLevel(ctx_, {&sizing, 1}, options_.particleFlags);
+        if (particleBlas_) retire(std::move(particleBlas_));
+        particleBlas_ = std::make_unique<gpu::AccelerationStructure>(
+            ctx_, VK_ACCELERATION_STRUCTURE_TYPE_BOTTOM_LEVEL_KHR, blasSizing.structureSize(), "bvh.particle_blas", true);
+        if (!particleTlas_) {
+            const gpu::AccelBuild tlasSizing =
+                gpu::AccelBuild::topLevel(ctx_, particleInstances_[0].address(), 1, options_.particleFlags);
+            particleTlas_ = std::make_unique<gpu::AccelerationStructure>(
+                ctx_, VK_ACCELERATION_STRUCTURE_TYPE_TOP_LEVEL_KHR, tlasSizing.structureSize(), "bvh.particle_tlas",
+                true);
+        }
+        stats_.particleBytes = particleData_.size() + particleQuads_.size() + particleBlas_->buffer().size() +
+                               particleTlas_->buffer().size();
+    }
+
+    work.particles.resize(count);
+    for (uint32_t i = 0; i < count; ++i) {
+        const scene::Particle& p = scene_.particles[i];
+        work.particles[i] = {p.position, p.radius, p.color};
+    }
+    // The camera's right and up in world space: the view matrix's first
+    // two rows (its rotation is orthonormal). The forward pass
+    // (passes/particles.cpp) faces its billboards the same way.
+    const glm::mat4& view = camera.view;
+    work.billboard.right = glm::normalize(glm::vec3(view[0][0], view[1][0], view[2][0]));
+    work.billboard.up = glm::normalize(glm::vec3(view[0][1], view[1][1], view[2][1]));
+    work.billboard.count = count;
+
+    gpu::TriangleGeometry quads;
+    quads.vertices = particleQuads_.address();
+    quads.vertexCount = count * shader::kParticleQuadVertices;
+    quads.triangleCount = count * 2;
+    // Not opaque: the traces look at every quad a ray crosses (any-hit or
+    // the ray query's candidates) and keep the nearest covering ones.
+    quads.opaque = false;
+    work.particleBlasBuild = gpu::AccelBuild::bottomLevel(ctx_, {&quads, 1}, options_.particleFlags);
+    const float identity[12] = {1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1, 0};
+    work.particleInstance =
+        gpu::makeInstance(*particleBlas_, identity, 0, uint8_t(shader::kInstanceMaskAll), shader::kSbtOffsetParticles);
+    work.particleTlasBuild =
+        gpu::AccelBuild::topLevel(ctx_, particleInstances_[work.slot].address(), 1, options_.particleFlags);
+    stats_.particleTlasBuilds = 1;
+    stats_.particles = count;
+    stats_.particleDispatches = 1;
+}
+
+void BvhManager::recordParticleQuads(const FrameWork& work, VkCommandBuffer cmd, const gpu::Buffer& particles) {
+    gpu::ScopedLabel label(ctx_, cmd, "bvh.particle_quads");
+    particleQuadsPipeline_.bind(cmd);
+    gpu::PushDescriptors(particleQuadsPipeline_).storageBuffer(0, particles).storageBuffer(1, particleQuads_).push(ctx_, cmd);
+    particleQuadsPipeline_.pushConstants(cmd, work.billboard);
+    vkCmdDispatch(cmd, (work.billboard.count + shader::kParticleBillboardGroupSize - 1) / shader::kParticleBillboardGroupSize,
+                  1, 1);
+}
+
+std::shared_ptr<BvhManager::FrameWork> BvhManager::prepare(const scene::BvhPlan& plan, const scene::Camera* camera) {
     ++frame_;
     collectRetired();
     auto work = std::make_shared<FrameWork>();
@@ -312,6 +421,7 @@ std::shared_ptr<BvhManager::FrameWork> BvhManager::prepare(const scene::BvhPlan&
     stats_.frame = frame_;
     stats_.blasBuilds = stats_.blasRebuilds = stats_.blasReleased = 0;
     stats_.packedTriangles = stats_.packDispatches = 0;
+    stats_.particleTlasBuilds = stats_.particles = stats_.particleDispatches = 0;
 
     for (const scene::BlasDrop& drop : plan.drops) {
         const auto it = blases_.find(drop.blas);
@@ -417,9 +527,22 @@ std::shared_ptr<BvhManager::FrameWork> BvhManager::prepare(const scene::BvhPlan&
     work->tlasBuild = gpu::AccelBuild::topLevel(ctx_, instanceBuffers_[work->slot].address(),
                                                 uint32_t(work->instances.size()), options_.tlasFlags);
 
-    // The TLAS build follows a barrier after the BLAS builds, so it reuses
+    // The particle BLAS builds beside the others, the particle TLAS beside
+    // the TLAS: their scratch follows.
+    VkDeviceSize tlasScratch = work->tlasBuild->scratchSize();
+    if (plan.particleTlas && camera) {
+        prepareParticles(plan, *camera, *work);
+    }
+    if (work->particleBlasBuild) {
+        work->particleBlasScratchOffset = blasScratch;
+        blasScratch += work->particleBlasBuild->scratchSize();
+        work->particleTlasScratchOffset = tlasScratch;
+        tlasScratch += work->particleTlasBuild->scratchSize();
+    }
+
+    // The TLAS builds follow a barrier after the BLAS builds, so they reuse
     // the scratch from offset 0.
-    const VkDeviceSize scratch = std::max(blasScratch, work->tlasBuild->scratchSize());
+    const VkDeviceSize scratch = std::max(blasScratch, tlasScratch);
     stats_.scratchBytes = scratch;
     scratchCapacity_ = std::max(scratchCapacity_, grownCapacity(scratch, kMinScratchBytes));
     return work;
@@ -448,6 +571,12 @@ void BvhManager::record(FrameWork& work, rg::PassContext& pc, const BvhUpdateOut
     if (!work.offsets.empty()) {
         std::memcpy(offsetStaging_[slot].mapped(), work.offsets.data(), work.offsets.size() * sizeof(uint32_t));
     }
+    const bool particles = !work.particles.empty();
+    if (particles) {
+        std::memcpy(particleStaging_[slot].mapped(), work.particles.data(),
+                    work.particles.size() * sizeof(shader::ParticleData));
+        std::memcpy(particleInstances_[slot].mapped(), &work.particleInstance, sizeof(work.particleInstance));
+    }
 
     // Resources the graph does not see (BLASes, their positions, an outgrown
     // pool) were last touched by this pass in an earlier frame on this same
@@ -463,8 +592,8 @@ void BvhManager::record(FrameWork& work, rg::PassContext& pc, const BvhUpdateOut
                            VK_ACCESS_2_SHADER_STORAGE_READ_BIT | VK_ACCESS_2_SHADER_STORAGE_WRITE_BIT |
                            VK_ACCESS_2_SHADER_READ_BIT | VK_ACCESS_2_TRANSFER_READ_BIT | VK_ACCESS_2_TRANSFER_WRITE_BIT);
 
-    // Copies: the outgrown pool into the new one, the offset table.
-    if (work.poolCopySource || !work.offsets.empty()) {
+    // Copies: the outgrown pool into the new one, the offset table, the particles.
+    if (work.poolCopySource || !work.offsets.empty() || particles) {
         gpu::ScopedLabel label(ctx_, cmd, "bvh.copies");
         if (work.poolCopySource) {
             const VkBufferCopy region{0, 0, work.poolCopyBytes};
@@ -474,12 +603,20 @@ void BvhManager::record(FrameWork& work, rg::PassContext& pc, const BvhUpdateOut
             const VkBufferCopy region{0, 0, work.offsets.size() * sizeof(uint32_t)};
             vkCmdCopyBuffer(cmd, offsetStaging_[slot].handle(), offsets.handle(), 1, &region);
         }
-        // The pack dispatches overwrite parts of the copied pool.
+        if (particles) {
+            const VkBufferCopy region{0, 0, work.particles.size() * sizeof(shader::ParticleData)};
+            vkCmdCopyBuffer(cmd, particleStaging_[slot].handle(), pc.buffer(handles.particles).handle(), 1, &region);
+        }
+        // The pack dispatches overwrite parts of the copied pool; the
+        // particle quads read the particles.
         gpu::memoryBarrier(cmd, VK_PIPELINE_STAGE_2_COPY_BIT, VK_ACCESS_2_TRANSFER_WRITE_BIT,
                            VK_PIPELINE_STAGE_2_COMPUTE_SHADER_BIT,
                            VK_ACCESS_2_SHADER_STORAGE_READ_BIT | VK_ACCESS_2_SHADER_STORAGE_WRITE_BIT);
     }
 
+    if (particles) {
+        recordParticleQuads(work, cmd, pc.buffer(handles.particles));
+    }
     if (!work.packs.empty()) {
         gpu::ScopedLabel label(ctx_, cmd, "bvh.pack_primitives");
         packPipeline_.bind(cmd);
@@ -497,15 +634,22 @@ void BvhManager::record(FrameWork& work, rg::PassContext& pc, const BvhUpdateOut
             vkCmdDispatch(cmd, (pack.params.triangleCount + shader::kBvhPackGroupSize - 1) / shader::kBvhPackGroupSize,
                           1, 1);
         }
-        // Unwrapped positions -> BLAS build input.
+    }
+    if (!work.packs.empty() || particles) {
+        // Unwrapped positions and particle quads -> BLAS build input.
         gpu::memoryBarrier(cmd, VK_PIPELINE_STAGE_2_COMPUTE_SHADER_BIT, VK_ACCESS_2_SHADER_STORAGE_WRITE_BIT,
                            VK_PIPELINE_STAGE_2_ACCELERATION_STRUCTURE_BUILD_BIT_KHR, VK_ACCESS_2_SHADER_READ_BIT);
     }
 
-    if (!work.builds.empty()) {
+    if (!work.builds.empty() || particles) {
         gpu::ScopedLabel label(ctx_, cmd, "bvh.blas_builds");
         for (const FrameWork::Build& build : work.builds) {
             build.blas->build->record(ctx_, cmd, build.blas->structure.handle(), scratch.address() + build.scratchOffset);
+        }
+        if (particles) {
+            // Rebuilt every frame: the quads turned with the camera.
+            work.particleBlasBuild->record(ctx_, cmd, particleBlas_->handle(),
+                                           scratch.address() + work.particleBlasScratchOffset);
         }
         // BLAS writes -> TLAS build reads; the TLAS build also reuses the scratch.
         gpu::memoryBarrier(cmd, VK_PIPELINE_STAGE_2_ACCELERATION_STRUCTURE_BUILD_BIT_KHR,
@@ -517,10 +661,24 @@ void BvhManager::record(FrameWork& work, rg::PassContext& pc, const BvhUpdateOut
 
     gpu::ScopedLabel label(ctx_, cmd, "bvh.tlas_build");
     work.tlasBuild->record(ctx_, cmd, tlas.handle(), scratch.address());
+    if (particles) {
+        work.particleTlasBuild->record(ctx_, cmd, pc.accel(handles.particleTlas).handle(),
+                                       scratch.address() + work.particleTlasScratchOffset);
+    }
 }
 
 BvhUpdateOutputs addBvhUpdatePass(rg::Graph& graph, BvhManager& manager, const scene::BvhPlan& plan) {
-    std::shared_ptr<BvhManager::FrameWork> work = manager.prepare(plan);
+    return BvhManager::declare(graph, manager, plan, nullptr);
+}
+
+BvhUpdateOutputs addBvhUpdatePass(rg::Graph& graph, BvhManager& manager, const scene::BvhPlan& plan,
+                                  const scene::Camera& camera) {
+    return BvhManager::declare(graph, manager, plan, &camera);
+}
+
+BvhUpdateOutputs BvhManager::declare(rg::Graph& graph, BvhManager& manager, const scene::BvhPlan& plan,
+                                     const scene::Camera* camera) {
+    std::shared_ptr<BvhManager::FrameWork> work = manager.prepare(plan, camera);
     const gpu::Capabilities& caps = manager.ctx_.caps();
     const rg::BoundaryState accelState = tracedAccelState(caps);
     const rg::BoundaryState bufferState = tracedBufferState(caps);
@@ -530,6 +688,14 @@ BvhUpdateOutputs addBvhUpdatePass(rg::Graph& graph, BvhManager& manager, const s
     const rg::Buffer offsets =
         graph.importBuffer("bvh.primitive_offsets", {{manager.offsets_.size()}, bufferState, bufferState});
     const uint64_t scratchBytes = manager.scratchCapacity_;
+    const bool particles = !work->particles.empty();
+    rg::AccelStruct particleTlas;
+    rg::Buffer particleData;
+    if (particles) {
+        particleTlas = graph.importAccelStruct("bvh.particle_tlas", {accelState, accelState});
+        particleData =
+            graph.importBuffer("bvh.particles", {{manager.particleData_.size()}, bufferState, bufferState});
+    }
 
     const BvhUpdateOutputs& out = graph.addPass<BvhUpdateOutputs>(
         "bvh_update", manager.options_.queue,
@@ -538,6 +704,10 @@ BvhUpdateOutputs addBvhUpdatePass(rg::Graph& graph, BvhManager& manager, const s
             d.primitivePool = b.write(pool, rg::Access::StorageWrite);
             d.primitiveOffsets = b.write(offsets, rg::Access::TransferDst);
             d.scratch = b.write(b.createBuffer("bvh.scratch", {scratchBytes}), rg::Access::AccelBuildWrite);
+            if (particles) {
+                d.particleTlas = b.write(particleTlas, rg::Access::AccelBuildWrite);
+                d.particles = b.write(particleData, rg::Access::TransferDst);
+            }
             // The BLASes are written here and observed only through the TLAS;
             // a frame whose TLAS nobody reads must still build them (static
             // BLASes are built exactly once).

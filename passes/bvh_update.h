@@ -15,11 +15,21 @@
 //   -> barrier -> BLAS builds -> barrier -> TLAS build,
 // with build scratch from the graph.
 //
+// Particles (issue 4's particle TLAS, DESIGN.md section 3 pass 0): when the
+// plan says particleTlas and the pass is given the camera, the same pass
+// uploads the scene's particles (per frame in flight), writes a
+// camera-facing quad per particle (shaders/bvh/particle_quads.comp, in the
+// pack step), builds one BLAS of those quads beside the other BLASes and a
+// particle TLAS of that one instance (kSbtOffsetParticles) beside the TLAS,
+// both every frame with fast build. A scene without particles gets no
+// particle buffer, BLAS, TLAS or dispatch (issue 4: model only what a scene
+// needs); BvhUpdateOutputs::particleTlas is then invalid.
+//
 //   passes::BvhManager bvh(ctx, scene);
 //   each frame:
 //     const scene::BvhPlan plan = planner.plan(scene, camera);
 //     rg::Graph graph(executor.queueCaps());
-//     const auto out = passes::addBvhUpdatePass(graph, bvh, plan);
+//     const auto out = passes::addBvhUpdatePass(graph, bvh, plan, camera);  // camera: particles face it
 //     ... passes reading out.tlas (AccelRead), out.primitivePool and
 //         out.primitiveOffsets (StorageRead) on the graphics queue ...
 //     rg::FrameResources frame;
@@ -42,6 +52,7 @@
 #include "graph/executor.h"
 #include "graph/graph.h"
 #include "scene/bvh_planner.h"
+#include "scene/camera.h"
 #include "scene/scene.h"
 
 #include <cstdint>
@@ -57,6 +68,13 @@ struct BvhUpdateOutputs {
     rg::Buffer primitivePool;      // PackedPrimitive per triangle; Access::StorageRead
     rg::Buffer primitiveOffsets;   // uint per (custom index + geometry); Access::StorageRead
     rg::Buffer scratch;            // the builds' scratch (transient)
+    // Invalid when the frame has no particles (or was declared without a
+    // camera): the particle TLAS (Access::AccelRead; one instance, SBT
+    // offset kSbtOffsetParticles, its primitive p is particle p / 2) and
+    // the particles as shader::ParticleData (glint/particles_shared.h;
+    // Access::StorageRead), indexed by primitive / 2.
+    rg::AccelStruct particleTlas;
+    rg::Buffer particles;
 };
 
 // What the GPU side did this frame and holds now.
@@ -78,6 +96,13 @@ struct BvhGpuStats {
     uint64_t geometryBytes = 0;       // uploaded vertices, indices and skin data
     uint64_t scratchBytes = 0;        // this frame's scratch request to the graph
     uint64_t totalBlasBuilds = 0;     // first builds and rebuilds, all frames
+    // Particles: this frame's particle BLAS/TLAS builds (1 or 0: none
+    // without particles), their particles and quad dispatches; the bytes
+    // of what is allocated for them (BLAS, TLAS, quads, particle data).
+    uint32_t particleTlasBuilds = 0;
+    uint32_t particles = 0;
+    uint32_t particleDispatches = 0;
+    uint64_t particleBytes = 0;
 };
 
 struct BvhUpdateOptions {
@@ -87,6 +112,9 @@ struct BvhUpdateOptions {
     VkBuildAccelerationStructureFlagsKHR staticFlags = VK_BUILD_ACCELERATION_STRUCTURE_PREFER_FAST_TRACE_BIT_KHR;
     VkBuildAccelerationStructureFlagsKHR deformableFlags = VK_BUILD_ACCELERATION_STRUCTURE_PREFER_FAST_BUILD_BIT_KHR;
     VkBuildAccelerationStructureFlagsKHR tlasFlags = VK_BUILD_ACCELERATION_STRUCTURE_PREFER_FAST_TRACE_BIT_KHR;
+    // The particle BLAS and TLAS are rebuilt every frame (the quads face
+    // the camera) and traced once, by one ray per pixel: fast build.
+    VkBuildAccelerationStructureFlagsKHR particleFlags = VK_BUILD_ACCELERATION_STRUCTURE_PREFER_FAST_BUILD_BIT_KHR;
     // The queue of the update pass. AsyncCompute overlaps the builds with
     // graphics work that does not need the TLAS (the graph maps it to the
     // graphics queue on one-queue devices); Graphics serializes them with it
@@ -122,13 +150,18 @@ public:
 
 private:
     friend BvhUpdateOutputs addBvhUpdatePass(rg::Graph&, BvhManager&, const scene::BvhPlan&);
+    friend BvhUpdateOutputs addBvhUpdatePass(rg::Graph&, BvhManager&, const scene::BvhPlan&, const scene::Camera&);
+    static BvhUpdateOutputs declare(rg::Graph& graph, BvhManager& manager, const scene::BvhPlan& plan,
+                                    const scene::Camera* camera);
     struct SourceGeometry;
     struct ResidentBlas;
     struct Retired;
     struct FrameWork;
     using GeometryKey = std::tuple<uint32_t, uint32_t, uint32_t>;  // mesh, lod, geometry
 
-    std::shared_ptr<FrameWork> prepare(const scene::BvhPlan& plan);
+    std::shared_ptr<FrameWork> prepare(const scene::BvhPlan& plan, const scene::Camera* camera);
+    void prepareParticles(const scene::BvhPlan& plan, const scene::Camera& camera, FrameWork& work);
+    void recordParticleQuads(const FrameWork& work, VkCommandBuffer cmd, const gpu::Buffer& particles);
     void record(FrameWork& work, rg::PassContext& pc, const BvhUpdateOutputs& handles);
     const SourceGeometry& sourceGeometry(uint32_t mesh, uint32_t lod, uint32_t geometry);
     ResidentBlas& createBlas(const scene::BlasDesc& desc);
@@ -144,6 +177,7 @@ private:
     uint32_t framesInFlight_;
     BvhUpdateOptions options_;
     gpu::Pipeline packPipeline_;
+    gpu::Pipeline particleQuadsPipeline_;
     uint64_t frame_ = 0;  // frames prepared so far
 
     std::map<GeometryKey, std::unique_ptr<SourceGeometry>> geometries_;
@@ -156,6 +190,17 @@ private:
     std::unique_ptr<gpu::AccelerationStructure> tlas_;
     uint32_t tlasCapacity_ = 0;                   // instances the TLAS and instance buffers hold
     uint64_t scratchCapacity_ = 0;                // high-water mark of the scratch request
+    // Particles, allocated on the first frame with particles, grown in
+    // powers of two: the data (device-local, read by the traces) and its
+    // per-slot staging, the quads (build input), the BLAS and TLAS sized
+    // for the capacity, the TLAS's one instance per slot.
+    uint32_t particleCapacity_ = 0;
+    gpu::Buffer particleData_;
+    std::vector<gpu::Buffer> particleStaging_;
+    gpu::Buffer particleQuads_;
+    std::unique_ptr<gpu::AccelerationStructure> particleBlas_;
+    std::unique_ptr<gpu::AccelerationStructure> particleTlas_;
+    std::vector<gpu::Buffer> particleInstances_;
     std::vector<Retired> retired_;
     BvhGpuStats stats_;
 };
@@ -165,7 +210,13 @@ private:
 // buffers and deferred releases count frames by these calls. Throws
 // gpu::GpuError when the plan names a BLAS the manager never built (a plan
 // from another planner or scene).
+// This overload has no camera to face the particles with: it builds no
+// particle TLAS whatever the plan says.
 BvhUpdateOutputs addBvhUpdatePass(rg::Graph& graph, BvhManager& manager, const scene::BvhPlan& plan);
+// With the frame's camera (the G-buffer's): also the particle TLAS when
+// plan.particleTlas (see the top of this file).
+BvhUpdateOutputs addBvhUpdatePass(rg::Graph& graph, BvhManager& manager, const scene::BvhPlan& plan,
+                                  const scene::Camera& camera);
 
 // The state the imports are left in and expected in: read by the trace
 // passes on the graphics queue, from compute (ray query) or the ray tracing

@@ -24,7 +24,7 @@ constexpr uint32_t kBindingDepth = 0, kBindingNormal = 1, kBindingRoughness = 2,
                    kBindingRays = 4, kBindingClasses = 5, kBindingRadiance = 6, kBindingHitDistance = 7,
                    kBindingSource = 8, kBindingReprojected = 9, kBindingCounters = 10, kBindingSslrRadiance = 11,
                    kBindingSslrConfidence = 12, kBindingSslrHit = 13, kBindingRtRadiance = 14,
-                   kBindingRtHitDistance = 15;
+                   kBindingRtHitDistance = 15, kBindingParticles = 16;
 
 std::string variantShader(uint32_t variant) {
     const bool sslr = (variant & kVariantSslr) != 0;
@@ -43,7 +43,7 @@ std::vector<gpu::Binding> variantBindings(uint32_t variant) {
         {kBindingRoughness, kSampled, kStage}, {kBindingConstants, kStorage, kStage},
         {kBindingRays, kStorage, kStage},      {kBindingClasses, kStorage, kStage},
         {kBindingRadiance, kImage, kStage},    {kBindingHitDistance, kImage, kStage},
-        {kBindingSource, kImage, kStage},
+        {kBindingSource, kImage, kStage},      {kBindingParticles, kSampled, kStage},
     };
     if ((variant & kVariantFeedback) != 0) {
         bindings.push_back({kBindingReprojected, kStorage, kStage});
@@ -100,6 +100,7 @@ IntegrateOutputs addIntegratePass(rg::Graph& graph, IntegratePipelines& pipeline
         throw gpu::GpuError("addIntegratePass: the feedback outputs must come from this frame's G-buffer size");
     }
     const bool hasRt = inputs.rtRadiance.valid();
+    const bool hasParticles = inputs.particles.valid();
     const uint32_t variant = (inputs.sslr ? kVariantSslr : 0u) | (hasRt ? kVariantRt : 0u) |
                              (hasFeedback ? kVariantFeedback : 0u);
 
@@ -116,6 +117,7 @@ IntegrateOutputs addIntegratePass(rg::Graph& graph, IntegratePipelines& pipeline
     constants.size = {gbuf.width, gbuf.height};
     constants.tiles = {tilesX, tilesY};
     constants.confidenceThreshold = settings.confidenceThreshold;
+    constants.particlesBound = hasParticles ? 1u : 0u;
 
     // The constants outgrow push constants (glint/integrate_shared.h); a
     // transfer inside the frame keeps their lifetime the graph's.
@@ -136,6 +138,7 @@ IntegrateOutputs addIntegratePass(rg::Graph& graph, IntegratePipelines& pipeline
         rg::Texture depth, normal, roughnessMetal;
         rg::Buffer constants, rays, classes, reprojected;
         rg::Texture sslrRadiance, sslrConfidence, sslrHit, rtRadiance, rtHitDistance;
+        rg::Texture particles;  // the particle trace, or the normal as a stand-in (never read)
         IntegrateOutputs out;
     };
     const IntegrateData& integrate = graph.addPass<IntegrateData>(
@@ -144,6 +147,10 @@ IntegrateOutputs addIntegratePass(rg::Graph& graph, IntegratePipelines& pipeline
             d.depth = b.read(gbuf.depth, rg::Access::SampledRead);
             d.normal = b.read(gbuf.normal, rg::Access::SampledRead);
             d.roughnessMetal = b.read(gbuf.roughnessMetal, rg::Access::SampledRead);
+            // The shader declares the particles in every variant (one flag
+            // in the constants rather than twice the variants); without
+            // them a texture this pass reads anyway fills the binding.
+            d.particles = hasParticles ? b.read(inputs.particles, rg::Access::SampledRead) : d.normal;
             d.constants = b.read(upload.constants, rg::Access::StorageRead);
             d.rays = b.read(rays.rays, rg::Access::StorageRead);
             d.classes = b.read(rays.classes, rg::Access::StorageRead);
@@ -183,7 +190,8 @@ IntegrateOutputs addIntegratePass(rg::Graph& graph, IntegratePipelines& pipeline
                 .storageBuffer(kBindingClasses, pc.buffer(d.classes))
                 .storageImage(kBindingRadiance, pc.view(d.out.radiance))
                 .storageImage(kBindingHitDistance, pc.view(d.out.hitDistance))
-                .storageImage(kBindingSource, pc.view(d.out.sourceDebug));
+                .storageImage(kBindingSource, pc.view(d.out.sourceDebug))
+                .sampledImage(kBindingParticles, pc.view(d.particles), sampler, pc.layout(d.particles));
             if ((variant & kVariantFeedback) != 0) {
                 push.storageBuffer(kBindingReprojected, pc.buffer(d.reprojected))
                     .storageBuffer(kBindingCounters, pc.buffer(d.out.counters));

@@ -22,6 +22,9 @@
 //         {gbuf, rays, sslr, rt.radiance, rt.hitDistance, feedback, lighting, camera}, {});
 //     ... temporal accumulation reads refl.radiance and refl.hitDistance ...
 //
+// With IntegrateInputs::particles the particle trace is composited in
+// front of each traced pixel's reflection (see there).
+//
 // Frames without SSLR ("rt" mode) or without the ray tracer ("ssr" mode)
 // leave those inputs empty, and a frame without the feedback pass leaves
 // IntegrateInputs::feedback default (then no counters are written and
@@ -59,6 +62,14 @@ struct IntegrateInputs {
     rg::Texture rtRadiance;
     rg::Texture rtHitDistance;
     FeedbackOutputs feedback;          // reprojected in, counters.current out
+    // Optional: the particle trace's radiance (passes/particles.h,
+    // ParticleTraceOutputs::radiance: RGBA16F, premultiplied rgb, a =
+    // coverage, at ray leaders; the G-buffer's size). Where valid, every
+    // traced pixel's reflection becomes
+    //   particles.rgb + (1 - particles.a) * reflection
+    // (its leader's particles, as for the traces); the hit distance stays
+    // the reflected surface's.
+    rg::Texture particles;
     shader::SceneLighting lighting;    // passes::sceneLighting(...)
     scene::Camera camera;              // the G-buffer's; its unjittered matrices rebuild positions
 };

@@ -19,7 +19,7 @@ constexpr std::array<std::string_view, 3> kBackendNames = {"auto", "query", "pip
 
 // Debug views: name, what they show. Kept in one table so the list printed
 // by --help, the parser and the wiring agree.
-constexpr std::array<std::string_view, 20> kDebugViews = {
+constexpr std::array<std::string_view, 23> kDebugViews = {
     "final",              // the composited, tonemapped image
     "lit",                // G-buffer: lit colour of the opaque scene
     "ray_classes",        // ray generation: sky black, env grey, SSLR blue, hybrid purple, RT red
@@ -30,6 +30,9 @@ constexpr std::array<std::string_view, 20> kDebugViews = {
     "sslr_hits",          // SSLR: hit uv, confidence
     "rt_radiance",        // RT: radiance along the traced rays
     "rt_hit_distance",    // RT: world distance, 0..100
+    "particles",          // particles trace: particles seen in the reflections (premultiplied)
+    "shadow_map",         // G-buffer: the sun's shadow map (reversed depth)
+    "lit_pyramid",        // SSLR: the cone trace's colour pyramid (level 0)
     "reflection_source",  // integrate: which trace each pixel used
     "reflections",        // integrate: reflection radiance
     "hit_distance",       // integrate: world distance to the reflected point, 0..100
@@ -43,8 +46,8 @@ constexpr std::array<std::string_view, 20> kDebugViews = {
 };
 
 // Passes that make up the reflections' cost, by name prefix.
-constexpr std::array<std::string_view, 6> kReflectionPassPrefixes = {"feedback",    "ray_generation", "sslr",
-                                                                     "rt_trace",    "integrate",      "temporal"};
+constexpr std::array<std::string_view, 7> kReflectionPassPrefixes = {
+    "feedback", "ray_generation", "sslr", "rt_trace", "particles.trace", "integrate", "temporal"};
 
 std::vector<gpu::Binding> storageBindings(uint32_t buffers, bool lastIsImage) {
     std::vector<gpu::Binding> bindings;
@@ -102,6 +105,7 @@ ReflectionRenderer::ReflectionRenderer(gpu::Context& ctx, const scene::Scene& sc
       integrate_(ctx),
       temporal_(ctx),
       composite_(ctx),
+      particles_(ctx, options.backend),
       tileView_(gpu::createComputePipeline(ctx, {"reflection_frame/tile_view.comp", storageBindings(1, true),
                                                  uint32_t(sizeof(shader::TileViewConstants)),
                                                  "reflection_frame.tile_view"})),
@@ -134,7 +138,7 @@ ReflectionFrame ReflectionRenderer::addFrame(rg::Graph& graph, const scene::Came
     if (traces) {
         const scene::BvhPlan plan = planner_.plan(scene_, camera);
         lastPlanStats_ = plan.stats;
-        f.bvh = addBvhUpdatePass(graph, bvh_, plan);
+        f.bvh = addBvhUpdatePass(graph, bvh_, plan, camera);
     }
     // 1. G-buffer.
     f.gbuffer = addGBufferPass(graph, gbuffer_, {camera}, settings.gbuffer);
@@ -169,6 +173,25 @@ ReflectionFrame ReflectionRenderer::addFrame(rg::Graph& graph, const scene::Came
         rtInputs.frameIndex = frameIndex;
         f.rt = addRtTracePass(graph, rt_, rtInputs, settings.rt);
     }
+    // 5'. Particles seen in the reflections, cut at each ray's reflected
+    // surface (the particle TLAS exists only when the scene has particles).
+    if (f.bvh && particlesTraced(*f.bvh)) {
+        ParticleTraceInputs particleInputs;
+        particleInputs.gbuffer = f.gbuffer;
+        particleInputs.rays = f.rays;
+        particleInputs.sslr = f.sslr;
+        if (f.rt) {
+            particleInputs.rtRadiance = f.rt->radiance;
+            particleInputs.rtHitDistance = f.rt->hitDistance;
+        }
+        particleInputs.bvh = *f.bvh;
+        particleInputs.camera = camera;
+        ParticleTraceSettings particleSettings;
+        particleSettings.backend = rt_.backend();
+        particleSettings.confidenceThreshold = settings.sslr.confidenceThreshold;
+        particleSettings.maxDistance = settings.rt.maxDistance;
+        f.particles = addParticleTracePass(graph, particles_, particleInputs, particleSettings);
+    }
     // 5. Integrate.
     IntegrateInputs integrateInputs;
     integrateInputs.gbuffer = f.gbuffer;
@@ -183,6 +206,9 @@ ReflectionFrame ReflectionRenderer::addFrame(rg::Graph& graph, const scene::Came
     }
     integrateInputs.lighting = lighting;
     integrateInputs.camera = camera;
+    if (f.particles) {
+        integrateInputs.particles = f.particles->radiance;
+    }
     IntegrateSettings integrateSettings = settings.integrate;
     integrateSettings.confidenceThreshold = settings.sslr.confidenceThreshold;
     f.integrate = addIntegratePass(graph, integrate_, integrateInputs, integrateSettings);
@@ -237,10 +263,14 @@ ReflectionFrame ReflectionRenderer::addFrame(rg::Graph& graph, const scene::Came
         f.counts = count.counts;
     }
 
-    // 8. Composite and tonemap, or the debug view in its place.
+    // 8. Composite and tonemap, or the debug view in its place. The
+    // particles are drawn into the lit colour only now: SSLR (and its cone
+    // pyramid) must not see them, or they would be reflected twice.
     const std::string_view view = settings.debugView;
     if (view.empty() || view == "final") {
-        f.output = addCompositePass(graph, composite_, {f.gbuffer, f.temporal.resolved, camera}, settings.composite);
+        GBufferOutputs composited = f.gbuffer;
+        composited.lit = addParticleForwardPass(graph, particles_, {f.gbuffer, scene_.particles, camera}).lit;
+        f.output = addCompositePass(graph, composite_, {composited, f.temporal.resolved, camera}, settings.composite);
         graph.markOutput(f.output.color);
         return f;
     }
@@ -300,6 +330,9 @@ ReflectionFrame ReflectionRenderer::addFrame(rg::Graph& graph, const scene::Came
     else if (view == "sslr_hits") show(f.sslr ? f.sslr->hitDebug : none, DebugViewKind::Raw);
     else if (view == "rt_radiance") show(f.rt ? f.rt->radiance : none, DebugViewKind::Color);
     else if (view == "rt_hit_distance") show(f.rt ? f.rt->hitDistance : none, DebugViewKind::Scalar, 0.0f, 100.0f);
+    else if (view == "particles") show(f.particles ? f.particles->radiance : none, DebugViewKind::Color);
+    else if (view == "shadow_map") show(f.gbuffer.shadowMap, DebugViewKind::Scalar);
+    else if (view == "lit_pyramid") show(f.sslr ? f.sslr->litPyramid : none, DebugViewKind::Color);
     else if (view == "reflection_source") show(f.integrate.sourceDebug, DebugViewKind::Raw);
     else if (view == "reflections") show(f.integrate.radiance, DebugViewKind::Color);
     else if (view == "hit_distance") show(f.integrate.hitDistance, DebugViewKind::Scalar, 0.0f, 100.0f);

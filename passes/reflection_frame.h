@@ -5,10 +5,12 @@
 // engine that wires the passes into its own frame.
 //
 //   BVH update (async compute) -> G-buffer -> feedback -> ray generation
-//   -> SSLR -> ray-traced hits -> integrate -> temporal -> composite
+//   -> SSLR -> ray-traced hits -> particles trace -> integrate -> temporal
+//   -> particles forward -> composite
 //
-// Each mode declares only what it uses: ssr has no BVH and no ray-traced
-// pass, rt no SSLR and no feedback.
+// Each mode declares only what it uses: ssr has no BVH, no ray-traced pass
+// and no reflected particles (the direct view still draws them), rt no
+// SSLR and no feedback; a scene without particles no particle passes.
 //
 //   passes::ReflectionRenderer renderer(ctx, scene, {});
 //   each frame (after scene::advanceScene and camera.advance):
@@ -26,6 +28,7 @@
 #include "passes/feedback.h"
 #include "passes/gbuffer.h"
 #include "passes/integrate.h"
+#include "passes/particles.h"
 #include "passes/ray_generation.h"
 #include "passes/rt_trace.h"
 #include "passes/sslr.h"
@@ -85,6 +88,7 @@ struct ReflectionFrame {
     RayGenerationOutputs rays;
     std::optional<SslrOutputs> sslr;
     std::optional<RtTraceOutputs> rt;
+    std::optional<ParticleTraceOutputs> particles;  // reflected particles (a BVH with particles)
     IntegrateOutputs integrate;
     TemporalOutputs temporal;
     CompositeOutputs output;  // RGBA8, sRGB-encoded: the image or the debug view
@@ -139,6 +143,7 @@ private:
     IntegratePipelines integrate_;
     TemporalPipelines temporal_;
     CompositePipelines composite_;
+    ParticlePipelines particles_;
     gpu::Pipeline tileView_;
     gpu::Pipeline classCount_;
     scene::BvhStats lastPlanStats_;

@@ -7,25 +7,29 @@
 #include "glint/ray_generation_shared.h"
 #include "glint/sslr_shared.h"
 
+#include <algorithm>
 #include <array>
+#include <bit>
 #include <cmath>
 
 namespace glint::passes {
 
 namespace {
 
-constexpr uint32_t kBindingCount = 11;
+constexpr uint32_t kBindingCount = 13;
 
 std::vector<gpu::Binding> traceBindings() {
     std::vector<gpu::Binding> bindings;
     for (uint32_t i = 0; i < kBindingCount; ++i) {
         VkDescriptorType type = VK_DESCRIPTOR_TYPE_STORAGE_BUFFER;
-        if (i < 3) type = VK_DESCRIPTOR_TYPE_COMBINED_IMAGE_SAMPLER;
+        if (i < 3 || i >= 11) type = VK_DESCRIPTOR_TYPE_COMBINED_IMAGE_SAMPLER;
         if (i >= 6 && i <= 8) type = VK_DESCRIPTOR_TYPE_STORAGE_IMAGE;
         bindings.push_back({i, type, VK_SHADER_STAGE_COMPUTE_BIT});
     }
     return bindings;
 }
+
+uint32_t groupsOf(uint32_t n) { return (n + 7) / 8; }
 
 // The trace inverts the projection from P00, P11, P22 and P32 alone
 // (glint/sslr_shared.h); anything else (an off-centre or orthographic
@@ -46,8 +50,22 @@ SslrPipelines::SslrPipelines(gpu::Context& ctx)
           ctx, {"sslr/trace.comp", traceBindings(), uint32_t(sizeof(shader::SslrConstants)), "sslr.trace"})),
       // Every read is a texelFetch; the sampler only completes the combined
       // descriptor.
+      pyramidBase_(gpu::createComputePipeline(
+          ctx, {"sslr/pyramid_base.comp",
+                {{0, VK_DESCRIPTOR_TYPE_COMBINED_IMAGE_SAMPLER, VK_SHADER_STAGE_COMPUTE_BIT},
+                 {1, VK_DESCRIPTOR_TYPE_STORAGE_IMAGE, VK_SHADER_STAGE_COMPUTE_BIT}},
+                uint32_t(sizeof(glm::uvec2)),
+                "sslr.pyramid_base"})),
+      pyramidDown_(gpu::createComputePipeline(
+          ctx, {"sslr/pyramid_down.comp",
+                {{0, VK_DESCRIPTOR_TYPE_STORAGE_IMAGE, VK_SHADER_STAGE_COMPUTE_BIT},
+                 {1, VK_DESCRIPTOR_TYPE_STORAGE_IMAGE, VK_SHADER_STAGE_COMPUTE_BIT}},
+                uint32_t(sizeof(shader::SslrPyramidConstants)),
+                "sslr.pyramid_down"})),
       nearest_(ctx, {VK_FILTER_NEAREST, VK_SAMPLER_MIPMAP_MODE_NEAREST, VK_SAMPLER_ADDRESS_MODE_CLAMP_TO_EDGE, 0.0f,
                      "sslr.nearest"}),
+      trilinear_(ctx, {VK_FILTER_LINEAR, VK_SAMPLER_MIPMAP_MODE_LINEAR, VK_SAMPLER_ADDRESS_MODE_CLAMP_TO_EDGE,
+                       VK_LOD_CLAMP_NONE, "sslr.trilinear"}),
       clearer_(ctx) {}
 
 SslrOutputs addSslrPass(rg::Graph& graph, SslrPipelines& pipelines, const SslrInputs& inputs,
@@ -89,6 +107,69 @@ SslrOutputs addSslrPass(rg::Graph& graph, SslrPipelines& pipelines, const SslrIn
             }
         });
 
+    // The cone trace's colour pyramid: level 0 is the lit colour, each
+    // further level the 2x2 mean of the one above, one graph pass per level
+    // (each reads the level above and writes its own: the graph orders
+    // them by subresource).
+    uint32_t pyramidMips = 0;
+    rg::Texture pyramid;
+    if (settings.coneTrace) {
+        pyramidMips = std::min(shader::kSslrPyramidMaxMips, uint32_t(std::bit_width(std::max(gbuf.width, gbuf.height))));
+        struct BaseData {
+            rg::Texture lit, pyramid;
+        };
+        const glm::uvec2 size{gbuf.width, gbuf.height};
+        const BaseData& base = graph.addPass<BaseData>(
+            "sslr.pyramid", rg::Queue::Graphics,
+            [&](rg::Builder& b, BaseData& d) {
+                d.lit = b.read(gbuf.lit, rg::Access::SampledRead);
+                d.pyramid = b.write(b.createTexture("sslr.lit_pyramid", {.width = gbuf.width,
+                                                                        .height = gbuf.height,
+                                                                        .mips = pyramidMips,
+                                                                        .format = kSslrRadianceFormat}),
+                                    rg::Access::StorageWrite, rg::Subresource::mip(0));
+            },
+            [&pipelines, size](const BaseData& d, rg::PassContext& pc) {
+                const gpu::Pipeline& pipeline = pipelines.pyramidBase_;
+                pipeline.bind(pc.cmd());
+                gpu::PushDescriptors(pipeline)
+                    .sampledImage(0, pc.view(d.lit), pipelines.nearest_.handle(), pc.layout(d.lit))
+                    .storageImage(1, pc.image(d.pyramid).mipView(0))
+                    .push(pipelines.ctx_, pc.cmd());
+                pipeline.pushConstants(pc.cmd(), size);
+                pc.dispatch(pipeline, groupsOf(size.x), groupsOf(size.y));
+            });
+        pyramid = base.pyramid;
+        for (uint32_t m = 1; m < pyramidMips; ++m) {
+            struct DownData {
+                rg::Texture pyramid;
+                uint32_t mip = 0;
+            };
+            shader::SslrPyramidConstants down{};
+            down.sourceSize = {std::max(1u, gbuf.width >> (m - 1)), std::max(1u, gbuf.height >> (m - 1))};
+            down.targetSize = {std::max(1u, gbuf.width >> m), std::max(1u, gbuf.height >> m)};
+            const DownData& level = graph.addPass<DownData>(
+                "sslr.pyramid", rg::Queue::Graphics,
+                [&](rg::Builder& b, DownData& d) {
+                    const rg::Texture above = b.read(pyramid, rg::Access::StorageRead, rg::Subresource::mip(m - 1));
+                    d.pyramid = b.write(above, rg::Access::StorageWrite, rg::Subresource::mip(m));
+                    d.mip = m;
+                },
+                [&pipelines, down](const DownData& d, rg::PassContext& pc) {
+                    const gpu::Pipeline& pipeline = pipelines.pyramidDown_;
+                    const gpu::Image& image = pc.image(d.pyramid);
+                    pipeline.bind(pc.cmd());
+                    gpu::PushDescriptors(pipeline)
+                        .storageImage(0, image.mipView(d.mip - 1))
+                        .storageImage(1, image.mipView(d.mip))
+                        .push(pipelines.ctx_, pc.cmd());
+                    pipeline.pushConstants(pc.cmd(), down);
+                    pc.dispatch(pipeline, groupsOf(down.targetSize.x), groupsOf(down.targetSize.y));
+                });
+            pyramid = level.pyramid;
+        }
+    }
+
     shader::SslrConstants constants{};
     constants.view = inputs.view;
     const glm::mat4& p = inputs.projection;
@@ -102,9 +183,11 @@ SslrOutputs addSslrPass(rg::Graph& graph, SslrPipelines& pipelines, const SslrIn
     constants.maxDistance = settings.maxDistance;
     constants.edgeFade = settings.edgeFade;
     constants.confidenceThreshold = settings.confidenceThreshold;
+    constants.coneRoughness = settings.coneRoughness;
+    constants.pyramidMips = pyramidMips;
 
     struct TraceData {
-        rg::Texture depth, normal, lit;
+        rg::Texture depth, normal, lit, roughnessMetal, pyramid;
         rg::Buffer rays, classes, tiles, tileArgs;
         SslrOutputs out;
     };
@@ -114,6 +197,8 @@ SslrOutputs addSslrPass(rg::Graph& graph, SslrPipelines& pipelines, const SslrIn
             d.depth = b.read(gbuf.depth, rg::Access::SampledRead);
             d.normal = b.read(gbuf.normal, rg::Access::SampledRead);
             d.lit = b.read(gbuf.lit, rg::Access::SampledRead);
+            d.roughnessMetal = b.read(gbuf.roughnessMetal, rg::Access::SampledRead);
+            if (pyramid.valid()) d.pyramid = b.read(pyramid, rg::Access::SampledRead);
             d.rays = b.read(rays.rays, rg::Access::StorageRead);
             d.classes = b.read(rays.classes, rg::Access::StorageRead);
             d.tiles = b.read(rays.sslrTiles, rg::Access::StorageRead);
@@ -125,6 +210,7 @@ SslrOutputs addSslrPass(rg::Graph& graph, SslrPipelines& pipelines, const SslrIn
             // Appends after ray generation's RT rays.
             d.out.rtRayList = b.write(rays.rtRays, rg::Access::StorageReadWrite);
             d.out.rtArgs = b.write(rays.rtArgs, rg::Access::StorageReadWrite);
+            d.out.litPyramid = d.pyramid;
         },
         [&pipelines, constants](const TraceData& d, rg::PassContext& pc) {
             const gpu::Pipeline& pipeline = pipelines.trace_;
@@ -142,6 +228,11 @@ SslrOutputs addSslrPass(rg::Graph& graph, SslrPipelines& pipelines, const SslrIn
                 .storageImage(8, pc.view(d.out.hitDebug))
                 .storageBuffer(9, pc.buffer(d.out.rtRayList))
                 .storageBuffer(10, pc.buffer(d.out.rtArgs))
+                .sampledImage(11, pc.view(d.roughnessMetal), sampler, pc.layout(d.roughnessMetal))
+                // Without the cone trace (pyramidMips 0) binding 12 is never
+                // read; the lit colour completes the descriptor set.
+                .sampledImage(12, pc.view(d.pyramid.valid() ? d.pyramid : d.lit), pipelines.trilinear_.handle(),
+                              pc.layout(d.pyramid.valid() ? d.pyramid : d.lit))
                 .push(pipelines.ctx_, pc.cmd());
             pipeline.pushConstants(pc.cmd(), constants);
             pc.dispatchIndirect(pipeline, d.tileArgs, kSslrArgsBytes);

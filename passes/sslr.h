@@ -63,6 +63,14 @@ struct SslrSettings {
     // Hybrid rays below this confidence go to the ray tracer: the Far Cry 6
     // talk's 0.9 (DESIGN.md section 3).
     float confidenceThreshold = 0.9f;
+    // Pixels at least this rough (perceptual) cone-trace: they march the
+    // mirror direction and sample a box-filtered pyramid of the lit colour
+    // at the GGX lobe's footprint, noise-free, instead of the lit colour at
+    // one stochastic ray's hit (issue 5's "fast cone trace for rough
+    // tiles"). Glint's starting value: where ray generation starts sharing
+    // one ray per quad (RayGenerationSettings::reuseRoughness).
+    float coneRoughness = 0.1f;
+    bool coneTrace = true;
 };
 
 struct SslrOutputs {
@@ -71,6 +79,7 @@ struct SslrOutputs {
     rg::Texture hitDebug;    // kSslrHitDebugFormat: hit uv, confidence, hit (debug view "sslr_hits")
     rg::Buffer rtRayList;    // ray generation's RT ray list with the unresolved hybrid rays appended
     rg::Buffer rtArgs;       // its args (glint/ray_generation_shared.h kRtList*)
+    rg::Texture litPyramid;  // the cone trace's colour pyramid (invalid without cone trace)
     uint32_t width = 0;
     uint32_t height = 0;
 };
@@ -84,7 +93,10 @@ private:
     friend SslrOutputs addSslrPass(rg::Graph&, SslrPipelines&, const SslrInputs&, const SslrSettings&);
     gpu::Context& ctx_;
     gpu::Pipeline trace_;
+    gpu::Pipeline pyramidBase_;
+    gpu::Pipeline pyramidDown_;
     gpu::Sampler nearest_;
+    gpu::Sampler trilinear_;
     ImageClearer clearer_;
 };
 

@@ -194,6 +194,12 @@ Pipeline createGraphicsPipeline(Context& ctx, const GraphicsPipelineDesc& desc) 
         b.colorWriteMask = VK_COLOR_COMPONENT_R_BIT | VK_COLOR_COMPONENT_G_BIT | VK_COLOR_COMPONENT_B_BIT |
                            VK_COLOR_COMPONENT_A_BIT;
     }
+    if (!desc.colorBlends.empty()) {
+        if (desc.colorBlends.size() != desc.colorFormats.size()) {
+            throw GpuError("graphics pipeline '" + p.name_ + "': colorBlends must have one entry per colour attachment");
+        }
+        blends = desc.colorBlends;
+    }
     VkPipelineColorBlendStateCreateInfo blend{VK_STRUCTURE_TYPE_PIPELINE_COLOR_BLEND_STATE_CREATE_INFO};
     blend.attachmentCount = static_cast<uint32_t>(blends.size());
     blend.pAttachments = blends.data();

@@ -81,6 +81,9 @@ struct GraphicsPipelineDesc {
     bool depthWrite = true;
     // Reversed Z is Glint's convention (near = 1, far = 0).
     VkCompareOp depthCompare = VK_COMPARE_OP_GREATER_OR_EQUAL;
+    // One per colour attachment (blending, write mask); empty: no blending,
+    // every channel written.
+    std::vector<VkPipelineColorBlendAttachmentState> colorBlends;
     std::string name;
 };
 

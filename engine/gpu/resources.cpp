@@ -171,6 +171,28 @@ void Image::create(Context& ctx, const MemoryRange* placed) {
     check(vkCreateImageView(ctx.device(), &viewInfo, nullptr, &view), "vkCreateImageView '" + desc_.name + "'");
     view_ = Unique<VkImageView>(ctx.device(), view, vkDestroyImageView);
     ctx.setName(view, VK_OBJECT_TYPE_IMAGE_VIEW, desc_.name);
+
+    // A storage image with mips is written one level at a time (a storage
+    // descriptor's view must hold exactly one mip): one view per level.
+    if (desc_.mips > 1 && (desc_.usage & VK_IMAGE_USAGE_STORAGE_BIT) && desc_.depth == 1) {
+        for (uint32_t m = 0; m < desc_.mips; ++m) {
+            viewInfo.subresourceRange.baseMipLevel = m;
+            viewInfo.subresourceRange.levelCount = 1;
+            VkImageView mip = VK_NULL_HANDLE;
+            const std::string name = desc_.name + ".mip" + std::to_string(m);
+            check(vkCreateImageView(ctx.device(), &viewInfo, nullptr, &mip), "vkCreateImageView '" + name + "'");
+            mipViews_.emplace_back(ctx.device(), mip, vkDestroyImageView);
+            ctx.setName(mip, VK_OBJECT_TYPE_IMAGE_VIEW, name);
+        }
+    }
+}
+
+VkImageView Image::mipView(uint32_t mip) const {
+    if (mip >= mipViews_.size()) {
+        throw GpuError("image '" + desc_.name + "': no view of mip " + std::to_string(mip) +
+                       " (per-mip views exist for 2D storage images with mips)");
+    }
+    return mipViews_[mip].get();
 }
 
 VkImageAspectFlags aspectOf(VkFormat format) {

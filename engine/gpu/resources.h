@@ -10,6 +10,7 @@
 
 #include <span>
 #include <string>
+#include <vector>
 
 namespace glint::gpu {
 
@@ -86,6 +87,8 @@ public:
     explicit operator bool() const { return static_cast<bool>(image_); }
     // A view of every mip and layer (null for transfer-only images).
     VkImageView view() const { return view_.get(); }
+    // A view of one mip (2D storage images with mips only; throws otherwise).
+    VkImageView mipView(uint32_t mip) const;
     const ImageDesc& desc() const { return desc_; }
     VkFormat format() const { return desc_.format; }
     VkExtent3D extent() const { return {desc_.width, desc_.height, desc_.depth}; }
@@ -99,6 +102,7 @@ private:
     Allocation allocation_;  // declared first: released after the image and view
     Unique<VkImage> image_;
     Unique<VkImageView> view_;
+    std::vector<Unique<VkImageView>> mipViews_;
 };
 
 VkImageAspectFlags aspectOf(VkFormat format);

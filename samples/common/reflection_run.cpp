@@ -241,15 +241,18 @@ ReflectionRunResult runReflections(gpu::Context& ctx, scene::Scene& scene, const
         lastTimed = timings.front().frame;
         double reflection = 0.0, total = 0.0;
         bool any = false;
+        // Passes that share a name (the pyramid's levels) count as one.
+        std::map<std::string, double> frameTimes;
         for (const rg::PassTiming& t : timings) {
             if (!t.milliseconds) continue;
             any = true;
-            if (!passTimes.count(t.name)) passOrder.push_back(t.name);
-            passTimes[t.name].push_back(*t.milliseconds);
+            if (!passTimes.count(t.name) && !frameTimes.count(t.name)) passOrder.push_back(t.name);
+            frameTimes[t.name] += *t.milliseconds;
             passQueues[t.name] = t.queue;
             total += *t.milliseconds;
             if (passes::isReflectionPass(t.name)) reflection += *t.milliseconds;
         }
+        for (const auto& [name, ms] : frameTimes) passTimes[name].push_back(ms);
         if (any) {
             reflectionTimes.push_back(reflection);
             totalTimes.push_back(total);

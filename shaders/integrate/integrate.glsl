@@ -42,6 +42,11 @@ layout(set = 0, binding = 14) uniform sampler2D rtRadianceTexture;
 layout(set = 0, binding = 15) uniform sampler2D rtHitDistanceTexture;
 #endif
 
+// The particle trace's radiance (passes/particles.h): bound in every
+// variant, read only where C.particlesBound says it holds this frame's
+// trace (otherwise the pass binds a stand-in texture).
+layout(set = 0, binding = 16) uniform sampler2D particlesTexture;
+
 // The largest finite half float: radiance above it would become +Inf in the
 // RGBA16F output.
 const float kMaxHalf = 65504.0;
@@ -143,21 +148,15 @@ Reflection integratePixel(uvec2 pixel) {
     }
 #endif
 
-    // Full confidence: SSLR alone. Below it, the more confident trace: a
-    // ray-traced result is fully confident (its miss is the true
-    // environment), so RT wins where it traced; else whatever SSLR found;
-    // else the environment map (issue 5, Far Cry 6 talk).
-    bool useSslr = false;
-    if (confidence >= C.confidenceThreshold) {
-        useSslr = true;
-    } else if (rtTraced) {
+    // glint/integrate_shared.h's chooseReflectionTrace, which the particle
+    // trace shares.
+    const uint trace = chooseReflectionTrace(confidence, C.confidenceThreshold, rtTraced);
+    if (trace == kTraceRt) {
         r.radiance = rtRadiance;
         r.hitDistance = rtHitDistance;
         r.source = kSourceRt;
-    } else if (confidence > 0.0) {
-        useSslr = true;
     }
-    if (useSslr) {
+    if (trace == kTraceSslr) {
         r.radiance = sslrRadiance;
         r.source = kSourceSslr;
         // The reflected point is the surface the depth buffer holds at the
@@ -167,6 +166,18 @@ Reflection integratePixel(uvec2 pixel) {
         if (hitDepth > 0.0) {
             const vec3 hitPosition = worldPosition(vec2(hitTexel) + 0.5, hitDepth);
             r.hitDistance = min(length(hitPosition - position), kMissHitDistance);
+        }
+    }
+    // Particles between the surface and what it reflects (the leader's
+    // trace, premultiplied, a = coverage) in front of the reflection. The
+    // hit distance stays the reflected surface's: particles are soft and
+    // partly transparent, and temporal reprojection follows what lies
+    // behind them.
+    if (traced && C.particlesBound != 0u) {
+        const vec4 particles = texelFetch(particlesTexture, leader, 0);
+        if (isFinite(particles.rgb) && isFinite(particles.a)) {
+            const float coverage = clamp(particles.a, 0.0, 1.0);
+            r.radiance = max(particles.rgb, vec3(0.0)) + (1.0 - coverage) * r.radiance;
         }
     }
     return r;

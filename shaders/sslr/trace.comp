@@ -30,6 +30,10 @@ layout(set = 0, binding = 7) uniform writeonly image2D confidenceImage;
 layout(set = 0, binding = 8, rgba16f) uniform writeonly image2D hitDebugImage;
 layout(set = 0, binding = 9, scalar) writeonly buffer RtRays { PackedRay rtRays[]; };
 layout(set = 0, binding = 10, scalar) buffer RtArgs { uint rtArgs[]; };
+layout(set = 0, binding = 11) uniform sampler2D roughnessMetalTexture;
+// The lit colour's box-filtered mip chain (pyramid_*.comp), sampled
+// trilinearly by the cone trace.
+layout(set = 0, binding = 12) uniform sampler2D pyramidTexture;
 
 layout(push_constant, scalar) uniform Constants { SslrConstants pc; };
 
@@ -92,7 +96,21 @@ void main() {
     const ivec2 p = ivec2(pixel);
     const vec2 centre = vec2(pixel) + 0.5;
     const vec3 origin = viewPosition(centre, texelFetch(depthTexture, p, 0).x);
-    const vec3 direction = normalize(mat3(pc.view) * unpackRayDirection(ray.direction));
+    vec3 direction = normalize(mat3(pc.view) * unpackRayDirection(ray.direction));
+    // Cone trace for rough pixels (Far Cry 6 talk's rough tiles; Uludag,
+    // "Hi-Z Screen-Space Cone-Traced Reflections", GPU Pro 5): march the
+    // mirror direction and take the lobe's spread from the pyramid below,
+    // instead of one stochastic GGX direction per frame: the result is
+    // noise-free where it hits. (The RT list keeps the stochastic ray.)
+    const float roughness = texelFetch(roughnessMetalTexture, p, 0).x;
+    const bool cone = pc.pyramidMips > 0u && roughness >= pc.coneRoughness;
+    if (cone) {
+        const vec3 normalView = normalize(mat3(pc.view) * texelFetch(normalTexture, p, 0).xyz);
+        const vec3 mirror = reflect(normalize(origin), normalView);
+        if (dot(mirror, normalView) > 1e-3) {
+            direction = normalize(mirror);
+        }
+    }
 
     // Clip the ray in view space: no further than maxDistance, and in
     // front of the near plane (z = -P32 where depth is 1) so w stays > 0.
@@ -179,8 +197,26 @@ void main() {
     if (tHit >= 0.0) {
         hitUv = (vec2(hitTexel) + 0.5) / vec2(pc.size);
         radiance = texelFetch(litTexture, hitTexel, 0).rgb;
-        // Back faces: the hit surface must face the ray (world normals).
-        const vec3 worldDirection = unpackRayDirection(ray.direction);
+        if (cone) {
+            // The GGX lobe around the mirror direction falls to half its
+            // peak at tan(theta_h) = alpha sqrt(sqrt(2) - 1) ~ 0.64 alpha
+            // for the half vector, twice that for the reflected ray. Its
+            // diameter where the ray meets the surface, d * 2 tan, in that
+            // depth's pixels, is the footprint; the pyramid level whose
+            // texels span it holds the lobe's mean colour.
+            const float alpha = roughness * roughness;
+            const float hitDepth = texelFetch(depthTexture, hitTexel, 0).x;
+            const vec3 hitPosition = viewPosition(vec2(hitTexel) + 0.5, hitDepth);
+            const float distance = length(hitPosition - origin);
+            const float pixelsPerUnit = 0.5 * abs(pc.projection.y) * float(pc.size.y) / max(-hitPosition.z, 1e-6);
+            const float footprint = 2.0 * 1.287 * alpha * distance * pixelsPerUnit;
+            const float mip = clamp(log2(max(footprint, 1.0)), 0.0, float(pc.pyramidMips - 1u));
+            radiance = textureLod(pyramidTexture, hitUv, mip).rgb;
+        }
+        // Back faces: the hit surface must face the ray (world normals; the
+        // view matrix is a rotation and translation, so its inverse
+        // rotation is the transpose).
+        const vec3 worldDirection = cone ? transpose(mat3(pc.view)) * direction : unpackRayDirection(ray.direction);
         const vec3 hitNormal = texelFetch(normalTexture, hitTexel, 0).xyz;
         const float facing = dot(hitNormal, worldDirection) < 0.0 ? 1.0 : 0.0;
         // Fade near the border, where neighbouring rays start to leave the

@@ -198,10 +198,46 @@ glm::vec2 wallPixel(glm::vec2 hit) {
     return {(ndcX * 0.5f + 0.5f) * float(kSize), (ndcY * 0.5f + 0.5f) * float(kSize)};
 }
 
-SslrFrame trace(test::GpuTest& gpu, uint64_t frame, const passes::SslrSettings& settings = {},
-               float wallRoughness = 1.0f) {
+// A floor of the given roughness (metallic) facing a wall of vertical red
+// and green stripes kStripeWidth wide at the same place as mirrorScene's.
+constexpr float kStripeWidth = 0.1f;
+
+scene::Scene stripedScene(float floorRoughness) {
+    scene::Scene s;
+    s.name = "sslr-cone-test";
+    scene::Material floor;
+    floor.roughnessFactor = floorRoughness;
+    floor.metallicFactor = 1.0f;
+    scene::Material red, green;
+    red.baseColorFactor = {0.9f, 0.0f, 0.0f, 1.0f};
+    green.baseColorFactor = {0.0f, 0.9f, 0.0f, 1.0f};
+    red.roughnessFactor = green.roughnessFactor = 1.0f;
+    red.metallicFactor = green.metallicFactor = 0.0f;
+    s.materials = {floor, red, green};
+    scene::Mesh mesh;
+    mesh.name = "floor-and-stripes";
+    scene::MeshLod lod;
+    lod.geometries.push_back(square({0, -1, -500}, {1, 0, 0}, {0, 0, -1}, 500.0f, 0));
+    const float half = 0.5f * (kWallTop + 1.0f);
+    for (int i = -120; i < 120; ++i) {
+        scene::Geometry g = square({(float(i) + 0.5f) * kStripeWidth, -1 + half, -kWallDistance}, {1, 0, 0}, {0, 1, 0},
+                                   half, i % 2 == 0 ? 1u : 2u);
+        // Squeeze the square to a stripe around its centre.
+        for (glm::vec3& p : g.positions) p.x = (float(i) + 0.5f) * kStripeWidth + (p.x - (float(i) + 0.5f) * kStripeWidth) * kStripeWidth / (2.0f * half);
+        lod.geometries.push_back(std::move(g));
+    }
+    mesh.lods.push_back(std::move(lod));
+    s.meshes.push_back(std::move(mesh));
+    scene::Instance inst;
+    inst.name = "floor-and-stripes";
+    s.instances.push_back(inst);
+    scene::prepareScene(s);
+    return s;
+}
+
+SslrFrame traceScene(test::GpuTest& gpu, const scene::Scene& scene, uint64_t frame, const passes::SslrSettings& settings,
+                     float roughnessCutoff = passes::RayGenerationSettings{}.roughnessCutoff) {
     auto& ctx = gpu.ctx();
-    const scene::Scene scene = mirrorScene(wallRoughness);
     rg::Executor executor(ctx);
     passes::GBufferRenderer renderer(ctx, scene);
     passes::RayGenerationPipelines rayPipelines(ctx);
@@ -212,6 +248,7 @@ SslrFrame trace(test::GpuTest& gpu, uint64_t frame, const passes::SslrSettings& 
     passes::RayGenerationSettings raySettings;
     raySettings.rtMaxDistance = 0.0f;
     raySettings.sslrMinDistance = 1e9f;
+    raySettings.roughnessCutoff = roughnessCutoff;
     rg::Graph graph(executor.queueCaps());
     rg::FrameResources resources;
     const passes::GBufferOutputs gbuf = passes::addGBufferPass(graph, renderer, {camera});
@@ -226,6 +263,11 @@ SslrFrame trace(test::GpuTest& gpu, uint64_t frame, const passes::SslrSettings& 
     executor.run(plan, resources);
     executor.waitIdle();
     return readback.decode();
+}
+
+SslrFrame trace(test::GpuTest& gpu, uint64_t frame, const passes::SslrSettings& settings = {},
+               float wallRoughness = 1.0f) {
+    return traceScene(gpu, mirrorScene(wallRoughness), frame, settings);
 }
 
 bool finite(glm::vec4 v) { return std::isfinite(v.x) && std::isfinite(v.y) && std::isfinite(v.z) && std::isfinite(v.w); }
@@ -360,4 +402,40 @@ TEST_CASE("rays from a mirror wall back toward the camera leave the screen with 
         }
     }
     CHECK(checked >= 3 * kSize);
+}
+
+TEST_CASE("rough pixels cone-trace: their reflection of thin stripes is the stripes' mean, a mirror's is one stripe") {
+    test::GpuTest gpu;
+    // The share of confident floor hits whose colour mixes both stripes
+    // (the weaker channel at least a quarter of the stronger).
+    const auto mixedShare = [](const SslrFrame& f) {
+        uint32_t hits = 0, mixed = 0;
+        for (uint32_t y = kSize / 2 + 1; y < kSize; ++y) {
+            for (uint32_t x = 0; x < kSize; ++x) {
+                const size_t i = f.at(x, y);
+                if (f.confidence[i] < 0.9f || f.radiance[i].a < 0.5f) continue;
+                const float r = f.radiance[i].r, g = f.radiance[i].g;
+                if (std::max(r, g) < 0.02f) continue;  // not the wall
+                ++hits;
+                mixed += std::min(r, g) >= 0.25f * std::max(r, g) ? 1u : 0u;
+            }
+        }
+        REQUIRE(hits > 100);
+        return double(mixed) / double(hits);
+    };
+    passes::SslrSettings cone;
+    passes::SslrSettings noCone;
+    noCone.coneTrace = false;
+    // Rough (0.4, alpha 0.16, traced: the cutoff is raised for the test):
+    // the lobe's footprint on the wall spans several pixels of stripes half
+    // a pixel wide, so the cone trace's pyramid sample mixes them, while a
+    // stochastic ray reads one texel of one stripe.
+    const double coneRough = mixedShare(traceScene(gpu, stripedScene(0.4f), 3, cone, 0.5f));
+    const double plainRough = mixedShare(traceScene(gpu, stripedScene(0.4f), 3, noCone, 0.5f));
+    // A mirror (below coneRoughness) reads single texels either way.
+    const double mirror = mixedShare(traceScene(gpu, stripedScene(0.0f), 3, cone));
+    INFO("mixed shares: cone " << coneRough << ", without cone " << plainRough << ", mirror " << mirror);
+    CHECK(coneRough > 0.8);
+    CHECK(plainRough < 0.4);
+    CHECK(mirror < 0.4);
 }

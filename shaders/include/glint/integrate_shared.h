@@ -44,6 +44,24 @@ GLINT_FUNC vec4 integrateSourceColour(uint source) {
     return vec4(0.0f, 0.0f, 0.0f, 1.0f);
 }
 
+// Which trace a traced pixel's reflection takes (issue 5, Far Cry 6 talk):
+// full SSLR confidence, SSLR alone; below it the more confident trace: a
+// ray-traced result is fully confident (its miss is the true environment),
+// so RT wins where it traced; else whatever SSLR found; else the
+// environment map. One definition: integrate picks its source with it and
+// the particle trace (passes/particles.h) its ray's length, so particles
+// are composited exactly up to the surface the reflection shows.
+GLINT_CONST uint kTraceNone = 0u;
+GLINT_CONST uint kTraceSslr = 1u;
+GLINT_CONST uint kTraceRt = 2u;
+
+GLINT_FUNC uint chooseReflectionTrace(float sslrConfidence, float confidenceThreshold, bool rtTraced) {
+    if (sslrConfidence >= confidenceThreshold) return kTraceSslr;
+    if (rtTraced) return kTraceRt;
+    if (sslrConfidence > 0.0f) return kTraceSslr;
+    return kTraceNone;
+}
+
 // Per-frame constants (a storage buffer: with the lighting they outgrow the
 // 128 bytes of push constants every device has; 192 bytes).
 struct IntegrateConstants {
@@ -53,7 +71,7 @@ struct IntegrateConstants {
     uvec2 size;                  // pixels
     uvec2 tiles;                 // 8x8 tiles in x and y
     float confidenceThreshold;   // SSLR confidence that counts as a hit
-    uint pad0;
+    uint particlesBound;         // 1: composite the particle trace (passes/particles.h) over the reflection
     uint pad1;
     uint pad2;
 };

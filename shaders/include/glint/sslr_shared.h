@@ -33,10 +33,20 @@ struct SslrConstants {
     float maxDistance;
     float edgeFade;
     float confidenceThreshold;
+    float coneRoughness;  // perceptual roughness from which the cone trace runs
+    uint pyramidMips;     // levels of the colour pyramid; 0: no cone trace
     uint pad0;
-    uint pad1;
-    uint pad2;
 };
+
+// Push constants of pyramid_down.comp.
+struct SslrPyramidConstants {
+    uvec2 sourceSize;
+    uvec2 targetSize;
+};
+
+// The pyramid stops at 2^(kSslrPyramidMaxMips - 1) pixels per texel: wider
+// footprints belong to pixels rougher than the cutoff, which trace nothing.
+GLINT_CONST uint kSslrPyramidMaxMips = 8u;
 
 GLINT_END
 

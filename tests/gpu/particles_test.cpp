@@ -1,0 +1,574 @@
+// Particles in the reflections (passes/particles.h, the particle TLAS of
+// passes/bvh_update.h) on a real device, validation on, behind the real
+// G-buffer, BVH update, ray generation, SSLR, ray tracer and integrate.
+// The scene: a mirror floor at y = -1, a wall at z = -6 that the floor
+// reflects, particle A floating in front of the wall (so the floor's
+// reflection shows it) and particle B behind the wall (its reflection
+// would show on the floor but the wall hides it). The camera looks down -Z
+// from the origin, so the quads face +Z. A CPU reference intersects each
+// floor pixel's mirror ray with A's quad and evaluates the coverage the
+// shaders evaluate (glint/particles_shared.h).
+#include "support/gpu_test.h"
+#include "support/pass_test_scene.h"
+
+#include "gpu/error.h"
+#include "graph/executor.h"
+#include "graph/graph.h"
+#include "graph/verify.h"
+#include "passes/bvh_update.h"
+#include "passes/gbuffer.h"
+#include "passes/integrate.h"
+#include "passes/lighting.h"
+#include "passes/particles.h"
+#include "passes/ray_generation.h"
+#include "passes/rt_trace.h"
+#include "passes/sslr.h"
+#include "scene/animation.h"
+#include "scene/builtin_scenes.h"
+#include "scene/bvh_planner.h"
+
+#include "glint/particles_shared.h"
+#include "glint/ray_generation_shared.h"
+
+#include <glm/gtc/packing.hpp>
+
+#include <algorithm>
+#include <cmath>
+#include <cstring>
+#include <optional>
+#include <string>
+#include <vector>
+
+using namespace glint;
+
+namespace {
+
+constexpr uint32_t kSize = test::kPassTestSize;
+constexpr size_t kPixels = size_t(kSize) * kSize;
+using test::square;
+
+constexpr float kFloorY = -1.0f;
+constexpr float kWallZ = -6.0f;
+// A: in front of the wall, reflected by the floor around pixel (32, 44).
+const scene::Particle kParticleA{{0.0f, -0.4f, -4.0f}, 0.5f, {1.0f, 0.5f, 0.25f, 0.8f}};
+// B: behind the wall; the floor around pixel (38, 42) would reflect it,
+// but its reflected rays meet the wall mid-height first (on screen, so
+// SSLR finds the wall too).
+const scene::Particle kParticleB{{1.5f, 0.5f, -8.0f}, 0.5f, {0.2f, 0.4f, 1.0f, 0.9f}};
+
+scene::Scene mirrorScene(bool withParticles) {
+    scene::Scene s;
+    s.name = "particles-test";
+    scene::Material mirror;
+    mirror.baseColorFactor = {0.9f, 0.9f, 0.9f, 1.0f};
+    mirror.metallicFactor = 1.0f;
+    mirror.roughnessFactor = 0.0f;
+    scene::Material wall;
+    wall.baseColorFactor = {0.5f, 0.5f, 0.5f, 1.0f};
+    wall.metallicFactor = 0.0f;
+    wall.roughnessFactor = 1.0f;  // rougher than the cutoff: no rays leave it
+    s.materials = {mirror, wall};
+    scene::Mesh floor;
+    floor.name = "floor";
+    floor.lods.push_back({{square({0, kFloorY, -8}, {1, 0, 0}, {0, 0, -1}, 8.0f, 0)}});
+    scene::Mesh wallMesh;
+    wallMesh.name = "wall";
+    wallMesh.lods.push_back({{square({0, 3, kWallZ}, {1, 0, 0}, {0, 1, 0}, 4.0f, 1)}});
+    s.meshes = {floor, wallMesh};
+    scene::Instance a;
+    a.name = "floor";
+    a.mesh = 0;
+    scene::Instance b;
+    b.name = "wall";
+    b.mesh = 1;
+    s.instances = {a, b};
+    if (withParticles) {
+        s.particles = {kParticleA, kParticleB};
+    }
+    scene::prepareScene(s);
+    return s;
+}
+
+size_t pixelIndex(uint32_t x, uint32_t y) { return size_t(y) * kSize + x; }
+
+// The floor point seen at pixel (x, y) and the CPU's expected particle
+// coverage and radiance along its mirror ray (A only: B is behind the wall).
+struct Expected {
+    bool floor = false;
+    glm::vec4 particles{0.0f};
+};
+
+Expected expectedAt(const scene::Camera& camera, uint32_t x, uint32_t y) {
+    Expected e;
+    const glm::mat4 inv = glm::inverse(camera.viewProjection());
+    const glm::vec2 ndc = test::pixelNdc(x, y);
+    const glm::vec4 a = inv * glm::vec4(ndc, 1.0f, 1.0f);
+    const glm::vec4 b = inv * glm::vec4(ndc, 0.5f, 1.0f);
+    const glm::vec3 origin = glm::vec3(a) / a.w;
+    const glm::vec3 dir = glm::normalize(glm::vec3(b) / b.w - origin);
+    if (dir.y >= -1e-4f) return e;
+    const float s = (kFloorY - origin.y) / dir.y;
+    const glm::vec3 p = origin + s * dir;
+    if (p.z < kWallZ || std::abs(p.x) > 8.0f) return e;
+    e.floor = true;
+    const glm::vec3 r = glm::reflect(dir, glm::vec3(0, 1, 0));
+    // A's quad: the plane z = A.z (it faces the camera, which looks down -Z).
+    const float t = (kParticleA.position.z - p.z) / r.z;
+    if (t <= 0.0f) return e;
+    const glm::vec3 q = p + t * r;
+    const shader::ParticleData particle{kParticleA.position, kParticleA.radius, kParticleA.color};
+    const float coverage = shader::particleCoverageAt(particle, q);
+    e.particles = glm::vec4(glm::vec3(kParticleA.color) * coverage, coverage);
+    return e;
+}
+
+// ---------------------------------------------------------------------------
+// One frame of the reflection passes with the particle trace
+// ---------------------------------------------------------------------------
+
+struct Frame {
+    std::vector<glm::vec4> particles;           // the trace's output
+    std::vector<std::array<uint16_t, 4>> particleBits;
+    std::vector<glm::vec4> untraced;            // the trace with no traces bound (every reflection a miss)
+    std::vector<glm::vec4> reflection;          // integrate with particles
+    std::vector<glm::vec4> reflectionAlone;     // integrate without
+    std::vector<glm::vec4> litBefore, litAfter;  // around the forward pass
+    passes::BvhGpuStats bvh;
+    bool traced = false;
+};
+
+class Rig {
+public:
+    Rig(gpu::Context& ctx, scene::Scene s)
+        : ctx_(ctx),
+          scene_(std::move(s)),
+          camera_(test::testCamera()),
+          executor_(ctx),
+          renderer_(ctx, scene_),
+          bvh_(ctx, scene_),
+          rays_(ctx),
+          sslr_(ctx),
+          rt_(ctx),
+          integrate_(ctx),
+          particles_(ctx) {
+        for (auto& b : readbacks_) {
+            b = gpu::Buffer(ctx, {kPixels * 8, VK_BUFFER_USAGE_TRANSFER_DST_BIT, gpu::MemoryUsage::Readback,
+                                  "particles_test.readback"});
+        }
+    }
+
+    const scene::Camera& camera() const { return camera_; }
+    passes::ParticlePipelines& particles() { return particles_; }
+
+    Frame run(passes::ReflectionMode mode, passes::RtBackend backend) {
+        // A backend switch changes the trace's shader stages; the graph
+        // orders frames as if they ran the same plan (passes/rt_trace.h).
+        ctx_.waitIdle();
+        rg::Graph graph(executor_.queueCaps());
+        rg::FrameResources resources;
+        const scene::BvhPlan plan = planner_.plan(scene_, camera_.position, frame_++);
+        const passes::BvhUpdateOutputs bvh = passes::addBvhUpdatePass(graph, bvh_, plan, camera_);
+        bvh_.bind(resources, bvh);
+        const passes::GBufferOutputs gbuf = passes::addGBufferPass(graph, renderer_, {camera_});
+        passes::RayGenerationSettings raySettings;
+        raySettings.mode = mode;
+        const passes::RayGenerationOutputs rays =
+            passes::addRayGenerationPass(graph, rays_, {gbuf, frame_, camera_, {}}, raySettings);
+        std::optional<passes::SslrOutputs> sslr;
+        if (mode != passes::ReflectionMode::Rt) {
+            sslr = passes::addSslrPass(graph, sslr_, {gbuf, rays, frame_, camera_.view, camera_.projection});
+        }
+        std::optional<passes::RtTraceOutputs> rt;
+        const shader::SceneLighting lighting = passes::sceneLighting(scene_);
+        if (mode != passes::ReflectionMode::Ssr) {
+            rt = passes::addRtTracePass(graph, rt_,
+                                        {gbuf, sslr ? sslr->rtRayList : rays.rtRays, sslr ? sslr->rtArgs : rays.rtArgs,
+                                         bvh, lighting, camera_, frame_});
+        }
+        Frame f;
+        f.traced = passes::particlesTraced(bvh);
+        std::vector<std::pair<rg::Texture, std::vector<glm::vec4>*>> reads;
+        passes::IntegrateInputs integrateInputs;
+        integrateInputs.gbuffer = gbuf;
+        integrateInputs.rays = rays;
+        integrateInputs.sslr = sslr;
+        if (rt) {
+            integrateInputs.rtRadiance = rt->radiance;
+            integrateInputs.rtHitDistance = rt->hitDistance;
+        }
+        integrateInputs.lighting = lighting;
+        integrateInputs.camera = camera_;
+        const passes::IntegrateOutputs alone = passes::addIntegratePass(graph, integrate_, integrateInputs);
+        reads.push_back({alone.radiance, &f.reflectionAlone});
+        rg::Texture particleRadiance;
+        if (f.traced) {
+            passes::ParticleTraceInputs in;
+            in.gbuffer = gbuf;
+            in.rays = rays;
+            in.sslr = sslr;
+            if (rt) {
+                in.rtRadiance = rt->radiance;
+                in.rtHitDistance = rt->hitDistance;
+            }
+            in.bvh = bvh;
+            in.camera = camera_;
+            passes::ParticleTraceSettings settings;
+            settings.backend = backend;
+            particleRadiance = passes::addParticleTracePass(graph, particles_, in, settings).radiance;
+            reads.push_back({particleRadiance, &f.particles});
+            // The same rays with no trace to end them: every reflection a
+            // miss, so they reach past the wall.
+            passes::ParticleTraceInputs unbounded = in;
+            unbounded.sslr.reset();
+            unbounded.rtRadiance = unbounded.rtHitDistance = rg::Texture{};
+            const rg::Texture untraced = passes::addParticleTracePass(graph, particles_, unbounded, settings).radiance;
+            reads.push_back({untraced, &f.untraced});
+            integrateInputs.particles = particleRadiance;
+            reads.push_back({passes::addIntegratePass(graph, integrate_, integrateInputs).radiance, &f.reflection});
+        }
+        // The lit colour before and after the forward pass.
+        addReadback(graph, gbuf.lit, 0, resources);
+        const passes::ParticleForwardOutputs forward =
+            passes::addParticleForwardPass(graph, particles_, {gbuf, scene_.particles, camera_});
+        addReadback(graph, forward.lit, 1, resources);
+        uint32_t slot = 2;
+        for (const auto& [texture, target] : reads) addReadback(graph, texture, slot++, resources);
+
+        const rg::Plan compiled = graph.compile(executor_.compileOptions());
+        const auto report = rg::verify(compiled);
+        REQUIRE_MESSAGE(report.ok(), report.text());
+        executor_.run(compiled, resources);
+        executor_.waitIdle();
+        ctx_.waitIdle();
+
+        f.litBefore = unpack(0);
+        f.litAfter = unpack(1);
+        slot = 2;
+        for (const auto& [texture, target] : reads) {
+            if (texture == particleRadiance) {
+                f.particleBits.resize(kPixels);
+                std::memcpy(f.particleBits.data(), readbacks_[slot].mapped(), kPixels * 8);
+            }
+            *target = unpack(slot++);
+        }
+        f.bvh = bvh_.stats();
+        return f;
+    }
+
+private:
+    std::vector<glm::vec4> unpack(uint32_t slot) const {
+        std::vector<glm::vec4> out(kPixels);
+        const auto* bits = reinterpret_cast<const uint16_t*>(readbacks_[slot].mapped());
+        for (size_t i = 0; i < kPixels; ++i) {
+            for (int c = 0; c < 4; ++c) out[i][c] = glm::unpackHalf1x16(bits[4 * i + c]);
+        }
+        return out;
+    }
+
+    // Copies an RGBA16F texture into readback slot `slot` inside the graph.
+    void addReadback(rg::Graph& graph, rg::Texture texture, uint32_t slot, rg::FrameResources& resources) {
+        REQUIRE(slot < readbacks_.size());
+        const rg::BoundaryState lastCopy = rg::BoundaryState::of(rg::Access::TransferDst);
+        const rg::BoundaryState hostRead = rg::BoundaryState::raw(VK_PIPELINE_STAGE_2_HOST_BIT,
+                                                                  VK_ACCESS_2_HOST_READ_BIT, VK_IMAGE_LAYOUT_UNDEFINED);
+        const std::string name = "particles_test.readback" + std::to_string(slot);
+        const rg::Buffer target = graph.importBuffer(name, {{readbacks_[slot].size()}, lastCopy, hostRead});
+        resources.bind(target, readbacks_[slot]);
+        struct Data {
+            rg::Texture source;
+            rg::Buffer target;
+        };
+        const Data& data = graph.addPass<Data>(
+            name, rg::Queue::Graphics,
+            [&](rg::Builder& b, Data& d) {
+                d.source = b.read(texture, rg::Access::TransferSrc);
+                d.target = b.write(target, rg::Access::TransferDst);
+            },
+            [](const Data& d, rg::PassContext& pc) {
+                const gpu::Image& image = pc.image(d.source);
+                VkBufferImageCopy region{};
+                region.imageSubresource = {image.aspect(), 0, 0, 1};
+                region.imageExtent = {kSize, kSize, 1};
+                vkCmdCopyImageToBuffer(pc.cmd(), image.handle(), VK_IMAGE_LAYOUT_TRANSFER_SRC_OPTIMAL,
+                                       pc.buffer(d.target).handle(), 1, &region);
+            });
+        graph.markOutput(data.target);
+    }
+
+    gpu::Context& ctx_;
+    scene::Scene scene_;
+    scene::Camera camera_;
+    rg::Executor executor_;
+    passes::GBufferRenderer renderer_;
+    passes::BvhManager bvh_;
+    scene::BvhPlanner planner_;
+    passes::RayGenerationPipelines rays_;
+    passes::SslrPipelines sslr_;
+    passes::RtTracePipelines rt_;
+    passes::IntegratePipelines integrate_;
+    passes::ParticlePipelines particles_;
+    std::array<gpu::Buffer, 8> readbacks_;
+    uint64_t frame_ = 1;
+};
+
+std::vector<passes::RtBackend> availableBackends(const gpu::Context& ctx) {
+    std::vector<passes::RtBackend> out;
+    for (const passes::RtBackend b : {passes::RtBackend::RayQuery, passes::RtBackend::Pipeline}) {
+        if (passes::ParticlePipelines::supported(ctx, b)) out.push_back(b);
+    }
+    return out;
+}
+
+std::string text(glm::vec4 v) {
+    return "(" + std::to_string(v.x) + ", " + std::to_string(v.y) + ", " + std::to_string(v.z) + ", " +
+           std::to_string(v.w) + ")";
+}
+
+bool near(glm::vec4 a, glm::vec4 b, float tolerance) {
+    return glm::all(glm::lessThanEqual(glm::abs(a - b), glm::vec4(tolerance)));
+}
+
+// B's mirror image seen on the floor: the pixel whose reflected ray passes
+// nearest B's centre (the mirror camera at (0, -2, 0) through B).
+glm::uvec2 mirrorPixelOf(const scene::Camera& camera, glm::vec3 particle) {
+    const glm::vec3 mirrorEye(0.0f, 2.0f * kFloorY, 0.0f);
+    const float s = (kFloorY - mirrorEye.y) / (particle.y - mirrorEye.y);
+    const glm::vec3 floorPoint = mirrorEye + s * (particle - mirrorEye);
+    const glm::vec4 clip = camera.viewProjection() * glm::vec4(floorPoint, 1.0f);
+    const glm::vec2 ndc = glm::vec2(clip) / clip.w;
+    return glm::uvec2((ndc * 0.5f + 0.5f) * float(kSize));
+}
+
+} // namespace
+
+TEST_CASE("a particle in front of a mirror tints exactly the reflected rays through it, with its colour and coverage") {
+    test::GpuTest gpu;
+    auto& ctx = gpu.ctx();
+    const auto backends = availableBackends(ctx);
+    REQUIRE_FALSE(backends.empty());
+    Rig rig(ctx, mirrorScene(true));
+    for (const passes::RtBackend backend : backends) {
+        const std::string backendName = passes::rtBackendName(backend);
+        CAPTURE(backendName);
+        const Frame f = rig.run(passes::ReflectionMode::Rt, backend);
+        REQUIRE(f.traced);
+        uint32_t floorPixels = 0, covered = 0, uncovered = 0, wrong = 0;
+        float peak = 0.0f;
+        for (uint32_t y = 0; y < kSize; ++y) {
+            for (uint32_t x = 0; x < kSize; ++x) {
+                const size_t i = pixelIndex(x, y);
+                const Expected e = expectedAt(rig.camera(), x, y);
+                const glm::vec4 got = f.particles[i];
+                if (!e.floor) {
+                    // The wall and the sky trace no rays: no particles.
+                    if (got != glm::vec4(0.0f) && wrong++ < 5) {
+                        MESSAGE("off-floor pixel " << x << "," << y << ": " << text(got));
+                    }
+                    continue;
+                }
+                ++floorPixels;
+                // Half-float output; the GPU reconstructs from depth and
+                // packs the ray's direction (16-bit octahedral).
+                if (!near(got, e.particles, 0.02f) && wrong++ < 5) {
+                    MESSAGE("pixel " << x << "," << y << ": " << text(got) << " vs " << text(e.particles));
+                }
+                if (e.particles.a == 0.0f) {
+                    ++uncovered;
+                    if (got != glm::vec4(0.0f) && wrong++ < 5) {
+                        MESSAGE("miss pixel " << x << "," << y << ": " << text(got));
+                    }
+                } else {
+                    ++covered;
+                }
+                peak = std::max(peak, got.a);
+                // Premultiplied: rgb = colour * coverage.
+                CHECK(near(glm::vec4(glm::vec3(got), 0.0f),
+                           glm::vec4(glm::vec3(kParticleA.color) * got.a, 0.0f), 2e-3f + 2e-3f * got.a));
+            }
+        }
+        MESSAGE(floorPixels << " floor pixels, " << covered << " see A, " << uncovered << " see no particle");
+        CHECK(wrong == 0);
+        CHECK(covered > 10);
+        CHECK(uncovered > 200);
+        // The ray nearest A's centre sees nearly its full alpha.
+        CHECK(peak > 0.95f * kParticleA.color.a);
+        CHECK(peak <= kParticleA.color.a + 1e-3f);
+
+        // Integrate composites it over the reflection: p.rgb + (1 - p.a) * reflection.
+        uint32_t compositeErrors = 0;
+        for (size_t i = 0; i < kPixels; ++i) {
+            const glm::vec4 p = f.particles[i];
+            const glm::vec3 expected = glm::vec3(p) + (1.0f - p.a) * glm::vec3(f.reflectionAlone[i]);
+            const glm::vec3 got = glm::vec3(f.reflection[i]);
+            const float tolerance = 2e-3f * std::max(1.0f, glm::length(expected));
+            if (glm::any(glm::greaterThan(glm::abs(got - expected), glm::vec3(tolerance)))) {
+                if (compositeErrors++ < 5) {
+                    MESSAGE("composite at " << i << ": " << text(f.reflection[i]) << " vs "
+                                            << text(glm::vec4(expected, 0.0f)));
+                }
+            }
+            CHECK(f.reflection[i].a == f.reflectionAlone[i].a);
+        }
+        CHECK(compositeErrors == 0);
+    }
+}
+
+TEST_CASE("particles behind the reflected surface are not composited; without a trace to end the ray they would be") {
+    test::GpuTest gpu;
+    auto& ctx = gpu.ctx();
+    Rig rig(ctx, mirrorScene(true));
+    const glm::uvec2 b = mirrorPixelOf(rig.camera(), kParticleB.position);
+    REQUIRE(expectedAt(rig.camera(), b.x, b.y).floor);
+    // RT mode (the ray tracer's hit distance) and SSR mode (SSLR's): both
+    // end the reflection at the wall.
+    for (const passes::ReflectionMode mode : {passes::ReflectionMode::Rt, passes::ReflectionMode::Ssr,
+                                              passes::ReflectionMode::Hybrid}) {
+        CAPTURE(int(mode));
+        const Frame f = rig.run(mode, passes::RtBackend::Auto);
+        const size_t i = pixelIndex(b.x, b.y);
+        MESSAGE("B's mirror pixel " << b.x << "," << b.y << ": " << text(f.particles[i]) << ", unbounded "
+                                    << text(f.untraced[i]));
+        CHECK(f.particles[i] == glm::vec4(0.0f));
+        CHECK(f.untraced[i].a > 0.5f * kParticleB.color.a);
+        // A, in front of the wall, is seen whichever trace resolved the floor.
+        const glm::uvec2 a = mirrorPixelOf(rig.camera(), kParticleA.position);
+        CHECK(f.particles[pixelIndex(a.x, a.y)].a > 0.9f * kParticleA.color.a);
+    }
+}
+
+TEST_CASE("the ray query and the ray tracing pipeline particle traces are bit-identical") {
+    test::GpuTest gpu;
+    auto& ctx = gpu.ctx();
+    if (availableBackends(ctx).size() < 2) {
+        MESSAGE("device '" << ctx.caps().deviceName << "' has one backend; nothing to compare");
+        return;
+    }
+    Rig rig(ctx, mirrorScene(true));
+    for (const passes::ReflectionMode mode : {passes::ReflectionMode::Rt, passes::ReflectionMode::Hybrid}) {
+        const Frame query = rig.run(mode, passes::RtBackend::RayQuery);
+        const Frame pipeline = rig.run(mode, passes::RtBackend::Pipeline);
+        uint32_t differing = 0, covered = 0;
+        for (size_t i = 0; i < kPixels; ++i) {
+            if (query.particleBits[i] != pipeline.particleBits[i] && differing++ < 5) {
+                MESSAGE("pixel " << i << ": " << text(query.particles[i]) << " vs " << text(pipeline.particles[i]));
+            }
+            if (query.particles[i].a > 0.0f) ++covered;
+        }
+        CHECK(differing == 0);
+        CHECK(covered > 10);
+    }
+}
+
+TEST_CASE("a scene without particles builds no particle TLAS, buffer or dispatch, and needs no particle trace") {
+    test::GpuTest gpu;
+    auto& ctx = gpu.ctx();
+    {
+        Rig rig(ctx, mirrorScene(false));
+        const Frame f = rig.run(passes::ReflectionMode::Hybrid, passes::RtBackend::Auto);
+        CHECK_FALSE(f.traced);
+        CHECK(f.bvh.particleTlasBuilds == 0);
+        CHECK(f.bvh.particles == 0);
+        CHECK(f.bvh.particleDispatches == 0);
+        CHECK(f.bvh.particleBytes == 0);
+        // Nothing drawn: the forward pass declared nothing, the lit colour is untouched.
+        CHECK(f.litBefore == f.litAfter);
+    }
+    {
+        Rig rig(ctx, mirrorScene(true));
+        const Frame f = rig.run(passes::ReflectionMode::Hybrid, passes::RtBackend::Auto);
+        CHECK(f.traced);
+        CHECK(f.bvh.particleTlasBuilds == 1);
+        CHECK(f.bvh.particles == 2);
+        CHECK(f.bvh.particleDispatches == 1);
+        CHECK(f.bvh.particleBytes > 0);
+    }
+    // The trace refuses a BVH without a particle TLAS.
+    rg::Graph graph;
+    passes::ParticlePipelines pipelines(ctx);
+    passes::ParticleTraceInputs in;
+    in.gbuffer.width = in.gbuffer.height = in.rays.width = in.rays.height = kSize;
+    CHECK_THROWS_AS(passes::addParticleTracePass(graph, pipelines, in), gpu::GpuError);
+}
+
+TEST_CASE("the forward pass blends particles over the lit colour where the G-buffer's depth lets it") {
+    test::GpuTest gpu;
+    auto& ctx = gpu.ctx();
+    Rig rig(ctx, mirrorScene(true));
+    const Frame f = rig.run(passes::ReflectionMode::Hybrid, passes::RtBackend::Auto);
+    const scene::Camera& camera = rig.camera();
+    const auto pixelOf = [&](glm::vec3 p) {
+        const glm::vec4 clip = camera.viewProjection() * glm::vec4(p, 1.0f);
+        return glm::uvec2((glm::vec2(clip) / clip.w * 0.5f + 0.5f) * float(kSize));
+    };
+    // A, in front of the wall: its centre pixel is nearly alpha over the wall.
+    const glm::uvec2 a = pixelOf(kParticleA.position);
+    const size_t ia = pixelIndex(a.x, a.y);
+    const float r2 = [&] {
+        // The pixel centre's quad coordinates (A's quad is the plane z = A.z, facing the camera).
+        const glm::vec2 ndc = test::pixelNdc(a.x, a.y);
+        const float d = -kParticleA.position.z;  // 90-degree lens: x = ndc.x * d, y = -ndc.y * d
+        const glm::vec2 q = (glm::vec2(ndc.x * d, -ndc.y * d) - glm::vec2(kParticleA.position)) / kParticleA.radius;
+        return glm::dot(q, q);
+    }();
+    const float coverage = shader::particleCoverage(kParticleA.color.a, r2);
+    const glm::vec3 expected = glm::vec3(kParticleA.color) * coverage + (1.0f - coverage) * glm::vec3(f.litBefore[ia]);
+    MESSAGE("A's pixel " << a.x << "," << a.y << ": " << text(f.litBefore[ia]) << " -> " << text(f.litAfter[ia]));
+    CHECK(coverage > 0.5f);
+    CHECK(glm::all(glm::lessThanEqual(glm::abs(glm::vec3(f.litAfter[ia]) - expected),
+                                      glm::vec3(4e-3f * std::max(1.0f, glm::length(expected))))));
+    CHECK(f.litAfter[ia].a == f.litBefore[ia].a);
+    // B, behind the wall, is hidden by the depth test; pixels away from A untouched.
+    const glm::uvec2 b = pixelOf(kParticleB.position);
+    CHECK(f.litAfter[pixelIndex(b.x, b.y)] == f.litBefore[pixelIndex(b.x, b.y)]);
+    uint32_t changed = 0, changedFar = 0;
+    for (uint32_t y = 0; y < kSize; ++y) {
+        for (uint32_t x = 0; x < kSize; ++x) {
+            if (f.litAfter[pixelIndex(x, y)] == f.litBefore[pixelIndex(x, y)]) continue;
+            ++changed;
+            // A covers radius / distance * 32 = 4 pixels around its centre.
+            if (std::abs(int(x) - int(a.x)) > 5 || std::abs(int(y) - int(a.y)) > 5) ++changedFar;
+        }
+    }
+    CHECK(changed > 10);
+    CHECK(changedFar == 0);
+}
+
+TEST_CASE("the plaza's lamp glows get a particle TLAS rebuilt every frame, frames in flight, the camera moving") {
+    test::GpuTest gpu;
+    auto& ctx = gpu.ctx();
+    scene::Scene plaza = scene::makePlaza();
+    REQUIRE_FALSE(plaza.particles.empty());
+    rg::Executor executor(ctx);
+    passes::BvhManager bvh(ctx, plaza);
+    scene::BvhPlanner planner;
+    scene::Camera camera;
+    camera.resolution = {64, 48};
+    camera.lens = plaza.lens;
+    camera.reset(plaza.cameraPath.atFrame(0, 6), 0);
+    // No waits between frames: the per-slot particle uploads and instance
+    // buffers, and the every-frame rebuilds, run with frames in flight.
+    for (uint32_t frame = 0; frame < 6; ++frame) {
+        scene::advanceScene(plaza, 0.1 * frame);
+        camera.advance(plaza.cameraPath.atFrame(frame, 6), frame);
+        rg::Graph graph(executor.queueCaps());
+        const scene::BvhPlan plan = planner.plan(plaza, camera);
+        REQUIRE(plan.particleTlas);
+        const passes::BvhUpdateOutputs out = passes::addBvhUpdatePass(graph, bvh, plan, camera);
+        REQUIRE(passes::particlesTraced(out));
+        rg::FrameResources resources;
+        bvh.bind(resources, out);
+        executor.run(graph.compile(executor.compileOptions()), resources);
+        CHECK(bvh.stats().particleTlasBuilds == 1);
+        CHECK(bvh.stats().particles == plaza.particles.size());
+    }
+    executor.waitIdle();
+    // Without the camera the same manager builds no particle TLAS.
+    rg::Graph graph(executor.queueCaps());
+    const passes::BvhUpdateOutputs out = passes::addBvhUpdatePass(graph, bvh, planner.plan(plaza, camera.position, 99));
+    CHECK_FALSE(passes::particlesTraced(out));
+    CHECK(bvh.stats().particleTlasBuilds == 0);
+    rg::FrameResources resources;
+    bvh.bind(resources, out);
+    executor.run(graph.compile(executor.compileOptions()), resources);
+    executor.waitIdle();
+}
