@@ -1,0 +1,718 @@
+// glint-viewer: the reflection frame (passes/reflection_frame.h) in a window,
+// with a fly camera and an ImGui panel over the same settings structs
+// glint-render and the benchmark use.
+//
+// One frame:
+//   1. the render graph: the reflection frame, then "viewer.blit" copies its
+//      output into the viewer's target image and "viewer.imgui" draws the
+//      panel over it; executor.run() submits it.
+//   2. our own small submission copies the target into the acquired
+//      swapchain image, waiting for the acquire semaphore and signalling the
+//      present semaphore, then vkQueuePresentKHR.
+//
+// Why the second step, rather than importing the swapchain image into the
+// graph: the executor submits its batches with its own timeline semaphores
+// only (graph/executor.h), so it cannot wait for an acquire semaphore or
+// signal a present one, and gpu::Image cannot wrap an image it did not
+// create. The target is an ordinary image the graph imports (entering and
+// leaving in TransferSrc, the state our copy reads it in); the copy is
+// later in submission order on the same graphics queue, so the graph's
+// final barrier covers it, and the next frame's first barrier orders its
+// blit after our copy. The cost is one full-screen copy.
+//
+// Colour: the output's bytes are sRGB-encoded; they travel unchanged
+// (UNORM to UNORM blit, raw copy), see swapchain.h.
+
+#include "common/app.h"
+#include "common/reflection_run.h"
+#include "gpu/commands.h"
+#include "gpu/error.h"
+#include "graph/executor.h"
+#include "graph/graph.h"
+#include "graph/verify.h"
+#include "imgui_layer.h"
+#include "present_passes.h"
+#include "scene/animation.h"
+#include "scene/builtin_scenes.h"
+#include "swapchain.h"
+#include "viewer_model.h"
+
+#include "glint/reflection_frame_shared.h"
+
+#define GLFW_INCLUDE_NONE
+#include <GLFW/glfw3.h>
+#include <imgui.h>
+#include <spdlog/spdlog.h>
+
+#include <glm/gtc/matrix_transform.hpp>
+
+#include <algorithm>
+#include <array>
+#include <cstring>
+#include <memory>
+#include <optional>
+
+using namespace glint;
+
+namespace {
+
+constexpr uint32_t kFramesInFlight = 2;
+// The stage our copy waits for the acquired image at; its first barrier
+// starts from the same stage, so the layout transition follows the wait.
+constexpr VkPipelineStageFlags2 kAcquireWaitStage = VK_PIPELINE_STAGE_2_ALL_TRANSFER_BIT;
+// The stage the present semaphore is signalled after; the last barrier on
+// the swapchain image ends at it.
+constexpr VkPipelineStageFlags2 kPresentSignalStage = VK_PIPELINE_STAGE_2_ALL_COMMANDS_BIT;
+
+// ---- GLFW: the library and one window
+
+std::string& glfwLastError() {
+    static std::string text;
+    return text;
+}
+
+void onGlfwError(int code, const char* text) {
+    glfwLastError() = text ? std::string(text) : "GLFW error " + std::to_string(code);
+}
+
+class Window {
+public:
+    Window(const char* title, uint32_t width, uint32_t height) {
+        glfwSetErrorCallback(onGlfwError);
+        // No display (CI, ssh): glfwInit fails and says why; that becomes
+        // the executable's one-line error.
+        if (!glfwInit()) {
+            throw std::runtime_error("cannot open a window: " + glfwLastError() +
+                                     " (glint-viewer needs a display; glint-render renders without one)");
+        }
+        if (!glfwVulkanSupported()) {
+            glfwTerminate();
+            throw std::runtime_error("cannot open a window: GLFW finds no Vulkan loader or no window-system "
+                                     "support in it (scripts/setup installs the loader)");
+        }
+        glfwWindowHint(GLFW_CLIENT_API, GLFW_NO_API);
+        window_ = glfwCreateWindow(int(width), int(height), title, nullptr, nullptr);
+        if (!window_) {
+            glfwTerminate();
+            throw std::runtime_error("cannot open a window: " + glfwLastError());
+        }
+        // Keys are polled once a frame; sticky keys keep a tap shorter than
+        // a frame (a CPU device renders a few a second) from being lost.
+        glfwSetInputMode(window_, GLFW_STICKY_KEYS, GLFW_TRUE);
+    }
+    ~Window() {
+        glfwDestroyWindow(window_);
+        glfwTerminate();
+    }
+    Window(const Window&) = delete;
+    Window& operator=(const Window&) = delete;
+
+    GLFWwindow* handle() const { return window_; }
+
+    std::vector<std::string> instanceExtensions() const {
+        uint32_t count = 0;
+        const char** names = glfwGetRequiredInstanceExtensions(&count);
+        return std::vector<std::string>(names, names + count);
+    }
+    VkExtent2D framebufferSize() const {
+        int w = 0, h = 0;
+        glfwGetFramebufferSize(window_, &w, &h);
+        return {uint32_t(std::max(w, 0)), uint32_t(std::max(h, 0))};
+    }
+
+private:
+    GLFWwindow* window_ = nullptr;
+};
+
+// The window's Vulkan surface; destroyed before the instance (declare after the Context).
+class Surface {
+public:
+    Surface(const gpu::Context& ctx, const Window& window) : instance_(ctx.instance()) {
+        gpu::check(glfwCreateWindowSurface(instance_, window.handle(), nullptr, &surface_), "glfwCreateWindowSurface");
+    }
+    ~Surface() { vkDestroySurfaceKHR(instance_, surface_, nullptr); }
+    Surface(const Surface&) = delete;
+    Surface& operator=(const Surface&) = delete;
+    VkSurfaceKHR handle() const { return surface_; }
+
+private:
+    VkInstance instance_;
+    VkSurfaceKHR surface_ = VK_NULL_HANDLE;
+};
+
+// ---- what the panel shows
+
+struct RayCounts {
+    std::array<uint32_t, shader::kPixelClassCount> pixelClasses{};
+    uint32_t sslrRays = 0;
+    uint32_t rtRays = 0;
+    bool valid = false;
+};
+
+// Per frame in flight: what our own submission and the count readback use.
+struct FrameSlot {
+    gpu::CommandPool pool;
+    gpu::Unique<VkSemaphore> acquired;
+    // Signalled by our copy's submission: every earlier graphics-queue
+    // command (this frame's graph batches included) is complete, and the
+    // acquire wait is done, so the semaphore may be used again.
+    gpu::Unique<VkFence> done;
+    gpu::Buffer counts;
+    bool countsPending = false;
+};
+
+class Viewer {
+public:
+    Viewer(gpu::Context& ctx, Window& window, VkSurfaceKHR surface, scene::Scene& scene,
+           const viewer::ViewerOptions& options, float startSeconds)
+        : ctx_(ctx), window_(window), scene_(scene), sliders_(viewer::parameterSliders()),
+          swapchain_(ctx, surface, window.framebufferSize()), sizedFor_(window.framebufferSize()),
+          sceneTime_(startSeconds) {
+        options_.renderer.framesInFlight = kFramesInFlight;
+        options_.renderer.backend = options.backend;
+        options_.frame.mode = options.mode;
+        options_.frame.debugView = options.debugView;
+        builtWith_ = options_.renderer;
+        renderer_ = std::make_unique<passes::ReflectionRenderer>(ctx_, scene_, options_.renderer);
+        executor_ = std::make_unique<rg::Executor>(ctx_, kFramesInFlight);
+        for (uint32_t i = 0; i < kFramesInFlight; ++i) {
+            auto slot = std::make_unique<FrameSlot>();
+            slot->pool = gpu::CommandPool(ctx_, ctx_.graphicsQueue().family, "viewer.frame" + std::to_string(i));
+            VkSemaphoreCreateInfo semaphoreInfo{VK_STRUCTURE_TYPE_SEMAPHORE_CREATE_INFO};
+            VkSemaphore semaphore = VK_NULL_HANDLE;
+            gpu::check(vkCreateSemaphore(ctx_.device(), &semaphoreInfo, nullptr, &semaphore), "vkCreateSemaphore");
+            slot->acquired = gpu::Unique<VkSemaphore>(ctx_.device(), semaphore, vkDestroySemaphore);
+            VkFenceCreateInfo fenceInfo{VK_STRUCTURE_TYPE_FENCE_CREATE_INFO};
+            fenceInfo.flags = VK_FENCE_CREATE_SIGNALED_BIT;
+            VkFence fence = VK_NULL_HANDLE;
+            gpu::check(vkCreateFence(ctx_.device(), &fenceInfo, nullptr, &fence), "vkCreateFence");
+            slot->done = gpu::Unique<VkFence>(ctx_.device(), fence, vkDestroyFence);
+            slot->counts = gpu::Buffer(ctx_, {shader::kReflectionCountWords * 4u, VK_BUFFER_USAGE_TRANSFER_DST_BIT,
+                                              gpu::MemoryUsage::Readback, "viewer.counts" + std::to_string(i)});
+            slots_.push_back(std::move(slot));
+        }
+        createTarget();
+        imgui_ = std::make_unique<viewer::ImGuiLayer>(ctx_, window_.handle(), swapchain_.copyFormat(),
+                                                      swapchain_.minImageCount(),
+                                                      std::max(swapchain_.imageCount(), kFramesInFlight));
+        imgui_->setTarget(*target_);
+        const scene::CameraPose start = pathPose(sceneTime_);
+        fly_ = viewer::FlyCamera::lookingAlong(start);
+        // Half the distance to what the path looks at per second: a helmet
+        // and a plaza both cross the view in a few seconds.
+        speed_ = std::clamp(0.5f * glm::length(start.target - start.position), 0.1f, 50.0f);
+        camera_.lens = scene_.lens;
+        lastTime_ = glfwGetTime();
+    }
+
+    ~Viewer() {
+        try {
+            ctx_.waitIdle();
+        } catch (const std::exception& e) {
+            spdlog::error("viewer: waiting for the GPU at exit failed: {}", e.what());
+        }
+    }
+
+    // Until the window closes, or after `frames` frames presented or skipped (0: no limit).
+    void run(uint32_t frames) {
+        while (!glfwWindowShouldClose(window_.handle()) && (frames == 0 || frameIndex_ < frames)) {
+            frame();
+        }
+        ctx_.waitIdle();
+    }
+
+private:
+    // ---- the camera path: the scene's, or a slow orbit for a file's single view
+    scene::CameraPose pathPose(double seconds) const {
+        const auto& keys = scene_.cameraPath.keys;
+        if (keys.size() != 1) return scene_.cameraPath.evaluate(float(seconds));
+        // glint-render's orbit: a quarter degree per frame at 30 frames a second.
+        const float angle = glm::radians(7.5f) * float(seconds);
+        const glm::mat4 orbit = glm::rotate(glm::mat4(1.0f), angle, glm::vec3(0.0f, 1.0f, 0.0f));
+        scene::CameraPose pose;
+        const scene::CameraPathKey& key = keys.front();
+        pose.position = key.target + glm::vec3(orbit * glm::vec4(key.position - key.target, 0.0f));
+        pose.target = key.target;
+        return pose;
+    }
+
+    void createTarget() {
+        const VkExtent2D e = swapchain_.extent();
+        target_.reset();
+        target_ = std::make_unique<gpu::Image>(
+            ctx_, gpu::ImageDesc{e.width, e.height, 1, 1, 1, swapchain_.copyFormat(),
+                                 VK_IMAGE_USAGE_TRANSFER_SRC_BIT | VK_IMAGE_USAGE_TRANSFER_DST_BIT |
+                                     VK_IMAGE_USAGE_COLOR_ATTACHMENT_BIT,
+                                 "viewer.target", false});
+        // Into the state every frame's graph expects it in (TransferSrc).
+        gpu::submitAndWait(ctx_, ctx_.graphicsQueue(), "viewer target layout", [&](VkCommandBuffer cmd) {
+            gpu::imageBarrier(cmd, *target_, VK_IMAGE_LAYOUT_UNDEFINED, VK_IMAGE_LAYOUT_TRANSFER_SRC_OPTIMAL,
+                              VK_PIPELINE_STAGE_2_NONE, 0, VK_PIPELINE_STAGE_2_ALL_TRANSFER_BIT,
+                              VK_ACCESS_2_TRANSFER_READ_BIT);
+        });
+    }
+
+    // Device idle: read every readback still pending.
+    void readPendingCounts() {
+        for (auto& slot : slots_) readCounts(*slot);
+    }
+    void readCounts(FrameSlot& slot) {
+        if (!slot.countsPending) return;
+        slot.countsPending = false;
+        std::array<uint32_t, shader::kReflectionCountWords> words{};
+        std::memcpy(words.data(), slot.counts.mapped(), sizeof words);
+        std::copy_n(words.begin(), shader::kPixelClassCount, counts_.pixelClasses.begin());
+        counts_.sslrRays = words[shader::kCountSslrRays];
+        counts_.rtRays = words[shader::kCountRtRays];
+        counts_.valid = true;
+    }
+
+    void recreateSwapchain(VkExtent2D size) {
+        ctx_.waitIdle();
+        readPendingCounts();
+        swapchain_.recreate(size);
+        sizedFor_ = size;
+        createTarget();
+        imgui_->setTarget(*target_);
+        imgui_->setMinImageCount(swapchain_.minImageCount());
+        // The executor keeps history images at the size it first made them;
+        // a new one makes them at the new size (transients follow anyway).
+        resetExecutor();
+        needsRecreate_ = false;
+    }
+
+    // A new executor: new history images, cleared. Needed where the history
+    // no longer fits the frame's plan: a new size, or a plan whose passes
+    // use the history differently (mode, debug view, counting): the
+    // executor leaves each history half in the layout the last plan left
+    // it in, and a plan that uses it otherwise expects another.
+    void resetExecutor() {
+        ctx_.waitIdle();
+        readPendingCounts();
+        executor_.reset();
+        executor_ = std::make_unique<rg::Executor>(ctx_, kFramesInFlight);
+        resetHistory_ = true;
+    }
+
+    void rebuildRenderer() {
+        rendererDirty_ = false;
+        if (!viewer::rendererOptionsDiffer(options_.renderer, builtWith_)) return;
+        ctx_.waitIdle();
+        readPendingCounts();
+        renderer_.reset();
+        try {
+            renderer_ = std::make_unique<passes::ReflectionRenderer>(ctx_, scene_, options_.renderer);
+            builtWith_ = options_.renderer;
+            message_.clear();
+            spdlog::info("renderer rebuilt: backend {}, BVH radius {}", passes::backendName(renderer_->backend()),
+                         options_.renderer.bvh.radius);
+        } catch (const std::exception& e) {
+            message_ = std::string("renderer: ") + e.what();
+            options_.renderer = builtWith_;
+            renderer_ = std::make_unique<passes::ReflectionRenderer>(ctx_, scene_, options_.renderer);
+        }
+        resetHistory_ = true;
+    }
+
+    void updateCamera(float dt) {
+        const ImGuiIO& io = ImGui::GetIO();
+        GLFWwindow* w = window_.handle();
+        double x = 0.0, y = 0.0;
+        glfwGetCursorPos(w, &x, &y);
+        const glm::vec2 cursor{float(x), float(y)};
+        const bool button = glfwGetMouseButton(w, GLFW_MOUSE_BUTTON_LEFT) == GLFW_PRESS;
+        // A drag belongs to the camera only if it started outside the panel.
+        if (button && !dragging_ && !io.WantCaptureMouse) dragging_ = true;
+        if (!button) dragging_ = false;
+        if (dragging_ && !playPath_) fly_.turn(cursor - lastCursor_, 0.004f);
+        lastCursor_ = cursor;
+
+        const auto down = [&](int key) { return glfwGetKey(w, key) == GLFW_PRESS; };
+        if (!io.WantCaptureKeyboard && down(GLFW_KEY_ESCAPE)) glfwSetWindowShouldClose(w, GLFW_TRUE);
+        if (playPath_) return;
+        glm::vec3 local{0.0f};
+        if (!io.WantCaptureKeyboard) {
+            local.z += down(GLFW_KEY_W) ? 1.0f : 0.0f;
+            local.z -= down(GLFW_KEY_S) ? 1.0f : 0.0f;
+            local.x += down(GLFW_KEY_D) ? 1.0f : 0.0f;
+            local.x -= down(GLFW_KEY_A) ? 1.0f : 0.0f;
+            local.y += down(GLFW_KEY_E) ? 1.0f : 0.0f;
+            local.y -= down(GLFW_KEY_Q) ? 1.0f : 0.0f;
+            const bool fast = down(GLFW_KEY_LEFT_SHIFT) || down(GLFW_KEY_RIGHT_SHIFT);
+            fly_.move(local, speed_ * (fast ? 4.0f : 1.0f) * dt);
+        }
+    }
+
+    void panel() {
+        ImGui::SetNextWindowPos(ImVec2(10, 10), ImGuiCond_FirstUseEver);
+        ImGui::SetNextWindowSize(ImVec2(380, std::max(200.0f, float(swapchain_.extent().height) - 20.0f)),
+                                 ImGuiCond_FirstUseEver);
+        ImGui::Begin("Glint");
+        const ImGuiIO& io = ImGui::GetIO();
+        ImGui::Text("%s, %ux%u, %.1f fps (%.2f ms)", ctx_.caps().deviceName.c_str(), swapchain_.extent().width,
+                    swapchain_.extent().height, double(io.Framerate), 1000.0 / double(std::max(io.Framerate, 1e-3f)));
+        if (!message_.empty()) ImGui::TextColored(ImVec4(1.0f, 0.4f, 0.3f, 1.0f), "%s", message_.c_str());
+
+        // -- scene and camera
+        ImGui::Text("scene %s, t = %.2f s", scene_.name.c_str(), sceneTime_);
+        ImGui::Checkbox("pause", &paused_);
+        ImGui::SameLine();
+        if (ImGui::Checkbox("play path", &playPath_)) {
+            // Leaving the path continues from where it was; entering it is a cut.
+            if (!playPath_) fly_ = viewer::FlyCamera::lookingAlong(pathPose(sceneTime_));
+            resetHistory_ = true;
+        }
+        ImGui::SliderFloat("speed", &speed_, 0.1f, 50.0f, "%.1f units/s", ImGuiSliderFlags_Logarithmic);
+
+        // -- mode, backend, debug view
+        int mode = int(options_.frame.mode);
+        if (ImGui::Combo("mode", &mode, "hybrid\0ssr\0rt\0")) {
+            options_.frame.mode = passes::ReflectionMode(mode);
+            if (!viewer::debugViewAvailable(options_.frame.debugView, options_.frame.mode)) {
+                options_.frame.debugView = "final";
+            }
+            resetHistory_ = true;
+        }
+        const std::string backendLabel =
+            std::string(passes::backendName(options_.renderer.backend)) + " (" +
+            std::string(passes::backendName(renderer_->backend())) + ")";
+        if (ImGui::BeginCombo("backend", backendLabel.c_str())) {
+            const bool has[3] = {true, ctx_.caps().rayQuery, ctx_.caps().rayTracingPipeline};
+            for (int b = 0; b < 3; ++b) {
+                ImGui::BeginDisabled(!has[b]);
+                const auto backend = passes::RtBackend(b);
+                if (ImGui::Selectable(std::string(passes::backendName(backend)).c_str(),
+                                      options_.renderer.backend == backend)) {
+                    options_.renderer.backend = backend;
+                    rendererDirty_ = true;
+                }
+                ImGui::EndDisabled();
+            }
+            ImGui::EndCombo();
+        }
+        const std::string view = options_.frame.debugView.empty() ? "final" : options_.frame.debugView;
+        if (ImGui::BeginCombo("debug view", view.c_str())) {
+            for (const std::string_view name : passes::debugViewNames()) {
+                ImGui::BeginDisabled(!viewer::debugViewAvailable(name, options_.frame.mode));
+                if (ImGui::Selectable(std::string(name).c_str(), name == view)) options_.frame.debugView = name;
+                ImGui::EndDisabled();
+            }
+            ImGui::EndCombo();
+        }
+
+        // -- the tunable parameters
+        if (ImGui::CollapsingHeader("parameters", ImGuiTreeNodeFlags_DefaultOpen)) {
+            for (const viewer::ParameterSlider& s : sliders_) {
+                const std::string name(s.parameter.name);
+                float value = float(app::getParameter(options_, s.parameter.name));
+                bool changed = false;
+                if (s.integer) {
+                    int v = int(value);
+                    changed = ImGui::SliderInt(name.c_str(), &v, int(s.min), int(s.max));
+                    value = float(v);
+                } else {
+                    changed = ImGui::SliderFloat(name.c_str(), &value, s.min, s.max, "%.3f");
+                }
+                if (ImGui::IsItemHovered()) {
+                    ImGui::SetTooltip("%.*s", int(s.parameter.field.size()), s.parameter.field.data());
+                }
+                if (changed) viewer::applySlider(options_, s, value);
+                // The renderer's own options take a new renderer: only on release.
+                if (s.rendererOption && ImGui::IsItemDeactivatedAfterEdit()) rendererDirty_ = true;
+            }
+            if (ImGui::Button("defaults")) {
+                const passes::RtBackend backend = options_.renderer.backend;
+                const std::string debugView = options_.frame.debugView;
+                const passes::ReflectionMode frameMode = options_.frame.mode;
+                options_ = app::ReflectionRunOptions{};
+                options_.renderer.framesInFlight = kFramesInFlight;
+                options_.renderer.backend = backend;
+                options_.frame.debugView = debugView;
+                options_.frame.mode = frameMode;
+                rendererDirty_ = true;
+            }
+        }
+
+        // -- GPU times of the newest completed frame
+        if (ImGui::CollapsingHeader("GPU time per pass", ImGuiTreeNodeFlags_DefaultOpen)) {
+            double total = 0.0, reflections = 0.0;
+            if (ImGui::BeginTable("passes", 2, ImGuiTableFlags_RowBg | ImGuiTableFlags_SizingStretchProp)) {
+                for (const rg::PassTiming& t : timings_) {
+                    if (!t.milliseconds) continue;
+                    total += *t.milliseconds;
+                    if (passes::isReflectionPass(t.name)) reflections += *t.milliseconds;
+                    ImGui::TableNextRow();
+                    ImGui::TableNextColumn();
+                    ImGui::Text("%s%s", t.name.c_str(), t.queue == rg::Queue::AsyncCompute ? " (async)" : "");
+                    ImGui::TableNextColumn();
+                    ImGui::Text("%.3f ms", *t.milliseconds);
+                }
+                ImGui::EndTable();
+            }
+            ImGui::Text("reflections %.3f ms, all passes %.3f ms", reflections, total);
+        }
+
+        // -- rays and pixel classes
+        if (ImGui::CollapsingHeader("rays", ImGuiTreeNodeFlags_DefaultOpen)) {
+            ImGui::Checkbox("count rays", &countRays_);
+            if (countRays_ && counts_.valid) {
+                const double pixels = double(swapchain_.extent().width) * swapchain_.extent().height;
+                ImGui::Text("SSLR rays %u, RT rays %u", counts_.sslrRays, counts_.rtRays);
+                const char* names[shader::kPixelClassCount] = {"sky", "env", "sslr", "hybrid", "rt"};
+                for (uint32_t c = 0; c < shader::kPixelClassCount; ++c) {
+                    ImGui::Text("  %-7s %5.1f %%", names[c], 100.0 * counts_.pixelClasses[c] / pixels);
+                }
+            }
+        }
+
+        // -- BVH
+        if (ImGui::CollapsingHeader("BVH", ImGuiTreeNodeFlags_DefaultOpen)) {
+            if (options_.frame.mode == passes::ReflectionMode::Ssr) {
+                ImGui::TextUnformatted("none in ssr mode");
+            } else {
+                const scene::BvhStats& p = renderer_->bvhPlanStats();
+                const passes::BvhGpuStats& g = renderer_->bvhGpuStats();
+                ImGui::Text("TLAS instances %u (in range %u, culled %u)", p.tlasInstances, p.instancesInRange,
+                            p.instancesCulled);
+                ImGui::Text("BLAS this frame: built %u, rebuilt %u (skinned %u), static reused %u", p.built, p.rebuilt,
+                            p.rebuiltSkinned, p.staticReused);
+                ImGui::Text("deferred by budget %u (skinned %u)", p.deferredBudget, p.deferredSkinnedBudget);
+                ImGui::Text("resident BLAS %u: %.1f MiB, TLAS %.1f MiB, pool %.1f MiB", g.residentBlases,
+                            double(g.blasBytes) / 1048576.0, double(g.tlasBytes) / 1048576.0,
+                            double(g.poolBytes) / 1048576.0);
+            }
+            const passes::GBufferStats& gb = renderer_->gbufferStats();
+            ImGui::Text("G-buffer: %u draws, %llu triangles", gb.draws, static_cast<unsigned long long>(gb.triangles));
+        }
+        ImGui::End();
+    }
+
+    void frame() {
+        glfwPollEvents();
+        const VkExtent2D size = window_.framebufferSize();
+        if (size.width == 0 || size.height == 0) {
+            glfwWaitEvents();  // minimised: nothing to draw into
+            return;
+        }
+        // Compared with the size asked for, not the swapchain's extent: a
+        // surface may settle on another extent, which must not mean a new
+        // swapchain every frame.
+        if (needsRecreate_ || size.width != sizedFor_.width || size.height != sizedFor_.height) {
+            recreateSwapchain(size);
+        }
+        const double now = glfwGetTime();
+        const float dt = float(std::min(now - lastTime_, 0.1));  // a stall is not a teleport
+        lastTime_ = now;
+
+        // The slot's previous frame (kFramesInFlight ago) is complete.
+        FrameSlot& slot = *slots_[frameIndex_ % slots_.size()];
+        const VkFence fence = slot.done.get();
+        gpu::check(vkWaitForFences(ctx_.device(), 1, &fence, VK_TRUE, 10'000'000'000ull), "vkWaitForFences (viewer)");
+        readCounts(slot);
+        slot.pool.reset();
+        if (const auto t = executor_->timings(); !t.empty()) timings_ = t;
+
+        imgui_->begin();
+        panel();
+        imgui_->end();
+        if (rendererDirty_) rebuildRenderer();
+
+        // ---- camera and scene
+        updateCamera(dt);
+        if (!paused_) sceneTime_ += dt;
+        const scene::CameraPose pose = playPath_ ? pathPose(sceneTime_) : fly_.pose();
+        const VkExtent2D extent = swapchain_.extent();
+        camera_.resolution = {extent.width, extent.height};
+        if (frameIndex_ == 0 || resetHistory_) {
+            camera_.reset(pose, frameIndex_);
+        } else {
+            camera_.advance(pose, frameIndex_);
+        }
+        scene::advanceScene(scene_, sceneTime_, &camera_);
+
+        // ---- the graph
+        const std::string planShape = std::string(passes::modeName(options_.frame.mode)) + "/" +
+                                      options_.frame.debugView + (countRays_ ? "/counted" : "");
+        if (planShape != planShape_) {
+            if (!planShape_.empty()) resetExecutor();
+            planShape_ = planShape;
+        }
+        passes::ReflectionFrameSettings settings = options_.frame;
+        settings.resetHistory = resetHistory_;
+        settings.countRays = countRays_;
+        resetHistory_ = false;
+        rg::Graph graph(executor_->queueCaps());
+        const passes::ReflectionFrame reflections = renderer_->addFrame(graph, camera_, settings);
+        rg::FrameResources resources;
+        renderer_->bind(resources, reflections);
+
+        viewer::ViewerPassesInputs viewerInputs;
+        viewerInputs.output = reflections.output.color;
+        viewerInputs.extent = extent;
+        viewerInputs.targetFormat = swapchain_.copyFormat();
+        viewerInputs.drawUi = [layer = imgui_.get()](rg::PassContext& pc, rg::Texture uiTarget) {
+            if (pc.layout(uiTarget) != viewer::kUiTargetLayout) {
+                throw gpu::GpuError("viewer.imgui: the graph gives the target a layout the UI render pass was "
+                                    "not made for");
+            }
+            layer->record(pc.cmd());
+        };
+        resources.bind(viewer::addViewerPasses(graph, viewerInputs), *target_);
+        if (settings.countRays) {
+            resources.bind(viewer::addCountsReadback(graph, reflections.counts, slot.counts.size()), slot.counts);
+        }
+        const rg::Plan plan = graph.compile(executor_->compileOptions());
+        if (ctx_.validationEnabled()) {
+            // As glint-render: the plan's own checker covers what the layer cannot see.
+            const rg::VerifyReport report = rg::verify(plan);
+            if (!report.ok()) throw std::runtime_error("render graph plan: " + report.text());
+        }
+        executor_->run(plan, resources);
+        slot.countsPending = settings.countRays;
+
+        // ---- present: acquire after submitting, so the GPU is busy while we may wait
+        const std::optional<uint32_t> image = swapchain_.acquire(slot.acquired.get());
+        if (!image) {
+            // Nothing waits for this frame's fence: wait for the device instead.
+            ctx_.waitIdle();
+            readPendingCounts();
+            needsRecreate_ = true;
+            ++frameIndex_;
+            return;
+        }
+        submitCopy(slot, *image);
+        if (!swapchain_.present(*image)) needsRecreate_ = true;
+        ++frameIndex_;
+    }
+
+    // Copies the target into swapchain image `index`: waits for the acquire,
+    // signals the present semaphore and the slot's fence.
+    void submitCopy(FrameSlot& slot, uint32_t index) {
+        const VkImage swapImage = swapchain_.image(index);
+        const VkExtent2D extent = swapchain_.extent();
+        VkCommandBuffer cmd = slot.pool.allocate();
+        VkCommandBufferBeginInfo begin{VK_STRUCTURE_TYPE_COMMAND_BUFFER_BEGIN_INFO};
+        begin.flags = VK_COMMAND_BUFFER_USAGE_ONE_TIME_SUBMIT_BIT;
+        gpu::check(vkBeginCommandBuffer(cmd, &begin), "vkBeginCommandBuffer (viewer present copy)");
+
+        VkImageMemoryBarrier2 toCopy{VK_STRUCTURE_TYPE_IMAGE_MEMORY_BARRIER_2};
+        toCopy.srcStageMask = kAcquireWaitStage;  // chained to the acquire semaphore's wait
+        toCopy.srcAccessMask = 0;
+        toCopy.dstStageMask = VK_PIPELINE_STAGE_2_ALL_TRANSFER_BIT;
+        toCopy.dstAccessMask = VK_ACCESS_2_TRANSFER_WRITE_BIT;
+        toCopy.oldLayout = VK_IMAGE_LAYOUT_UNDEFINED;  // the whole image is overwritten
+        toCopy.newLayout = VK_IMAGE_LAYOUT_TRANSFER_DST_OPTIMAL;
+        toCopy.srcQueueFamilyIndex = toCopy.dstQueueFamilyIndex = VK_QUEUE_FAMILY_IGNORED;
+        toCopy.image = swapImage;
+        toCopy.subresourceRange = {VK_IMAGE_ASPECT_COLOR_BIT, 0, 1, 0, 1};
+        VkDependencyInfo dep{VK_STRUCTURE_TYPE_DEPENDENCY_INFO};
+        dep.imageMemoryBarrierCount = 1;
+        dep.pImageMemoryBarriers = &toCopy;
+        vkCmdPipelineBarrier2(cmd, &dep);
+
+        // The target and the swapchain image share the UNORM bytes' texel
+        // size; a raw copy keeps the sRGB-encoded values as they are.
+        VkImageCopy region{};
+        region.srcSubresource = {VK_IMAGE_ASPECT_COLOR_BIT, 0, 0, 1};
+        region.dstSubresource = region.srcSubresource;
+        region.extent = {extent.width, extent.height, 1};
+        vkCmdCopyImage(cmd, target_->handle(), VK_IMAGE_LAYOUT_TRANSFER_SRC_OPTIMAL, swapImage,
+                       VK_IMAGE_LAYOUT_TRANSFER_DST_OPTIMAL, 1, &region);
+
+        VkImageMemoryBarrier2 toPresent = toCopy;
+        toPresent.srcStageMask = VK_PIPELINE_STAGE_2_ALL_TRANSFER_BIT;
+        toPresent.srcAccessMask = VK_ACCESS_2_TRANSFER_WRITE_BIT;
+        // Chained to the present semaphore's signal by the same stage, so
+        // the presentation engine sees the transition done (a NONE stage
+        // here leaves it outside the signal: a present-after-write hazard).
+        toPresent.dstStageMask = kPresentSignalStage;
+        toPresent.dstAccessMask = 0;
+        toPresent.oldLayout = VK_IMAGE_LAYOUT_TRANSFER_DST_OPTIMAL;
+        toPresent.newLayout = VK_IMAGE_LAYOUT_PRESENT_SRC_KHR;
+        dep.pImageMemoryBarriers = &toPresent;
+        vkCmdPipelineBarrier2(cmd, &dep);
+        gpu::check(vkEndCommandBuffer(cmd), "vkEndCommandBuffer (viewer present copy)");
+
+        VkSemaphoreSubmitInfo wait{VK_STRUCTURE_TYPE_SEMAPHORE_SUBMIT_INFO};
+        wait.semaphore = slot.acquired.get();
+        wait.stageMask = kAcquireWaitStage;
+        VkSemaphoreSubmitInfo signal{VK_STRUCTURE_TYPE_SEMAPHORE_SUBMIT_INFO};
+        signal.semaphore = swapchain_.presentReady(index);
+        signal.stageMask = kPresentSignalStage;
+        VkCommandBufferSubmitInfo cmdInfo{VK_STRUCTURE_TYPE_COMMAND_BUFFER_SUBMIT_INFO};
+        cmdInfo.commandBuffer = cmd;
+        VkSubmitInfo2 submit{VK_STRUCTURE_TYPE_SUBMIT_INFO_2};
+        submit.waitSemaphoreInfoCount = 1;
+        submit.pWaitSemaphoreInfos = &wait;
+        submit.commandBufferInfoCount = 1;
+        submit.pCommandBufferInfos = &cmdInfo;
+        submit.signalSemaphoreInfoCount = 1;
+        submit.pSignalSemaphoreInfos = &signal;
+        const VkFence fence = slot.done.get();
+        gpu::check(vkResetFences(ctx_.device(), 1, &fence), "vkResetFences (viewer)");
+        gpu::check(vkQueueSubmit2(ctx_.graphicsQueue().queue, 1, &submit, fence),
+                   "vkQueueSubmit2 (viewer present copy)");
+    }
+
+    gpu::Context& ctx_;
+    Window& window_;
+    scene::Scene& scene_;
+    const std::vector<viewer::ParameterSlider> sliders_;
+    app::ReflectionRunOptions options_;            // what the panel edits
+    passes::ReflectionRendererOptions builtWith_;  // what renderer_ was built with
+    viewer::Swapchain swapchain_;
+    VkExtent2D sizedFor_;  // the window size the swapchain was made for
+    std::unique_ptr<gpu::Image> target_;
+    std::vector<std::unique_ptr<FrameSlot>> slots_;
+    std::unique_ptr<passes::ReflectionRenderer> renderer_;
+    std::unique_ptr<rg::Executor> executor_;
+    std::unique_ptr<viewer::ImGuiLayer> imgui_;
+
+    scene::Camera camera_;
+    viewer::FlyCamera fly_;
+    float speed_ = 5.0f;
+    bool dragging_ = false;
+    glm::vec2 lastCursor_{0.0f};
+    double sceneTime_ = 0.0;
+    double lastTime_ = 0.0;
+    bool paused_ = false;
+    bool playPath_ = false;
+
+    uint64_t frameIndex_ = 0;
+    bool resetHistory_ = true;
+    bool needsRecreate_ = false;
+    bool rendererDirty_ = false;
+    bool countRays_ = true;
+    std::string planShape_;  // mode, debug view and counting of the last frame
+    std::vector<rg::PassTiming> timings_;
+    RayCounts counts_;
+    std::string message_;
+};
+
+} // namespace
+
+int main(int argc, char** argv) {
+    return app::runMain("glint-viewer", [&] {
+        const app::Args args(argc, argv, viewer::kUsage, viewer::viewerFlags(), {});
+        const viewer::ViewerOptions options = viewer::viewerOptions(args);
+
+        // The window first: without a display this fails at once, before
+        // any Vulkan or scene work.
+        Window window("glint-viewer", options.width, options.height);
+        gpu::ContextOptions contextOptions = args.contextOptions();
+        contextOptions.instanceExtensions = window.instanceExtensions();
+        contextOptions.swapchain = true;
+        gpu::Context ctx(contextOptions);
+        const Surface surface(ctx, window);
+
+        scene::Scene scene = scene::loadScene(options.scene);
+        // As glint-render: 3 s along the plaza's path looks down the plaza.
+        const float startSeconds = options.scene == "plaza" ? 3.0f : 0.0f;
+        spdlog::info("{}: {} on {}", scene.name, options.scene, ctx.caps().deviceName);
+        {
+            Viewer viewer(ctx, window, surface.handle(), scene, options, startSeconds);
+            viewer.run(options.frames);
+        }
+        return app::validationClean(ctx) ? 0 : 2;
+    });
+}

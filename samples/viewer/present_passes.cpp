@@ -1,0 +1,78 @@
+#include "present_passes.h"
+
+#include "graph/executor.h"
+
+namespace glint::viewer {
+
+namespace {
+
+// The host reads the counts after the frame's fence: the final state makes
+// the copy's writes visible there.
+constexpr rg::BoundaryState kHostRead =
+    rg::BoundaryState::raw(VK_PIPELINE_STAGE_2_HOST_BIT, VK_ACCESS_2_HOST_READ_BIT, VK_IMAGE_LAYOUT_UNDEFINED);
+
+} // namespace
+
+rg::Texture addViewerPasses(rg::Graph& graph, const ViewerPassesInputs& in) {
+    const rg::BoundaryState copied = rg::BoundaryState::of(rg::Access::TransferSrc);
+    const rg::Texture imported = graph.importTexture(
+        "viewer.target",
+        {{.width = in.extent.width, .height = in.extent.height, .format = in.targetFormat}, copied, copied});
+
+    struct BlitData {
+        rg::Texture source, target;
+    };
+    const VkExtent2D extent = in.extent;
+    const BlitData& blit = graph.addPass<BlitData>(
+        "viewer.blit", rg::Queue::Graphics,
+        [&](rg::Builder& b, BlitData& d) {
+            d.source = b.read(in.output, rg::Access::TransferSrc);
+            d.target = b.write(imported, rg::Access::TransferDst);
+        },
+        [extent](const BlitData& d, rg::PassContext& pc) {
+            // Same size, UNORM to UNORM: every byte arrives unchanged, only
+            // the channel order may change (a BGRA target).
+            VkImageBlit region{};
+            region.srcSubresource = {VK_IMAGE_ASPECT_COLOR_BIT, 0, 0, 1};
+            region.dstSubresource = region.srcSubresource;
+            region.srcOffsets[1] = {int32_t(extent.width), int32_t(extent.height), 1};
+            region.dstOffsets[1] = region.srcOffsets[1];
+            vkCmdBlitImage(pc.cmd(), pc.image(d.source).handle(), pc.layout(d.source), pc.image(d.target).handle(),
+                           pc.layout(d.target), 1, &region, VK_FILTER_NEAREST);
+        });
+
+    struct UiData {
+        rg::Texture target;
+    };
+    graph.addPass<UiData>(
+        "viewer.imgui", rg::Queue::Graphics,
+        [&](rg::Builder& b, UiData& d) {
+            b.setPipeline(rg::Pipeline::Raster);
+            d.target = b.write(blit.target, rg::Access::ColorAttachment);
+        },
+        [drawUi = in.drawUi](const UiData& d, rg::PassContext& pc) {
+            if (drawUi) drawUi(pc, d.target);
+        });
+    return imported;
+}
+
+rg::Buffer addCountsReadback(rg::Graph& graph, rg::Buffer counts, uint64_t bytes) {
+    const rg::Buffer imported = graph.importBuffer(
+        "viewer.counts", {{bytes}, rg::BoundaryState::of(rg::Access::TransferDst), kHostRead});
+    struct CopyData {
+        rg::Buffer source, target;
+    };
+    graph.addPass<CopyData>(
+        "viewer.read_counts", rg::Queue::Graphics,
+        [&](rg::Builder& b, CopyData& d) {
+            d.source = b.read(counts, rg::Access::TransferSrc);
+            d.target = b.write(imported, rg::Access::TransferDst);
+        },
+        [bytes](const CopyData& d, rg::PassContext& pc) {
+            const VkBufferCopy region{0, 0, bytes};
+            vkCmdCopyBuffer(pc.cmd(), pc.buffer(d.source).handle(), pc.buffer(d.target).handle(), 1, &region);
+        });
+    return imported;
+}
+
+} // namespace glint::viewer

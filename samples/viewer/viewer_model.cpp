@@ -1,0 +1,173 @@
+#include "viewer_model.h"
+
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+#include <stdexcept>
+
+namespace glint::viewer {
+
+namespace {
+
+// Slider ranges around the defaults each settings field documents; a
+// parameter added later without a row gets [0, 4 x its default].
+struct RangeRow {
+    std::string_view name;
+    float min, max;
+    bool integer;
+};
+constexpr RangeRow kRanges[] = {
+    {"sslr_threshold", 0.0f, 1.0f, false},      // a confidence
+    {"sslr_steps", 1.0f, 256.0f, true},         // default 64 (the talk)
+    {"sslr_thickness", 0.001f, 0.5f, false},    // default 0.02 view-space units
+    {"roughness_cutoff", 0.0f, 1.0f, false},    // a roughness
+    {"reuse_roughness", 0.0f, 1.0f, false},     // a roughness
+    {"rt_near_distance", 0.0f, 50.0f, false},   // default 3 world units
+    {"sslr_far_distance", 0.0f, 500.0f, false}, // default 100
+    {"bvh_radius", 1.0f, 500.0f, false},        // default 100 (the talk)
+    {"rt_max_distance", 1.0f, 500.0f, false},   // default 100 (the talk)
+};
+
+bool startsWith(std::string_view s, std::string_view prefix) { return s.substr(0, prefix.size()) == prefix; }
+
+} // namespace
+
+glm::uvec2 parseWindowSize(std::string_view text) {
+    const auto number = [&](std::string_view part) {
+        uint32_t v = 0;
+        bool ok = !part.empty() && part.size() <= 5;
+        for (const char c : part) {
+            ok = ok && c >= '0' && c <= '9';
+            if (ok) v = v * 10 + uint32_t(c - '0');
+        }
+        if (!ok || v < 64 || v > 8192) {
+            throw std::runtime_error("--size " + std::string(text) + ": expected WxH with 64..8192 pixels each");
+        }
+        return v;
+    };
+    const size_t x = text.find('x');
+    if (x == std::string_view::npos) {
+        const uint32_t n = number(text);
+        return {n, n};
+    }
+    return {number(text.substr(0, x)), number(text.substr(x + 1))};
+}
+
+std::vector<std::string> viewerFlags() { return {"scene", "size", "frames", "mode", "backend", "debug-view"}; }
+
+ViewerOptions viewerOptions(const app::Args& args) {
+    ViewerOptions o;
+    o.scene = args.get("scene", o.scene);
+    if (args.has("size")) {
+        const glm::uvec2 size = parseWindowSize(args.get("size", ""));
+        o.width = size.x;
+        o.height = size.y;
+    }
+    o.frames = args.getUint("frames", 0);
+    try {
+        o.mode = passes::parseMode(args.get("mode", "hybrid"));
+        o.backend = passes::parseBackend(args.get("backend", "auto"));
+    } catch (const std::invalid_argument& e) {
+        throw std::runtime_error(std::string("--mode/--backend: ") + e.what());
+    }
+    o.debugView = args.get("debug-view", o.debugView);
+    const auto names = passes::debugViewNames();
+    if (std::find(names.begin(), names.end(), o.debugView) == names.end()) {
+        throw std::runtime_error("--debug-view " + o.debugView + ": unknown (glint-render --list-debug-views)");
+    }
+    if (!debugViewAvailable(o.debugView, o.mode)) {
+        throw std::runtime_error("--debug-view " + o.debugView + ": not produced in mode " +
+                                 std::string(passes::modeName(o.mode)));
+    }
+    return o;
+}
+
+bool debugViewAvailable(std::string_view view, passes::ReflectionMode mode) {
+    using passes::ReflectionMode;
+    if (view == "tile_modes" || view == "feedback_counters") return mode == ReflectionMode::Hybrid;
+    if (startsWith(view, "sslr_")) return mode != ReflectionMode::Rt;
+    if (startsWith(view, "rt_")) return mode != ReflectionMode::Ssr;
+    return true;
+}
+
+std::vector<ParameterSlider> parameterSliders() {
+    std::vector<ParameterSlider> sliders;
+    const app::ReflectionRunOptions defaults;
+    for (const app::Parameter& p : app::parameters()) {
+        ParameterSlider s;
+        s.parameter = p;
+        const auto row = std::find_if(std::begin(kRanges), std::end(kRanges),
+                                      [&](const RangeRow& r) { return r.name == p.name; });
+        if (row != std::end(kRanges)) {
+            s.min = row->min;
+            s.max = row->max;
+            s.integer = row->integer;
+        } else {
+            s.max = std::max(1.0f, 4.0f * float(app::getParameter(defaults, p.name)));
+        }
+        // The renderer's own options (ReflectionRendererOptions::bvh and
+        // ::bvhUpdate) are read once, when it is built.
+        s.rendererOption = startsWith(p.field, "BvhSettings::") || startsWith(p.field, "BvhUpdateOptions::");
+        sliders.push_back(s);
+    }
+    return sliders;
+}
+
+void applySlider(app::ReflectionRunOptions& options, const ParameterSlider& slider, float value) {
+    float v = std::clamp(std::isfinite(value) ? value : slider.min, slider.min, slider.max);
+    char text[32];
+    if (slider.integer) {
+        std::snprintf(text, sizeof text, "%u", unsigned(std::lround(std::max(v, 1.0f))));
+    } else {
+        std::snprintf(text, sizeof text, "%.9g", double(v));
+    }
+    app::setParameter(options, slider.parameter.name, text);
+}
+
+bool rendererOptionsDiffer(const passes::ReflectionRendererOptions& a, const passes::ReflectionRendererOptions& b) {
+    return a.backend != b.backend || a.bvh.radius != b.bvh.radius;
+}
+
+// ---- fly camera
+
+FlyCamera FlyCamera::lookingAlong(const scene::CameraPose& pose) {
+    FlyCamera c;
+    c.position = pose.position;
+    const glm::vec3 d = pose.target - pose.position;
+    const float length = glm::length(d);
+    if (length > 0.0f && std::isfinite(length)) {
+        const glm::vec3 n = d / length;
+        c.yaw = std::atan2(n.x, -n.z);
+        c.pitch = std::clamp(std::asin(std::clamp(n.y, -1.0f, 1.0f)), -kMaxPitch, kMaxPitch);
+    }
+    return c;
+}
+
+glm::vec3 FlyCamera::forward() const {
+    return {std::cos(pitch) * std::sin(yaw), std::sin(pitch), -std::cos(pitch) * std::cos(yaw)};
+}
+
+glm::vec3 FlyCamera::right() const { return {std::cos(yaw), 0.0f, std::sin(yaw)}; }
+
+scene::CameraPose FlyCamera::pose() const {
+    scene::CameraPose p;
+    p.position = position;
+    p.target = position + forward();
+    return p;
+}
+
+void FlyCamera::turn(glm::vec2 pixels, float radiansPerPixel) {
+    yaw = std::remainder(yaw + pixels.x * radiansPerPixel, 2.0f * 3.14159265f);
+    pitch = std::clamp(pitch - pixels.y * radiansPerPixel, -kMaxPitch, kMaxPitch);
+}
+
+void FlyCamera::move(glm::vec3 local, float distance) {
+    const float length = glm::length(local);
+    if (!(length > 0.0f)) return;
+    const glm::vec3 l = local / length;
+    // Forward follows the view (pitch included), as a fly camera does; up
+    // is the world's, so Q/E change height whatever the view.
+    position += (right() * l.x + glm::vec3(0.0f, 1.0f, 0.0f) * l.y + forward() * l.z) * distance;
+}
+
+} // namespace glint::viewer

@@ -1,0 +1,207 @@
+// The viewer's parts that need no window: command line, panel model, fly
+// camera, and its graph passes compiled and verified without a GPU.
+
+#include <doctest/doctest.h>
+
+#include "graph/access.h"
+#include "graph/compile.h"
+#include "graph/plan.h"
+#include "graph/synthetic.h"
+#include "graph/verify.h"
+#include "imgui_layer.h"
+#include "present_passes.h"
+#include "viewer_model.h"
+
+#include <cmath>
+#include <set>
+#include <stdexcept>
+#include <string>
+
+using namespace glint;
+
+namespace {
+
+app::Args argsOf(std::vector<std::string> words) {
+    std::vector<char*> argv;
+    static std::string program = "glint-viewer";
+    argv.push_back(program.data());
+    for (std::string& w : words) argv.push_back(w.data());
+    return app::Args(int(argv.size()), argv.data(), viewer::kUsage, viewer::viewerFlags(), {});
+}
+
+} // namespace
+
+TEST_CASE("the command line gives the scene and the window size") {
+    const viewer::ViewerOptions defaults = viewer::viewerOptions(argsOf({}));
+    CHECK(defaults.scene == "plaza");
+    CHECK(defaults.width == 1280);
+    CHECK(defaults.height == 720);
+    CHECK(defaults.frames == 0);
+    const viewer::ViewerOptions o =
+        viewer::viewerOptions(argsOf({"--scene", "hard-cases", "--size", "800x600", "--frames", "3"}));
+    CHECK(o.scene == "hard-cases");
+    CHECK(o.width == 800);
+    CHECK(o.height == 600);
+    CHECK(o.frames == 3);
+    CHECK(viewer::parseWindowSize("512") == glm::uvec2(512, 512));
+}
+
+TEST_CASE("a window size outside 64..8192 or not WxH is refused, naming the flag") {
+    for (const char* bad : {"0x600", "800x", "x600", "800x60", "9000x600", "800x600x2", "-800x600", "abc", ""}) {
+        INFO(bad);
+        CHECK_THROWS_WITH_AS(viewer::parseWindowSize(bad), doctest::Contains("--size"), std::runtime_error);
+    }
+    CHECK_THROWS_AS(argsOf({"--set", "sslr_steps=8"}), std::exception);  // glint-render's flag, not the viewer's
+}
+
+TEST_CASE("debug views a mode does not produce are unavailable, every other one is") {
+    using passes::ReflectionMode;
+    for (const std::string_view name : passes::debugViewNames()) {
+        CHECK(viewer::debugViewAvailable(name, ReflectionMode::Hybrid));
+    }
+    CHECK_FALSE(viewer::debugViewAvailable("sslr_confidence", ReflectionMode::Rt));
+    CHECK_FALSE(viewer::debugViewAvailable("rt_hit_distance", ReflectionMode::Ssr));
+    CHECK_FALSE(viewer::debugViewAvailable("tile_modes", ReflectionMode::Ssr));
+    CHECK_FALSE(viewer::debugViewAvailable("feedback_counters", ReflectionMode::Rt));
+    CHECK(viewer::debugViewAvailable("reflection_source", ReflectionMode::Ssr));
+    CHECK(viewer::debugViewAvailable("ray_classes", ReflectionMode::Rt));
+    CHECK(viewer::debugViewAvailable("final", ReflectionMode::Rt));
+}
+
+TEST_CASE("every tunable parameter has a slider whose range holds its default") {
+    const std::vector<viewer::ParameterSlider> sliders = viewer::parameterSliders();
+    REQUIRE(sliders.size() == app::parameters().size());
+    const app::ReflectionRunOptions defaults;
+    for (const viewer::ParameterSlider& s : sliders) {
+        INFO(s.parameter.name);
+        const double v = app::getParameter(defaults, s.parameter.name);
+        CHECK(s.min <= v);
+        CHECK(v <= s.max);
+        CHECK(s.min < s.max);
+    }
+}
+
+TEST_CASE("a slider sets its parameter through setParameter, clamped and rounded") {
+    const std::vector<viewer::ParameterSlider> sliders = viewer::parameterSliders();
+    const auto find = [&](std::string_view name) {
+        for (const auto& s : sliders)
+            if (s.parameter.name == name) return s;
+        FAIL("no slider " << name);
+        return sliders.front();
+    };
+    app::ReflectionRunOptions o;
+    viewer::applySlider(o, find("sslr_threshold"), 0.5f);
+    CHECK(o.frame.sslr.confidenceThreshold == doctest::Approx(0.5f));
+    viewer::applySlider(o, find("sslr_threshold"), 7.0f);
+    CHECK(o.frame.sslr.confidenceThreshold == doctest::Approx(1.0f));
+    viewer::applySlider(o, find("sslr_steps"), 31.6f);
+    CHECK(o.frame.sslr.linearSteps == 32u);
+    viewer::applySlider(o, find("sslr_steps"), NAN);
+    CHECK(o.frame.sslr.linearSteps == 1u);
+}
+
+TEST_CASE("only the BVH radius among the parameters needs a new renderer") {
+    for (const viewer::ParameterSlider& s : viewer::parameterSliders()) {
+        INFO(s.parameter.name);
+        CHECK(s.rendererOption == (s.parameter.name == "bvh_radius"));
+        app::ReflectionRunOptions o;
+        const passes::ReflectionRendererOptions before = o.renderer;
+        viewer::applySlider(o, s, s.max);
+        CHECK(viewer::rendererOptionsDiffer(before, o.renderer) == s.rendererOption);
+    }
+}
+
+TEST_CASE("the fly camera keeps the direction it starts from and moves along its own axes") {
+    scene::CameraPose pose;
+    pose.position = {1.0f, 2.0f, 3.0f};
+    pose.target = {4.0f, 2.0f, 7.0f};  // level, towards +x +z
+    viewer::FlyCamera c = viewer::FlyCamera::lookingAlong(pose);
+    CHECK(c.pitch == doctest::Approx(0.0f));
+    const glm::vec3 f = c.forward();
+    CHECK(f.x == doctest::Approx(0.6f));
+    CHECK(f.z == doctest::Approx(0.8f));
+    CHECK(glm::dot(c.right(), f) == doctest::Approx(0.0f).epsilon(1e-6));
+    CHECK(glm::cross(c.right(), f).y == doctest::Approx(1.0f));  // right x forward = up: right-handed
+    c.move({0.0f, 0.0f, 1.0f}, 5.0f);
+    CHECK(c.position.x == doctest::Approx(4.0f));
+    CHECK(c.position.z == doctest::Approx(7.0f));
+    c.move({0.0f, 1.0f, 0.0f}, 2.0f);
+    CHECK(c.position.y == doctest::Approx(4.0f));
+    c.turn({0.0f, -1e6f}, 0.01f);  // far up: stops short of vertical
+    CHECK(c.pitch == doctest::Approx(viewer::FlyCamera::kMaxPitch));
+    CHECK(std::isfinite(glm::length(c.pose().target)));
+}
+
+TEST_CASE("the viewer's passes leave its target in TransferSrc for the present copy and verify clean") {
+    for (const bool countRays : {false, true}) {
+        rg::Graph graph(rg::synthetic::twoQueueCaps());
+        const VkExtent2D extent{96, 64};
+        struct Frame {
+            rg::Texture color;
+            rg::Buffer counts;
+        };
+        // Stands in for the reflection frame: a compute pass writing the
+        // RGBA8 output (and the counts).
+        const Frame& frame = graph.addPass<Frame>(
+            "composite", rg::Queue::Graphics,
+            [&](rg::Builder& b, Frame& d) {
+                d.color = b.write(b.createTexture("composite.color", {.width = extent.width, .height = extent.height,
+                                                                     .format = VK_FORMAT_R8G8B8A8_UNORM}),
+                                  rg::Access::StorageWrite);
+                d.counts = b.write(b.createBuffer("stats.counts", {28}), rg::Access::StorageWrite);
+            },
+            [](const Frame&, rg::PassContext&) {});
+        graph.markOutput(frame.color);
+        viewer::ViewerPassesInputs in;
+        in.output = frame.color;
+        in.extent = extent;
+        viewer::addViewerPasses(graph, in);
+        if (countRays) viewer::addCountsReadback(graph, frame.counts, 28);
+
+        const rg::Plan plan = graph.compile();
+        const rg::VerifyReport report = rg::verify(plan);
+        INFO(plan.toText());
+        INFO(report.text());
+        CHECK(report.ok());
+        CHECK(plan.findPass("viewer.blit") != nullptr);
+        CHECK(plan.findPass("viewer.imgui") != nullptr);
+        CHECK((plan.findPass("viewer.read_counts") != nullptr) == countRays);
+
+        // The UI pass sees the layout the UI render pass was made for.
+        CHECK(rg::accessScope(rg::Access::ColorAttachment, rg::ResourceKind::Texture, rg::Pipeline::Raster).layout ==
+              viewer::kUiTargetLayout);
+        // Leaves the target in TRANSFER_SRC_OPTIMAL, readable by transfers.
+        const uint32_t target = plan.findResource("viewer.target");
+        REQUIRE(target != rg::kNoIndex);
+        bool leftForCopy = false;
+        for (const rg::Batch& batch : plan.batches) {
+            for (const rg::Barrier& b : plan.barriersAfter(batch)) {
+                if (b.resource != target) continue;
+                leftForCopy = b.newLayout == VK_IMAGE_LAYOUT_TRANSFER_SRC_OPTIMAL &&
+                              (b.dstAccess & VK_ACCESS_2_TRANSFER_READ_BIT) &&
+                              (b.dstStages & VK_PIPELINE_STAGE_2_ALL_TRANSFER_BIT);
+            }
+        }
+        CHECK(leftForCopy);
+        // The blit waits for last frame's copy (a transfer read) before writing.
+        bool afterCopy = false;
+        for (const rg::Barrier& b : plan.barriersBefore(*plan.findPass("viewer.blit"))) {
+            if (b.resource == target) afterCopy = (b.srcStages & VK_PIPELINE_STAGE_2_ALL_TRANSFER_BIT) != 0;
+        }
+        CHECK(afterCopy);
+    }
+}
+
+TEST_CASE("the starting mode, backend and debug view come from the command line, checked like the panel") {
+    const viewer::ViewerOptions o =
+        viewer::viewerOptions(argsOf({"--mode", "rt", "--backend", "pipeline", "--debug-view", "rt_hit_distance"}));
+    CHECK(o.mode == passes::ReflectionMode::Rt);
+    CHECK(o.backend == passes::RtBackend::Pipeline);
+    CHECK(o.debugView == "rt_hit_distance");
+    CHECK_THROWS_WITH_AS(viewer::viewerOptions(argsOf({"--mode", "fast"})), doctest::Contains("--mode"),
+                         std::runtime_error);
+    CHECK_THROWS_WITH_AS(viewer::viewerOptions(argsOf({"--debug-view", "nope"})),
+                         doctest::Contains("--debug-view nope"), std::runtime_error);
+    CHECK_THROWS_WITH_AS(viewer::viewerOptions(argsOf({"--mode", "ssr", "--debug-view", "rt_radiance"})),
+                         doctest::Contains("not produced in mode ssr"), std::runtime_error);
+}
