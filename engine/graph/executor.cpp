@@ -80,6 +80,18 @@ struct Executor::History {
     std::unique_ptr<gpu::Buffer> buffers[2];
     uint32_t current = 0;  // which of the two is this frame's `current`
     bool flippedThisFrame = false;
+    // What the pair was made from, and the layout each image was left in
+    // by the last frame that used it: a later plan may expect others.
+    TextureDesc texture;
+    BufferDesc buffer;
+    VkImageUsageFlags imageUsage = 0;
+    VkBufferUsageFlags bufferUsage = 0;
+    bool shared = false;
+    VkImageLayout layout[2] = {VK_IMAGE_LAYOUT_UNDEFINED, VK_IMAGE_LAYOUT_UNDEFINED};
+    // The uses of both halves in the last plan (queue, access kinds, writes,
+    // in plan order): barriers at a frame's start assume the previous frame
+    // ended the way this plan ends, so another plan needs a full barrier.
+    uint64_t useSignature = 0;
 };
 
 struct Executor::FrameSlot {
@@ -208,13 +220,55 @@ void Executor::prepareTransients(const Plan& plan) {
     stats_.transientBytes = transients_->bytes;
 }
 
+namespace {
+
+// A history half's layout between frames: the layout its role starts a
+// frame in (a half no pass reads or writes there is kept in GENERAL).
+VkImageLayout restingLayout(VkImageLayout entry) {
+    return entry == VK_IMAGE_LAYOUT_UNDEFINED ? VK_IMAGE_LAYOUT_GENERAL : entry;
+}
+
+// FNV-1a over how `plan` uses resources a and b.
+uint64_t useSignature(const Plan& plan, uint32_t a, uint32_t b) {
+    uint64_t h = 1469598103934665603ull;
+    const auto mix = [&h](uint64_t v) {
+        for (int i = 0; i < 8; ++i) {
+            h ^= (v >> (8 * i)) & 0xFFu;
+            h *= 1099511628211ull;
+        }
+    };
+    for (const PlannedPass& p : plan.passes) {
+        for (const ir::Use& use : plan.uses(p)) {
+            if (use.resource != a && use.resource != b) continue;
+            mix(use.resource == a ? 1u : 2u);
+            mix(uint64_t(p.queue));
+            mix(uint64_t(use.kinds));
+            mix(use.writes ? 1u : 0u);
+        }
+    }
+    return h;
+}
+
+} // namespace
+
 void Executor::prepareHistory(const Plan& plan) {
     const auto& decl = *plan.declaration;
     for (auto& [name, h] : history_) {
         h->flippedThisFrame = false;
     }
-    // Pairs seen for the first time: create both halves, clear them, and put
-    // each in the layout its role starts frame 0 in.
+    // A plan expects each history half in the layout its role starts the
+    // frame in, as if the previous frame had run the same plan (the graph
+    // plans the cycle of one plan). When the plan changes (a mode, a debug
+    // view, a culled pass), the images are moved to the layouts this plan
+    // expects; when the description changes (a resize), the pair starts
+    // afresh. Both wait for the device: they are rare, and correct beats
+    // fast there.
+    struct Relayout {
+        History* history;
+        VkImageLayout from[2];
+        VkImageLayout to[2];
+    };
+    std::vector<Relayout> relayouts;
     for (uint32_t i = 0; i < plan.resources.size(); ++i) {
         const PlannedResource& r = plan.resources[i];
         if (r.origin != ir::Origin::HistoryCurrent || !r.used) {
@@ -222,19 +276,55 @@ void Executor::prepareHistory(const Plan& plan) {
         }
         const ir::Resource& current = decl.resources[i];
         const std::string name = historyName(current.name);
+        const PlannedResource& prevPlan = plan.resources[r.partner];
+        const bool shared = r.crossQueue || prevPlan.crossQueue;
         auto it = history_.find(name);
         if (it != history_.end()) {
-            if (!it->second->flippedThisFrame) {
-                it->second->current ^= 1u;
-                it->second->flippedThisFrame = true;
+            History& existing = *it->second;
+            const bool sameDesc = existing.kind == r.kind &&
+                                  (r.kind == ResourceKind::Texture ? existing.texture == current.texture
+                                                                   : existing.buffer == current.buffer) &&
+                                  (existing.imageUsage & r.imageUsage) == r.imageUsage &&
+                                  (existing.bufferUsage & r.bufferUsage) == r.bufferUsage && existing.shared == shared;
+            if (!sameDesc) {
+                spdlog::info("render graph: history '{}' recreated: its description or usage changed", name);
+                waitIdle();
+                history_.erase(it);
+            } else {
+                const uint64_t signature = useSignature(plan, i, r.partner);
+                const bool samePlan = signature == existing.useSignature;
+                existing.useSignature = signature;
+                if (!existing.flippedThisFrame) {
+                    existing.current ^= 1u;
+                    existing.flippedThisFrame = true;
+                }
+                if (existing.kind == ResourceKind::Texture) {
+                    const uint32_t k = existing.current;
+                    const VkImageLayout wantCurrent = restingLayout(r.entryLayout);
+                    const VkImageLayout wantPrevious = restingLayout(prevPlan.entryLayout);
+                    if (!samePlan || existing.layout[k] != wantCurrent || existing.layout[1u - k] != wantPrevious) {
+                        Relayout move{&existing, {existing.layout[0], existing.layout[1]}, {}};
+                        move.to[k] = wantCurrent;
+                        move.to[1u - k] = wantPrevious;
+                        relayouts.push_back(move);
+                    }
+                    // After this frame the roles swap: `current` starts the
+                    // next frame as `previous`, and the other way round.
+                    existing.layout[k] = wantPrevious;
+                    existing.layout[1u - k] = wantCurrent;
+                }
+                continue;
             }
-            continue;
         }
         auto h = std::make_unique<History>();
         h->kind = r.kind;
         h->flippedThisFrame = true;
-        const PlannedResource& prevPlan = plan.resources[r.partner];
-        const bool shared = r.crossQueue || prevPlan.crossQueue;
+        h->texture = current.texture;
+        h->buffer = current.buffer;
+        h->imageUsage = r.imageUsage;
+        h->bufferUsage = r.bufferUsage;
+        h->shared = shared;
+        h->useSignature = useSignature(plan, i, r.partner);
         for (uint32_t k = 0; k < 2; ++k) {
             const std::string halfName = name + "[" + std::to_string(k) + "]";
             if (r.kind == ResourceKind::Texture) {
@@ -250,9 +340,12 @@ void Executor::prepareHistory(const Plan& plan) {
                 const VkImageLayout entry = k == h->current ? r.entryLayout : prevPlan.entryLayout;
                 if (r.kind == ResourceKind::Texture) {
                     const gpu::Image& img = *h->images[k];
+                    // From every earlier command: a recreated pair may sit in
+                    // the memory of the one it replaces (waited for, but the
+                    // ordering is stated, not left to the host wait).
                     gpu::imageBarrier(cmd, img, VK_IMAGE_LAYOUT_UNDEFINED, VK_IMAGE_LAYOUT_TRANSFER_DST_OPTIMAL,
-                                      VK_PIPELINE_STAGE_2_NONE, 0, VK_PIPELINE_STAGE_2_CLEAR_BIT,
-                                      VK_ACCESS_2_TRANSFER_WRITE_BIT);
+                                      VK_PIPELINE_STAGE_2_ALL_COMMANDS_BIT, VK_ACCESS_2_MEMORY_WRITE_BIT,
+                                      VK_PIPELINE_STAGE_2_CLEAR_BIT, VK_ACCESS_2_TRANSFER_WRITE_BIT);
                     const VkImageSubresourceRange range = img.fullRange();
                     if (img.aspect() & VK_IMAGE_ASPECT_COLOR_BIT) {
                         const VkClearColorValue zero{};
@@ -262,8 +355,7 @@ void Executor::prepareHistory(const Plan& plan) {
                         vkCmdClearDepthStencilImage(cmd, img.handle(), VK_IMAGE_LAYOUT_TRANSFER_DST_OPTIMAL, &zero, 1,
                                                     &range);
                     }
-                    gpu::imageBarrier(cmd, img, VK_IMAGE_LAYOUT_TRANSFER_DST_OPTIMAL,
-                                      entry == VK_IMAGE_LAYOUT_UNDEFINED ? VK_IMAGE_LAYOUT_GENERAL : entry,
+                    gpu::imageBarrier(cmd, img, VK_IMAGE_LAYOUT_TRANSFER_DST_OPTIMAL, restingLayout(entry),
                                       VK_PIPELINE_STAGE_2_CLEAR_BIT, VK_ACCESS_2_TRANSFER_WRITE_BIT,
                                       VK_PIPELINE_STAGE_2_ALL_COMMANDS_BIT,
                                       VK_ACCESS_2_MEMORY_READ_BIT | VK_ACCESS_2_MEMORY_WRITE_BIT);
@@ -275,9 +367,32 @@ void Executor::prepareHistory(const Plan& plan) {
                 }
             }
         });
+        // After frame 0 the roles swap (see above).
+        h->layout[h->current] = restingLayout(prevPlan.entryLayout);
+        h->layout[1u - h->current] = restingLayout(r.entryLayout);
         spdlog::debug("render graph: history '{}' created", name);
         history_[name] = std::move(h);
     }
+    if (relayouts.empty()) {
+        return;
+    }
+    waitIdle();
+    gpu::submitAndWait(gpu_, gpu_.graphicsQueue(), "rg.history.relayout", [&](VkCommandBuffer cmd) {
+        for (const Relayout& move : relayouts) {
+            // A barrier even where the layout stays: the plan's own first
+            // barrier assumes its own last accesses, not the old plan's.
+            for (uint32_t j = 0; j < 2; ++j) {
+                {
+                    gpu::imageBarrier(cmd, *move.history->images[j], move.from[j], move.to[j],
+                                      VK_PIPELINE_STAGE_2_ALL_COMMANDS_BIT,
+                                      VK_ACCESS_2_MEMORY_READ_BIT | VK_ACCESS_2_MEMORY_WRITE_BIT,
+                                      VK_PIPELINE_STAGE_2_ALL_COMMANDS_BIT,
+                                      VK_ACCESS_2_MEMORY_READ_BIT | VK_ACCESS_2_MEMORY_WRITE_BIT);
+                }
+            }
+        }
+    });
+    spdlog::debug("render graph: {} history pair(s) moved to this plan's layouts", relayouts.size());
 }
 
 void Executor::bindResources(const Plan& plan, const FrameResources& imports) {

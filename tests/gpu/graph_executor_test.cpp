@@ -207,6 +207,103 @@ TEST_CASE("a history buffer carries last frame's value into this frame, with two
     }
 }
 
+TEST_CASE("a history texture survives plans that leave it in other layouts, and a resize starts it afresh") {
+    // Frames alternate two plans: A writes `current` with a transfer clear
+    // (it ends in TRANSFER_DST), B with a shader (GENERAL); both read
+    // `previous` with a shader. Each plan expects the layouts its own cycle
+    // leaves, so the executor must move the images when the plan changes.
+    // Validation (layouts at submit, sync hazards) fails the test on any
+    // message; the values prove the history itself carried over.
+    test::GpuTest gpu;
+    auto& ctx = gpu.ctx();
+    const Pipelines pipelines(ctx);
+    rg::Executor executor(ctx, 2);
+    constexpr uint32_t kFrames = 6;
+    std::vector<gpu::Buffer> results;
+    for (uint32_t i = 0; i < kFrames; ++i) results.push_back(readbackTarget(ctx, "history.texture.result"));
+    for (uint32_t frame = 0; frame < kFrames; ++frame) {
+        // The last frame shrinks the image: a new pair, cleared.
+        const uint32_t height = frame + 1 == kFrames ? kCount / kWidth / 2 : kCount / kWidth;
+        const uint32_t words = kWidth * height;
+        rg::Graph g(executor.queueCaps());
+        const rg::HistoryTexture history = g.createHistoryTexture("history", {kWidth, height, 1, 1, 1, VK_FORMAT_R32_UINT});
+        struct WriteData {
+            rg::Buffer src;
+            rg::Texture image;
+        };
+        const uint32_t value = frame + 1;
+        rg::Texture written;
+        if (frame % 2 == 0) {
+            written = g.addPass<WriteData>(
+                           "write-clear", rg::Queue::Graphics,
+                           [&](rg::Builder& b, WriteData& d) { d.image = b.write(history.current, rg::Access::TransferDst); },
+                           [value](const WriteData& d, rg::PassContext& pc) {
+                               VkClearColorValue clear{};
+                               clear.uint32[0] = value;
+                               const VkImageSubresourceRange range{VK_IMAGE_ASPECT_COLOR_BIT, 0, 1, 0, 1};
+                               vkCmdClearColorImage(pc.cmd(), pc.image(d.image).handle(), pc.layout(d.image), &clear, 1,
+                                                    &range);
+                           })
+                          .image;
+        } else {
+            const rg::Buffer filled = addOp(g, pipelines, "fill", rg::Queue::Graphics, {},
+                                            g.createBuffer("fill", {kCount * 4}), 0, value);
+            written = g.addPass<WriteData>(
+                           "write-shader", rg::Queue::Graphics,
+                           [&](rg::Builder& b, WriteData& d) {
+                               d.src = b.read(filled, rg::Access::StorageRead);
+                               d.image = b.write(history.current, rg::Access::StorageWrite);
+                           },
+                           [&pipelines, words](const WriteData& d, rg::PassContext& pc) {
+                               gpu::PushDescriptors(pipelines.imageWrite)
+                                   .storageBuffer(0, pc.buffer(d.src))
+                                   .storageImage(1, pc.view(d.image))
+                                   .push(pc.gpu(), pc.cmd());
+                               pipelines.imageWrite.pushConstants(pc.cmd(), OpPush{words, kWidth, 0, 0});
+                               pc.dispatch(pipelines.imageWrite, words / 64);
+                           })
+                          .image;
+        }
+        (void)written;
+        struct ReadData {
+            rg::Texture image;
+            rg::Buffer dst;
+        };
+        const ReadData& read = g.addPass<ReadData>(
+            "read-previous", rg::Queue::Graphics,
+            [&](rg::Builder& b, ReadData& d) {
+                d.image = b.read(history.previous, rg::Access::StorageRead);
+                d.dst = b.write(g.createBuffer("previous-words", {kCount * 4}), rg::Access::StorageWrite);
+            },
+            [&pipelines, words](const ReadData& d, rg::PassContext& pc) {
+                gpu::PushDescriptors(pipelines.imageRead)
+                    .storageImage(0, pc.view(d.image))
+                    .storageBuffer(1, pc.buffer(d.dst))
+                    .push(pc.gpu(), pc.cmd());
+                pipelines.imageRead.pushConstants(pc.cmd(), OpPush{words, kWidth, 0, 0});
+                pc.dispatch(pipelines.imageRead, words / 64);
+            });
+        const rg::Buffer out = g.importBuffer("result", {{kCount * 4}, rg::BoundaryState::of(rg::Access::None), kHostRead});
+        g.markOutput(addOp(g, pipelines, "copy-out", rg::Queue::Graphics, read.dst, out, 1, 0));
+        const rg::Plan plan = g.compile(executor.compileOptions());
+        const auto report = rg::verify(plan);
+        REQUIRE_MESSAGE(report.ok(), report.text());
+        rg::FrameResources imports;
+        imports.bind(out, results[frame]);
+        executor.run(plan, imports);
+    }
+    executor.waitIdle();
+    for (uint32_t frame = 0; frame < kFrames; ++frame) {
+        const auto got = results[frame].mappedSpan<uint32_t>();
+        // `previous` holds last frame's value; frame 0 and the resized frame
+        // start from a cleared pair.
+        const uint32_t expected = frame == 0 || frame + 1 == kFrames ? 0u : frame;
+        INFO("frame " << frame);
+        CHECK(got[0] == expected);
+        CHECK(got[kWidth * 3 + 5] == expected);
+    }
+}
+
 TEST_CASE("running a plan whose import has nothing bound names the resource") {
     test::GpuTest gpu;
     auto& ctx = gpu.ctx();
