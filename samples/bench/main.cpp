@@ -77,29 +77,6 @@ const std::array<Sweep, 5> kSweeps = {{
     {"bvh_radius", {10, 25, 50, 200}, {25}, {true, false, true}},
 }};
 
-// "W", "WxH": 1..8192 each (as glint-render).
-std::pair<uint32_t, uint32_t> parseSize(const std::string& text) {
-    const auto number = [&](const std::string& part) {
-        size_t used = 0;
-        unsigned long v = 0;
-        try {
-            v = std::stoul(part, &used);
-        } catch (const std::exception&) {
-            used = 0;
-        }
-        if (used == 0 || used != part.size() || v == 0 || v > 8192) {
-            throw std::runtime_error("--size " + text + ": expected N or WxH with 1..8192 pixels each");
-        }
-        return uint32_t(v);
-    };
-    const size_t x = text.find('x');
-    if (x == std::string::npos) {
-        const uint32_t n = number(text);
-        return {n, n};
-    }
-    return {number(text.substr(0, x)), number(text.substr(x + 1))};
-}
-
 double parsePositive(const std::string& flag, const std::string& text, bool allowZero) {
     try {
         size_t used = 0;
@@ -251,7 +228,7 @@ int main(int argc, char** argv) {
         gpu::Context ctx(args.contextOptions());
         const bool cpuDevice = ctx.caps().deviceType == VK_PHYSICAL_DEVICE_TYPE_CPU;
         const auto [width, height] =
-            parseSize(args.get("size", cpuDevice ? "256x256" : "1920x1080"));
+            app::parseSize(args.get("size", cpuDevice ? "256x256" : "1920x1080"));
         scene::Scene scene = scene::loadScene(sceneName);
 
         app::ReflectionRunOptions base;

@@ -112,6 +112,28 @@ bool validationClean(gpu::Context& ctx) {
     return false;
 }
 
+std::pair<uint32_t, uint32_t> parseSize(const std::string& text) {
+    const auto number = [&](const std::string& part) {
+        size_t used = 0;
+        unsigned long v = 0;
+        try {
+            v = std::stoul(part, &used);
+        } catch (const std::exception&) {
+            used = 0;
+        }
+        if (used == 0 || used != part.size() || v == 0 || v > 8192) {
+            throw UsageError("--size " + text + ": expected N or WxH with 1..8192 pixels each");
+        }
+        return uint32_t(v);
+    };
+    const size_t x = text.find('x');
+    if (x == std::string::npos) {
+        const uint32_t n = number(text);
+        return {n, n};
+    }
+    return {number(text.substr(0, x)), number(text.substr(x + 1))};
+}
+
 void writePng(const std::string& path, uint32_t width, uint32_t height, const std::vector<uint8_t>& rgba) {
     const auto dir = std::filesystem::path(path).parent_path();
     if (!dir.empty()) {

@@ -8,6 +8,7 @@
 #include <functional>
 #include <map>
 #include <string>
+#include <utility>
 #include <vector>
 
 namespace glint::app {
@@ -42,6 +43,10 @@ int runMain(const char* program, const std::function<int()>& body);
 
 // Reports validation messages collected by `ctx`; true when there were none.
 bool validationClean(gpu::Context& ctx);
+
+// A --size value: "N" (square) or "WxH", 1..8192 pixels each; throws a
+// one-line error naming the value otherwise.
+std::pair<uint32_t, uint32_t> parseSize(const std::string& text);
 
 void writePng(const std::string& path, uint32_t width, uint32_t height, const std::vector<uint8_t>& rgba);
 

@@ -29,29 +29,6 @@ constexpr const char* kUsage =
     "                    [--tolerance REL] [--seed N] [--max-frames N] (reference mode)\n"
     "                    [--list-debug-views] [--list-parameters] [--validate]";
 
-// "W", "WxH": 1..8192 each.
-std::pair<uint32_t, uint32_t> parseSize(const std::string& text) {
-    const auto number = [&](const std::string& part) {
-        size_t used = 0;
-        unsigned long v = 0;
-        try {
-            v = std::stoul(part, &used);
-        } catch (const std::exception&) {
-            used = 0;
-        }
-        if (used == 0 || used != part.size() || v == 0 || v > 8192) {
-            throw std::runtime_error("--size " + text + ": expected N or WxH with 1..8192 pixels each");
-        }
-        return uint32_t(v);
-    };
-    const size_t x = text.find('x');
-    if (x == std::string::npos) {
-        const uint32_t n = number(text);
-        return {n, n};
-    }
-    return {number(text.substr(0, x)), number(text.substr(x + 1))};
-}
-
 float parseSeconds(const std::string& text) {
     try {
         size_t used = 0;
@@ -96,7 +73,7 @@ int main(int argc, char** argv) {
             return 0;
         }
         const std::string sceneName = args.get("scene", "plaza");
-        const auto [width, height] = parseSize(args.get("size", "256"));
+        const auto [width, height] = app::parseSize(args.get("size", "256"));
         const uint32_t frames = args.getUint("frames", 1);
         if (frames == 0) throw std::runtime_error("--frames 0: must be at least 1");
 
