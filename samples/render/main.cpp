@@ -24,7 +24,8 @@ namespace {
 constexpr const char* kUsage =
     "usage: glint-render [--scene plaza|hard-cases|smoke|FILE.gltf|FILE.glb] [--mode hybrid|ssr|rt|reference]\n"
     "                    [--size WxH|N] [--frames N] [--out IMAGE.png] [--debug-view NAME] [--stats FILE.json]\n"
-    "                    [--backend auto|query|pipeline] [--time SECONDS] [--camera NAME|INDEX]\n"
+    "                    [--backend auto|query|pipeline] [--bvh-queue async|graphics] [--time SECONDS]\n"
+    "                    [--camera NAME|INDEX]\n"
     "                    [--set NAME=VALUE[,NAME=VALUE...]]\n"
     "                    [--tolerance REL] [--seed N] [--max-frames N] (reference mode)\n"
     "                    [--list-debug-views] [--list-parameters] [--validate]";
@@ -60,7 +61,7 @@ int main(int argc, char** argv) {
     return app::runMain("glint-render", [&] {
         app::Args args(argc, argv, kUsage,
                        {"scene", "mode", "size", "frames", "out", "debug-view", "stats", "backend", "time", "set", "tolerance",
-                        "seed", "max-frames", "camera"},
+                        "seed", "max-frames", "camera", "bvh-queue"},
                        {"list-debug-views", "list-parameters"});
         if (args.has("list-parameters")) {
             for (const app::Parameter& p : app::parameters()) {
@@ -116,6 +117,14 @@ int main(int argc, char** argv) {
             }
             start = end + 1;
         }
+        // Where the BVH builds run: async compute (default; the graphics
+        // queue on one-queue devices) or the graphics queue, to measure what
+        // the overlap buys.
+        const std::string bvhQueue = args.get("bvh-queue", "async");
+        if (bvhQueue != "async" && bvhQueue != "graphics") {
+            throw std::runtime_error("--bvh-queue " + bvhQueue + ": expected async or graphics");
+        }
+        options.renderer.bvhUpdate.queue = bvhQueue == "graphics" ? rg::Queue::Graphics : rg::Queue::AsyncCompute;
         options.frame.debugView = args.get("debug-view", "");
         if (!options.frame.debugView.empty()) {
             bool known = false;
