@@ -7,6 +7,7 @@
 
 #include "glint/reflection_frame_shared.h"
 
+#include <algorithm>
 #include <array>
 #include <stdexcept>
 
@@ -220,7 +221,9 @@ ReflectionFrame ReflectionRenderer::addFrame(rg::Graph& graph, const scene::Came
     temporalInputs.camera = camera;
     temporalInputs.frameIndex = frameIndex;
     temporalInputs.resetHistory = settings.resetHistory;
-    f.temporal = addTemporalPass(graph, temporal_, temporalInputs, settings.temporal);
+    TemporalSettings temporalSettings = settings.temporal;
+    temporalSettings.spatialRoughnessMax = std::min(temporalSettings.spatialRoughnessMax, settings.rays.roughnessCutoff);
+    f.temporal = addTemporalPass(graph, temporal_, temporalInputs, temporalSettings);
 
     if (settings.countRays) {
         struct ClearData {

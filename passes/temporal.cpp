@@ -71,6 +71,7 @@ shader::TemporalFrame frameConstants(const TemporalInputs& in, const TemporalSet
     f.spatialPlaneSigma = s.spatialPlaneSigma;
     f.spatialNormalPower = s.spatialNormalPower;
     f.spatialRoughnessSigma = s.spatialRoughnessSigma;
+    f.spatialRoughnessMax = s.spatialRoughnessMax;
     return f;
 }
 

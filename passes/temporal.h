@@ -106,6 +106,11 @@ struct TemporalSettings {
     float spatialPlaneSigma = 0.01f;
     float spatialNormalPower = 128.0f;
     float spatialRoughnessSigma = 0.05f;
+    // Pixels rougher than this are not filtered: above ray generation's
+    // roughness cutoff a pixel takes the environment, which has no noise to
+    // remove (the frame passes its cutoff; on the plaza that skips the 5x5
+    // filter on over half the pixels).
+    float spatialRoughnessMax = 1.0f;
 };
 
 struct TemporalOutputs {

@@ -42,7 +42,7 @@ void main() {
     const float roughness = texelFetch(roughnessMetalTexture, p, 0).r;
     const float strength = ramp(roughness, frame.spatialRoughnessStart, frame.spatialRoughnessEnd);
     const int radius = int(min(frame.spatialRadius, kTemporalMaxSpatialRadius));
-    if (radius == 0 || strength <= 0.0) {
+    if (radius == 0 || strength <= 0.0 || roughness > frame.spatialRoughnessMax) {
         imageStore(resolvedImage, p, vec4(centre.rgb, 1.0));
         return;
     }

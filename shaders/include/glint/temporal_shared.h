@@ -53,7 +53,7 @@ struct TemporalFrame {
     float spatialPlaneSigma;
     float spatialNormalPower;
     float spatialRoughnessSigma;
-    float pad0;
+    float spatialRoughnessMax;
     float pad1;
 };
 
