@@ -5,6 +5,8 @@
 #include <spdlog/spdlog.h>
 
 #include <algorithm>
+#include <chrono>
+#include <ctime>
 #include <tuple>
 
 namespace glint::rg {
@@ -33,6 +35,12 @@ gpu::BufferDesc bufferDescOf(const BufferDesc& b, VkBufferUsageFlags usage, std:
     d.name = std::move(name);
     d.sharedAcrossQueues = shared;
     return d;
+}
+
+double processCpuMilliseconds() {
+    timespec t{};
+    clock_gettime(CLOCK_PROCESS_CPUTIME_ID, &t);
+    return double(t.tv_sec) * 1e3 + double(t.tv_nsec) * 1e-6;
 }
 
 // The name of a history pair: its halves are "<name>.previous" and "<name>.current".
@@ -101,6 +109,7 @@ struct Executor::FrameSlot {
     bool used = false;
     uint64_t endValue[kQueueCount] = {0, 0};  // timeline values that mark this frame done
     std::vector<PassTiming> passes;            // names and queues, in query-pair order
+    bool hostTimed = false;                    // passes[].milliseconds are host times already
 };
 
 // ---------------------------------------------------------------- Executor
@@ -530,6 +539,7 @@ void Executor::run(const Plan& plan, const FrameResources& imports) {
     slot.passes.clear();
     slot.frame = frame_;
     slot.used = true;
+    slot.hostTimed = passTimer_ == PassTimer::HostSerial;
 
     prepareTransients(plan);
     prepareHistory(plan);
@@ -543,38 +553,11 @@ void Executor::run(const Plan& plan, const FrameResources& imports) {
 
     PassContext ctx(*this, gpu_);
     ctx.frame_ = frame_;
+    const bool hostTimed = passTimer_ == PassTimer::HostSerial;
     for (const Batch& batch : plan.batches) {
         const uint32_t qi = static_cast<uint32_t>(batch.queue);
-        VkCommandBuffer cmd = slot.pools[qi].allocate();
-        VkCommandBufferBeginInfo begin{VK_STRUCTURE_TYPE_COMMAND_BUFFER_BEGIN_INFO};
-        begin.flags = VK_COMMAND_BUFFER_USAGE_ONE_TIME_SUBMIT_BIT;
-        gpu::check(vkBeginCommandBuffer(cmd, &begin), "vkBeginCommandBuffer (render graph)");
-        ctx.cmd_ = cmd;
+        const VkQueue queue = queueOf(batch.queue).queue;
         ctx.queue_ = batch.queue;
-        for (const PlannedPass& p : plan.passesOf(batch)) {
-            recordBarriers(cmd, plan, plan.barriersBefore(p));
-            ctx.name_ = plan.passName(p);
-            ctx.plan_ = &plan;
-            ctx.pass_ = &p;
-            gpu::ScopedLabel label(gpu_, cmd, ctx.name_);
-            const uint32_t pair = p.timestampQuery / 2;
-            // ALL_COMMANDS: written once every earlier command of the queue
-            // is done, so a pass is timed from when it can start, not from
-            // when the command processor reached it while earlier passes
-            // were still draining (a TOP_OF_PIPE start charges their tail
-            // to this pass: a 2 MB clear read 0.8 ms on an H200).
-            slot.timer.begin(cmd, pair, VK_PIPELINE_STAGE_2_ALL_COMMANDS_BIT);
-            if (const ExecuteFn& execute = plan.execute(p)) {
-                execute(ctx);
-            }
-            slot.timer.end(cmd, pair);
-            if (slot.passes.size() <= pair) {
-                slot.passes.resize(pair + 1);
-            }
-            slot.passes[pair] = {ctx.name_, p.queue, std::nullopt};
-        }
-        recordBarriers(cmd, plan, plan.barriersAfter(batch));
-        gpu::check(vkEndCommandBuffer(cmd), "vkEndCommandBuffer (render graph)");
 
         std::vector<VkSemaphoreSubmitInfo> waits;
         for (const SemaphoreWait& w : plan.waitsOf(batch)) {
@@ -600,18 +583,98 @@ void Executor::run(const Plan& plan, const FrameResources& imports) {
         signal.semaphore = timelines_[qi].handle();
         signal.value = base[qi] + batch.ordinal + 1;
         signal.stageMask = VK_PIPELINE_STAGE_2_ALL_COMMANDS_BIT;
-        VkCommandBufferSubmitInfo cmdInfo{VK_STRUCTURE_TYPE_COMMAND_BUFFER_SUBMIT_INFO};
-        cmdInfo.commandBuffer = cmd;
-        VkSubmitInfo2 submit{VK_STRUCTURE_TYPE_SUBMIT_INFO_2};
-        submit.waitSemaphoreInfoCount = static_cast<uint32_t>(waits.size());
-        submit.pWaitSemaphoreInfos = waits.data();
-        submit.commandBufferInfoCount = 1;
-        submit.pCommandBufferInfos = &cmdInfo;
-        submit.signalSemaphoreInfoCount = 1;
-        submit.pSignalSemaphoreInfos = &signal;
-        gpu::check(vkQueueSubmit2(queueOf(batch.queue).queue, 1, &submit, VK_NULL_HANDLE),
-                   "vkQueueSubmit2 (render graph, " + std::string(toString(batch.queue)) + " batch " +
-                       std::to_string(batch.ordinal) + ")");
+
+        // One command buffer per batch; with host-timed passes, one per pass
+        // (the batch's waits on the first, its signal on the last).
+        VkCommandBuffer cmd = VK_NULL_HANDLE;
+        bool first = true;
+        const auto begin = [&] {
+            cmd = slot.pools[qi].allocate();
+            VkCommandBufferBeginInfo info{VK_STRUCTURE_TYPE_COMMAND_BUFFER_BEGIN_INFO};
+            info.flags = VK_COMMAND_BUFFER_USAGE_ONE_TIME_SUBMIT_BIT;
+            gpu::check(vkBeginCommandBuffer(cmd, &info), "vkBeginCommandBuffer (render graph)");
+            ctx.cmd_ = cmd;
+        };
+        const auto submit = [&](bool last) {
+            gpu::check(vkEndCommandBuffer(cmd), "vkEndCommandBuffer (render graph)");
+            VkCommandBufferSubmitInfo cmdInfo{VK_STRUCTURE_TYPE_COMMAND_BUFFER_SUBMIT_INFO};
+            cmdInfo.commandBuffer = cmd;
+            VkSubmitInfo2 info{VK_STRUCTURE_TYPE_SUBMIT_INFO_2};
+            if (first) {
+                info.waitSemaphoreInfoCount = static_cast<uint32_t>(waits.size());
+                info.pWaitSemaphoreInfos = waits.data();
+            }
+            info.commandBufferInfoCount = 1;
+            info.pCommandBufferInfos = &cmdInfo;
+            if (last) {
+                info.signalSemaphoreInfoCount = 1;
+                info.pSignalSemaphoreInfos = &signal;
+            }
+            gpu::check(vkQueueSubmit2(queue, 1, &info, VK_NULL_HANDLE),
+                       "vkQueueSubmit2 (render graph, " + std::string(toString(batch.queue)) + " batch " +
+                           std::to_string(batch.ordinal) + ")");
+            first = false;
+        };
+
+        if (!hostTimed) {
+            begin();
+        }
+        const auto batchPasses = plan.passesOf(batch);
+        for (size_t k = 0; k < batchPasses.size(); ++k) {
+            const PlannedPass& p = batchPasses[k];
+            const bool lastPass = k + 1 == batchPasses.size();
+            if (hostTimed) {
+                begin();
+            }
+            recordBarriers(cmd, plan, plan.barriersBefore(p));
+            ctx.name_ = plan.passName(p);
+            ctx.plan_ = &plan;
+            ctx.pass_ = &p;
+            const uint32_t pair = p.timestampQuery / 2;
+            if (slot.passes.size() <= pair) {
+                slot.passes.resize(pair + 1);
+            }
+            slot.passes[pair] = {ctx.name_, p.queue, std::nullopt, frame_};
+            {
+                gpu::ScopedLabel label(gpu_, cmd, ctx.name_);
+                // ALL_COMMANDS: written once every earlier command of the queue
+                // is done, so a pass is timed from when it can start, not from
+                // when the command processor reached it while earlier passes
+                // were still draining (a TOP_OF_PIPE start charges their tail
+                // to this pass: a 2 MB clear read 0.8 ms on an H200).
+                if (!hostTimed) {
+                    slot.timer.begin(cmd, pair, VK_PIPELINE_STAGE_2_ALL_COMMANDS_BIT);
+                }
+                if (const ExecuteFn& execute = plan.execute(p)) {
+                    execute(ctx);
+                }
+                if (!hostTimed) {
+                    slot.timer.end(cmd, pair);
+                }
+            }
+            if (hostTimed) {
+                if (lastPass) {
+                    recordBarriers(cmd, plan, plan.barriersAfter(batch));
+                }
+                // Everything earlier has finished (each submission is waited
+                // for), so this submission's wall time is the pass's own.
+                const auto start = std::chrono::steady_clock::now();
+                const double cpuStart = processCpuMilliseconds();
+                submit(lastPass);
+                gpu::check(vkQueueWaitIdle(queue), "vkQueueWaitIdle (render graph, host-timed pass '" + ctx.name_ + "')");
+                slot.passes[pair].milliseconds =
+                    std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
+                slot.passes[pair].cpuMilliseconds = processCpuMilliseconds() - cpuStart;
+            }
+        }
+        if (!hostTimed) {
+            recordBarriers(cmd, plan, plan.barriersAfter(batch));
+            submit(true);
+        } else if (batchPasses.empty()) {
+            begin();
+            recordBarriers(cmd, plan, plan.barriersAfter(batch));
+            submit(true);
+        }
         lastSignal_[qi] = std::max(lastSignal_[qi], signal.value);
     }
     for (uint32_t q = 0; q < kQueueCount; ++q) {
@@ -639,6 +702,9 @@ std::vector<PassTiming> Executor::timings() const {
         return {};
     }
     std::vector<PassTiming> out = best->passes;
+    if (best->hostTimed) {
+        return out;
+    }
     const auto ms = best->timer.readMilliseconds();
     for (size_t i = 0; i < out.size() && i < ms.size(); ++i) {
         out[i].milliseconds = ms[i];

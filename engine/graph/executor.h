@@ -100,9 +100,23 @@ private:
 struct PassTiming {
     std::string name;
     Queue queue = Queue::Graphics;
-    std::optional<double> milliseconds;  // none where the queue has no timestamps
+    std::optional<double> milliseconds;  // none where the queue has no timestamps (see PassTimer)
     uint64_t frame = 0;                  // the run() it belongs to, counted from 0
+    // PassTimer::HostSerial only: the process's CPU time over the pass (all
+    // threads, the CPU implementation's included): what the pass costs on a
+    // CPU device even when other processes share the cores.
+    std::optional<double> cpuMilliseconds;
 };
+
+// How per-pass times are taken.
+// - GpuTimestamps: a timestamp pair around each pass; the frame runs as the
+//   plan batches it. What a GPU is measured with.
+// - HostSerial: each pass is submitted alone and waited for; its time is the
+//   host's wall time from submission to idle. For CPU implementations
+//   (lavapipe), whose timestamps do not cover compute dispatches; it
+//   serialises the queues (no async overlap) and adds one submission's
+//   overhead (tens of microseconds) to every pass.
+enum class PassTimer : uint8_t { GpuTimestamps, HostSerial };
 
 struct ExecutorStats {
     uint64_t frames = 0;
@@ -129,6 +143,8 @@ public:
     // submission order (after waitIdle(): the last frame run).
     std::vector<PassTiming> timings() const;
     const ExecutorStats& stats() const { return stats_; }
+    void setPassTimer(PassTimer timer) { passTimer_ = timer; }
+    PassTimer passTimer() const { return passTimer_; }
 
 private:
     friend class PassContext;
@@ -161,6 +177,7 @@ private:
     std::vector<Physical> physical_;
     std::vector<std::string> resourceNames_;
     ExecutorStats stats_;
+    PassTimer passTimer_ = PassTimer::GpuTimestamps;
 };
 
 }  // namespace glint::rg

@@ -64,6 +64,9 @@ struct RunInfo {
     double ppd = 0.0;
     double relMseEpsilon = 0.0;
     std::string timeAxis;       // "reflection_ms" or "frame_wall_ms": what the plot's x is
+    // How pass times were taken: "gpu_timestamps", or "host_serial" (each
+    // pass submitted alone and timed on the host: CPU devices).
+    std::string passTimer = "gpu_timestamps";
     uint32_t referenceFrames = 0;
     bool referenceConverged = false;
     double referenceLastChange = 0.0;

@@ -207,10 +207,14 @@ ReflectionRunResult runReflections(gpu::Context& ctx, scene::Scene& scene, const
     const ReflectionRunOptions options = reference ? referenceSettings(requested) : requested;
     if (options.frames == 0) throw std::invalid_argument("--frames must be at least 1");
     rg::Executor executor(ctx, options.renderer.framesInFlight);
+    const bool cpuDevice = ctx.caps().deviceType == VK_PHYSICAL_DEVICE_TYPE_CPU;
+    executor.setPassTimer(options.passTimer.value_or(cpuDevice ? rg::PassTimer::HostSerial
+                                                               : rg::PassTimer::GpuTimestamps));
     passes::ReflectionRenderer renderer(ctx, scene, options.renderer);
 
     ReflectionRunResult result;
     result.backend = renderer.backend();
+    result.passTimer = executor.passTimer();
     const uint32_t w = options.width, h = options.height;
     gpu::Buffer image(ctx, {VkDeviceSize(w) * h * 4, VK_BUFFER_USAGE_TRANSFER_DST_BIT, gpu::MemoryUsage::Readback,
                             "glint.output_readback"});
@@ -229,10 +233,10 @@ ReflectionRunResult runReflections(gpu::Context& ctx, scene::Scene& scene, const
     camera.lens = scene.lens;
     camera.jitter = options.jitter && options.frames > 1;
 
-    std::map<std::string, std::vector<double>> passTimes;
+    std::map<std::string, std::vector<double>> passTimes, passCpuTimes;
     std::map<std::string, rg::Queue> passQueues;
     std::vector<std::string> passOrder;
-    std::vector<double> reflectionTimes, totalTimes;
+    std::vector<double> reflectionTimes, totalTimes, reflectionCpuTimes;
     std::optional<uint64_t> lastTimed;
     std::vector<double> wallTimes;
     const auto collectTimings = [&] {
@@ -242,17 +246,24 @@ ReflectionRunResult runReflections(gpu::Context& ctx, scene::Scene& scene, const
         double reflection = 0.0, total = 0.0;
         bool any = false;
         // Passes that share a name (the pyramid's levels) count as one.
-        std::map<std::string, double> frameTimes;
+        std::map<std::string, double> frameTimes, frameCpuTimes;
+        double reflectionCpu = 0.0;
         for (const rg::PassTiming& t : timings) {
             if (!t.milliseconds) continue;
             any = true;
             if (!passTimes.count(t.name) && !frameTimes.count(t.name)) passOrder.push_back(t.name);
             frameTimes[t.name] += *t.milliseconds;
+            if (t.cpuMilliseconds) {
+                frameCpuTimes[t.name] += *t.cpuMilliseconds;
+                if (passes::isReflectionPass(t.name)) reflectionCpu += *t.cpuMilliseconds;
+            }
             passQueues[t.name] = t.queue;
             total += *t.milliseconds;
             if (passes::isReflectionPass(t.name)) reflection += *t.milliseconds;
         }
         for (const auto& [name, ms] : frameTimes) passTimes[name].push_back(ms);
+        for (const auto& [name, ms] : frameCpuTimes) passCpuTimes[name].push_back(ms);
+        if (!frameCpuTimes.empty()) reflectionCpuTimes.push_back(reflectionCpu);
         if (any) {
             reflectionTimes.push_back(reflection);
             totalTimes.push_back(total);
@@ -353,12 +364,14 @@ ReflectionRunResult runReflections(gpu::Context& ctx, scene::Scene& scene, const
     if (options.frames == 1 || !options.timeEveryFrame) collectTimings();
 
     for (const std::string& name : passOrder) {
-        result.passes.push_back({name, passQueues[name], median(passTimes[name])});
+        result.passes.push_back({name, passQueues[name], median(passTimes[name]),
+                                 passCpuTimes.count(name) ? std::optional(median(passCpuTimes[name])) : std::nullopt});
     }
     result.framesTimed = uint32_t(totalTimes.size());
     if (!wallTimes.empty()) result.frameWallMs = median(wallTimes);
     if (!totalTimes.empty()) {
         result.reflectionMs = median(reflectionTimes);
+        if (!reflectionCpuTimes.empty()) result.reflectionCpuMs = median(reflectionCpuTimes);
         result.totalMs = median(totalTimes);
     }
     result.rgba.resize(size_t(w) * h * 4);
@@ -399,9 +412,14 @@ std::string statsJson(const gpu::Context& ctx, const ReflectionRunOptions& optio
         passList.push_back({{"name", p.name},
                             {"queue", p.queue == rg::Queue::AsyncCompute ? "async_compute" : "graphics"},
                             {"gpu_ms", p.milliseconds}});
+        if (p.cpuMilliseconds) passList.back()["cpu_ms"] = *p.cpuMilliseconds;
     }
     j["passes"] = passList;
+    // gpu_ms is a GPU timestamp difference, or with host_serial the host's
+    // wall time of the pass submitted alone (CPU devices).
+    j["pass_timer"] = r.passTimer == rg::PassTimer::HostSerial ? "host_serial" : "gpu_timestamps";
     j["reflection_ms"] = r.reflectionMs ? json(*r.reflectionMs) : json(nullptr);
+    if (r.reflectionCpuMs) j["reflection_cpu_ms"] = *r.reflectionCpuMs;
     j["total_ms"] = r.totalMs ? json(*r.totalMs) : json(nullptr);
     j["frame_wall_ms"] = r.frameWallMs ? json(*r.frameWallMs) : json(nullptr);
     j["rays"] = {{"sslr", r.sslrRays}, {"rt", r.rtRays}};

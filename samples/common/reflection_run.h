@@ -53,6 +53,9 @@ struct ReflectionRunOptions {
     // pass's output) into ReflectionRunResult::resolved: the benchmark
     // measures the reflection term's error on it, before the composite.
     bool readResolved = false;
+    // How pass times are taken; none: host-serial on a CPU device (lavapipe's
+    // timestamps do not cover compute dispatches), GPU timestamps elsewhere.
+    std::optional<rg::PassTimer> passTimer;
     passes::ReflectionRendererOptions renderer;
     passes::ReflectionFrameSettings frame;
     ReferenceOptions reference;  // when enabled, `frames` and `mode` are ignored
@@ -62,6 +65,7 @@ struct PassTime {
     std::string name;
     rg::Queue queue = rg::Queue::Graphics;
     double milliseconds = 0.0;  // median over the frames measured
+    std::optional<double> cpuMilliseconds;  // host-serial timing only: median process CPU time
 };
 
 struct ReflectionRunResult {
@@ -71,12 +75,13 @@ struct ReflectionRunResult {
     // the pixel has a reflection, else all zero).
     std::vector<float> resolved;
     std::vector<PassTime> passes;
+    rg::PassTimer passTimer = rg::PassTimer::GpuTimestamps;  // how `passes` were timed
     std::optional<double> reflectionMs;  // median per-frame sum of the reflection passes
     std::optional<double> totalMs;       // median per-frame sum of all passes
+    std::optional<double> reflectionCpuMs;  // host-serial timing only: as reflectionMs, in process CPU time
     uint32_t framesTimed = 0;
-    // Median host time from declaring a frame to its completion. On a CPU
-    // device (lavapipe) it is the frame's cost: there, GPU timestamps do
-    // not cover compute dispatches (an SSLR pass 30x longer read the same).
+    // Median host time from declaring a frame to its completion (with
+    // host-serial pass times, including their waits).
     std::optional<double> frameWallMs;
     // The last frame's counts (glint/reflection_frame_shared.h).
     uint64_t sslrRays = 0;

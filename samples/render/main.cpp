@@ -25,7 +25,7 @@ constexpr const char* kUsage =
     "usage: glint-render [--scene plaza|hard-cases|smoke|FILE.gltf|FILE.glb] [--mode hybrid|ssr|rt|reference]\n"
     "                    [--size WxH|N] [--frames N] [--out IMAGE.png] [--debug-view NAME] [--stats FILE.json]\n"
     "                    [--backend auto|query|pipeline] [--bvh-queue async|graphics] [--time SECONDS]\n"
-    "                    [--camera NAME|INDEX]\n"
+    "                    [--camera NAME|INDEX] [--pass-timer auto|gpu|host]\n"
     "                    [--set NAME=VALUE[,NAME=VALUE...]]\n"
     "                    [--tolerance REL] [--seed N] [--max-frames N] (reference mode)\n"
     "                    [--list-debug-views] [--list-parameters] [--validate]";
@@ -60,7 +60,7 @@ int renderSmoke(gpu::Context& ctx, const std::filesystem::path& outDir, uint32_t
 int main(int argc, char** argv) {
     return app::runMain("glint-render", [&] {
         app::Args args(argc, argv, kUsage,
-                       {"scene", "mode", "size", "frames", "out", "debug-view", "stats", "backend", "time", "set", "tolerance",
+                       {"scene", "mode", "size", "frames", "out", "debug-view", "stats", "backend", "time", "set", "tolerance", "pass-timer",
                         "seed", "max-frames", "camera", "bvh-queue"},
                        {"list-debug-views", "list-parameters"});
         if (args.has("list-parameters")) {
@@ -125,6 +125,17 @@ int main(int argc, char** argv) {
             throw std::runtime_error("--bvh-queue " + bvhQueue + ": expected async or graphics");
         }
         options.renderer.bvhUpdate.queue = bvhQueue == "graphics" ? rg::Queue::Graphics : rg::Queue::AsyncCompute;
+        // Pass times: GPU timestamps, or each pass submitted alone and timed
+        // on the host (auto: host on a CPU device such as lavapipe, whose
+        // timestamps do not cover compute dispatches).
+        const std::string passTimer = args.get("pass-timer", "auto");
+        if (passTimer == "gpu") {
+            options.passTimer = rg::PassTimer::GpuTimestamps;
+        } else if (passTimer == "host") {
+            options.passTimer = rg::PassTimer::HostSerial;
+        } else if (passTimer != "auto") {
+            throw std::runtime_error("--pass-timer " + passTimer + ": expected auto, gpu or host");
+        }
         options.frame.debugView = args.get("debug-view", "");
         if (!options.frame.debugView.empty()) {
             bool known = false;
@@ -169,9 +180,11 @@ int main(int argc, char** argv) {
                          p.queue == rg::Queue::AsyncCompute ? " (async compute)" : "");
         }
         if (result.reflectionMs) {
-            spdlog::info("reflections {:.3f} ms, frame {:.3f} ms GPU, {:.3f} ms wall (median of {} frames); rays: {} "
+            spdlog::info("reflections {:.3f} ms, frame {:.3f} ms {}, {:.3f} ms wall (median of {} frames); rays: {} "
                          "SSLR, {} RT",
-                         *result.reflectionMs, *result.totalMs, result.frameWallMs.value_or(0.0), result.framesTimed,
+                         *result.reflectionMs, *result.totalMs,
+                         result.passTimer == rg::PassTimer::HostSerial ? "host (passes submitted alone)" : "GPU",
+                         result.frameWallMs.value_or(0.0), result.framesTimed,
                          result.sslrRays, result.rtRays);
         }
         if (args.has("stats")) {
