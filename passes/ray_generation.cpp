@@ -10,9 +10,8 @@
 
 namespace glint::passes {
 
-static_assert(kSslrArgsBytes == shader::kSslrArgsOffset * sizeof(uint32_t));
-static_assert(kRtDispatchArgsBytes == shader::kRtListDispatchOffset * sizeof(uint32_t));
-static_assert(kRtTraceArgsBytes == shader::kRtListCountOffset * sizeof(uint32_t));
+static_assert(kRayListDispatchArgsBytes == shader::kRayListDispatchOffset * sizeof(uint32_t));
+static_assert(kRayListTraceArgsBytes == shader::kRayListCountOffset * sizeof(uint32_t));
 static_assert(uint32_t(ReflectionMode::Hybrid) == shader::kModeHybrid && uint32_t(ReflectionMode::Ssr) == shader::kModeSsr &&
               uint32_t(ReflectionMode::Rt) == shader::kModeRt);
 
@@ -58,27 +57,25 @@ RayGenerationOutputs addRayGenerationPass(rg::Graph& graph, RayGenerationPipelin
     out.tilesX = (gbuf.width + shader::kTileSize - 1) / shader::kTileSize;
     out.tilesY = (gbuf.height + shader::kTileSize - 1) / shader::kTileSize;
     const uint64_t pixels = uint64_t(gbuf.width) * gbuf.height;
-    const uint64_t tiles = uint64_t(out.tilesX) * out.tilesY;
 
     // The lists count up from zero every frame, and a dispatch's (or a
     // trace's) y and z are 1: the args are reset by a transfer before the
     // classification.
     struct ClearData {
-        rg::Buffer args, rtArgs;
+        rg::Buffer sslrArgs, rtArgs;
     };
     const ClearData& clear = graph.addPass<ClearData>(
         "ray_generation.clear_args", rg::Queue::Graphics,
         [&](rg::Builder& b, ClearData& d) {
-            d.args = b.write(b.createBuffer("ray_generation.indirect_args", {shader::kIndirectArgsWords * 4u}),
-                             rg::Access::TransferDst);
-            d.rtArgs = b.write(b.createBuffer("ray_generation.rt_args", {shader::kRtListArgsWords * 4u}),
+            d.sslrArgs = b.write(b.createBuffer("ray_generation.sslr_args", {shader::kRayListArgsWords * 4u}),
+                                 rg::Access::TransferDst);
+            d.rtArgs = b.write(b.createBuffer("ray_generation.rt_args", {shader::kRayListArgsWords * 4u}),
                                rg::Access::TransferDst);
         },
         [](const ClearData& d, rg::PassContext& pc) {
-            const std::array<uint32_t, shader::kIndirectArgsWords> initial = {0, 1, 1};
-            vkCmdUpdateBuffer(pc.cmd(), pc.buffer(d.args).handle(), 0, sizeof(initial), initial.data());
-            const std::array<uint32_t, shader::kRtListArgsWords> rtInitial = {0, 1, 1, 0, 1, 1};
-            vkCmdUpdateBuffer(pc.cmd(), pc.buffer(d.rtArgs).handle(), 0, sizeof(rtInitial), rtInitial.data());
+            const std::array<uint32_t, shader::kRayListArgsWords> initial = {0, 1, 1, 0, 1, 1};
+            vkCmdUpdateBuffer(pc.cmd(), pc.buffer(d.sslrArgs).handle(), 0, sizeof(initial), initial.data());
+            vkCmdUpdateBuffer(pc.cmd(), pc.buffer(d.rtArgs).handle(), 0, sizeof(initial), initial.data());
         });
 
     shader::RayGenerationConstants constants{};
@@ -118,9 +115,9 @@ RayGenerationOutputs addRayGenerationPass(rg::Graph& graph, RayGenerationPipelin
             };
             d.out.rays = buffer("ray_generation.rays", pixels * sizeof(shader::PackedRay));
             d.out.classes = buffer("ray_generation.classes", pixels * sizeof(uint32_t));
-            d.out.sslrTiles = buffer("ray_generation.sslr_tiles", tiles * sizeof(uint32_t));
+            d.out.sslrRays = buffer("ray_generation.sslr_rays", pixels * sizeof(shader::PackedRay));
             d.out.rtRays = buffer("ray_generation.rt_rays", pixels * sizeof(shader::PackedRay));
-            d.out.indirectArgs = b.write(clear.args, rg::Access::StorageReadWrite);
+            d.out.sslrArgs = b.write(clear.sslrArgs, rg::Access::StorageReadWrite);
             d.out.rtArgs = b.write(clear.rtArgs, rg::Access::StorageReadWrite);
             d.out.classDebug = b.write(b.createTexture("ray_generation.class_debug",
                                                        {.width = gbuf.width, .height = gbuf.height,
@@ -138,9 +135,9 @@ RayGenerationOutputs addRayGenerationPass(rg::Graph& graph, RayGenerationPipelin
                 .sampledImage(2, pc.view(d.roughnessMetal), sampler, pc.layout(d.roughnessMetal))
                 .storageBuffer(3, pc.buffer(d.out.rays))
                 .storageBuffer(4, pc.buffer(d.out.classes))
-                .storageBuffer(5, pc.buffer(d.out.sslrTiles))
+                .storageBuffer(5, pc.buffer(d.out.sslrRays))
                 .storageBuffer(6, pc.buffer(d.out.rtRays))
-                .storageBuffer(7, pc.buffer(d.out.indirectArgs))
+                .storageBuffer(7, pc.buffer(d.out.sslrArgs))
                 .storageImage(8, pc.view(d.out.classDebug))
                 .storageBuffer(9, pc.buffer(d.out.rtArgs))
                 // Without tile modes the shader never reads binding 10; the

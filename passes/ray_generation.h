@@ -8,16 +8,16 @@
 //     with per-pixel, per-frame low-discrepancy noise (glint/sampling.glsl);
 //   - on rough quads, shares one ray per 2x2 quad (the leader rotates with
 //     the frame);
-// and lists the 8x8 tiles that hold SSLR/hybrid pixels with their
-// VkDispatchIndirectCommand, and the ray leaders of the RT pixels in the RT
-// ray list (which SSLR extends with the hybrid rays it cannot resolve) with
-// args for compute and for vkCmdTraceRaysIndirectKHR. Layouts:
+// and lists the ray leaders of the SSLR and hybrid pixels in the SSLR ray
+// list and those of the RT pixels in the RT ray list (which SSLR extends
+// with the hybrid rays it cannot resolve), each with args for a compute
+// dispatch and for vkCmdTraceRaysIndirectKHR. Layouts:
 // glint/ray_generation_shared.h.
 //
 //   passes::RayGenerationPipelines pipelines(ctx);     // once
 //   each frame, after the G-buffer:
 //     const auto rays = passes::addRayGenerationPass(graph, pipelines, {gbuf, frame, camera}, {});
-//     ... SSLR: dispatchIndirect(rays.indirectArgs, kSslrArgsBytes) over rays.sslrTiles ...
+//     ... SSLR: dispatchIndirect(rays.sslrArgs, kRayListDispatchArgsBytes) over rays.sslrRays ...
 
 #include "gpu/context.h"
 #include "gpu/pipeline.h"
@@ -30,12 +30,10 @@
 
 namespace glint::passes {
 
-// Byte offset of the SSLR tiles' dispatch command in RayGenerationOutputs::indirectArgs.
-inline constexpr VkDeviceSize kSslrArgsBytes = 0;
-// Byte offsets of the RT ray list's compute dispatch and trace-rays commands
-// in RayGenerationOutputs::rtArgs.
-inline constexpr VkDeviceSize kRtDispatchArgsBytes = 0;
-inline constexpr VkDeviceSize kRtTraceArgsBytes = 3 * sizeof(uint32_t);
+// Byte offsets of a ray list's compute dispatch and trace-rays commands in
+// its args (RayGenerationOutputs::sslrArgs, rtArgs).
+inline constexpr VkDeviceSize kRayListDispatchArgsBytes = 0;
+inline constexpr VkDeviceSize kRayListTraceArgsBytes = 3 * sizeof(uint32_t);
 
 // Which trace resolves a pixel's reflection: issue 5's three modes.
 enum class ReflectionMode : uint32_t { Hybrid, Ssr, Rt };
@@ -85,10 +83,10 @@ struct RayGenerationSettings {
 struct RayGenerationOutputs {
     rg::Buffer rays;          // shader::PackedRay per pixel
     rg::Buffer classes;       // uint per pixel: shader::kPixel*
-    rg::Buffer sslrTiles;     // uint per listed tile: tx | ty << 16
-    rg::Buffer indirectArgs;  // VkDispatchIndirectCommand over sslrTiles at kSslrArgsBytes
+    rg::Buffer sslrRays;      // SSLR ray list: shader::PackedRay per SSLR/hybrid ray leader (capacity: one per pixel)
+    rg::Buffer sslrArgs;      // shader::kRayListArgsWords: dispatch at kRayListDispatchArgsBytes
     rg::Buffer rtRays;        // RT ray list: shader::PackedRay per RT ray leader (capacity: one per pixel)
-    rg::Buffer rtArgs;        // shader::kRtListArgsWords: dispatch at kRtDispatchArgsBytes, trace at kRtTraceArgsBytes
+    rg::Buffer rtArgs;        // shader::kRayListArgsWords: dispatch at kRayListDispatchArgsBytes, trace at kRayListTraceArgsBytes
     rg::Texture classDebug;   // kRayClassDebugFormat: a colour per class (debug view "ray_classes")
     uint32_t width = 0;
     uint32_t height = 0;

@@ -16,12 +16,12 @@ namespace glint::passes {
 
 namespace {
 
-static_assert(shader::kRtTraceGroupSize == shader::kRtListGroupSize,
+static_assert(shader::kRtTraceGroupSize == shader::kRayListGroupSize,
               "the ray query dispatch runs the list's own dispatch command");
 
 // Byte offsets of the list's two indirect commands (glint/ray_generation_shared.h).
-constexpr VkDeviceSize kDispatchArgsBytes = shader::kRtListDispatchOffset * sizeof(uint32_t);
-constexpr VkDeviceSize kTraceArgsBytes = shader::kRtListCountOffset * sizeof(uint32_t);
+constexpr VkDeviceSize kDispatchArgsBytes = shader::kRayListDispatchOffset * sizeof(uint32_t);
+constexpr VkDeviceSize kTraceArgsBytes = shader::kRayListCountOffset * sizeof(uint32_t);
 
 // Binding numbers of glint/rt_trace.glsl.
 enum Binding : uint32_t {

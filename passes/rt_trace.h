@@ -1,7 +1,7 @@
 #pragma once
 // Pass 4 of the reflection pipeline (issue 5): ray-traced hits and
 // lighting. Traces the rays of the RT ray list (glint/ray_generation_shared.h,
-// kRtList*: ray generation's RT pixels and the hybrid rays SSLR could not
+// kRayList*: ray generation's RT pixels and the hybrid rays SSLR could not
 // resolve) through the BVH update's TLAS, dispatched indirectly from the
 // list's args, so only listed rays cost anything. Per ray:
 //   - the origin is the G-buffer surface at the entry's pixel (the quad
@@ -55,7 +55,7 @@ const char* rtBackendName(RtBackend backend);
 struct RtTraceInputs {
     GBufferOutputs gbuffer;          // depth, normal, roughnessMetal read (SampledRead)
     rg::Buffer rayList;              // shader::PackedRay entries (glint/ray_generation_shared.h)
-    rg::Buffer rayListArgs;          // kRtListArgsWords uints, layout in ray_generation_shared.h (IndirectArgs)
+    rg::Buffer rayListArgs;          // kRayListArgsWords uints, layout in ray_generation_shared.h (IndirectArgs)
     BvhUpdateOutputs bvh;            // tlas (AccelRead), primitivePool, primitiveOffsets (StorageRead)
     shader::SceneLighting lighting;  // passes::sceneLighting(scene, gbufferSettings.lighting)
     // The G-buffer's camera. Origins are reconstructed with the jittered

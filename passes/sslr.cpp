@@ -16,13 +16,13 @@ namespace glint::passes {
 
 namespace {
 
-constexpr uint32_t kBindingCount = 13;
+constexpr uint32_t kBindingCount = 14;
 
 std::vector<gpu::Binding> traceBindings() {
     std::vector<gpu::Binding> bindings;
     for (uint32_t i = 0; i < kBindingCount; ++i) {
         VkDescriptorType type = VK_DESCRIPTOR_TYPE_STORAGE_BUFFER;
-        if (i < 3 || i >= 11) type = VK_DESCRIPTOR_TYPE_COMBINED_IMAGE_SAMPLER;
+        if (i < 3 || i == 11 || i == 12) type = VK_DESCRIPTOR_TYPE_COMBINED_IMAGE_SAMPLER;
         if (i >= 6 && i <= 8) type = VK_DESCRIPTOR_TYPE_STORAGE_IMAGE;
         bindings.push_back({i, type, VK_SHADER_STAGE_COMPUTE_BIT});
     }
@@ -188,7 +188,7 @@ SslrOutputs addSslrPass(rg::Graph& graph, SslrPipelines& pipelines, const SslrIn
 
     struct TraceData {
         rg::Texture depth, normal, lit, roughnessMetal, pyramid;
-        rg::Buffer rays, classes, tiles, tileArgs;
+        rg::Buffer rays, classes, sslrRays, sslrArgs;
         SslrOutputs out;
     };
     const TraceData& trace = graph.addPass<TraceData>(
@@ -201,8 +201,10 @@ SslrOutputs addSslrPass(rg::Graph& graph, SslrPipelines& pipelines, const SslrIn
             if (pyramid.valid()) d.pyramid = b.read(pyramid, rg::Access::SampledRead);
             d.rays = b.read(rays.rays, rg::Access::StorageRead);
             d.classes = b.read(rays.classes, rg::Access::StorageRead);
-            d.tiles = b.read(rays.sslrTiles, rg::Access::StorageRead);
-            d.tileArgs = b.read(rays.indirectArgs, rg::Access::IndirectArgs);
+            d.sslrRays = b.read(rays.sslrRays, rg::Access::StorageRead);
+            // The dispatch's size, and the list's length for the shader.
+            d.sslrArgs = b.read(rays.sslrArgs, rg::Access::IndirectArgs);
+            b.read(rays.sslrArgs, rg::Access::StorageRead);
             d.out = out;
             d.out.radiance = b.write(clear.radiance, rg::Access::StorageWrite);
             d.out.confidence = b.write(clear.confidence, rg::Access::StorageWrite);
@@ -222,7 +224,7 @@ SslrOutputs addSslrPass(rg::Graph& graph, SslrPipelines& pipelines, const SslrIn
                 .sampledImage(2, pc.view(d.lit), sampler, pc.layout(d.lit))
                 .storageBuffer(3, pc.buffer(d.rays))
                 .storageBuffer(4, pc.buffer(d.classes))
-                .storageBuffer(5, pc.buffer(d.tiles))
+                .storageBuffer(5, pc.buffer(d.sslrRays))
                 .storageImage(6, pc.view(d.out.radiance))
                 .storageImage(7, pc.view(d.out.confidence))
                 .storageImage(8, pc.view(d.out.hitDebug))
@@ -233,9 +235,10 @@ SslrOutputs addSslrPass(rg::Graph& graph, SslrPipelines& pipelines, const SslrIn
                 // read; the lit colour completes the descriptor set.
                 .sampledImage(12, pc.view(d.pyramid.valid() ? d.pyramid : d.lit), pipelines.trilinear_.handle(),
                               pc.layout(d.pyramid.valid() ? d.pyramid : d.lit))
+                .storageBuffer(13, pc.buffer(d.sslrArgs))
                 .push(pipelines.ctx_, pc.cmd());
             pipeline.pushConstants(pc.cmd(), constants);
-            pc.dispatchIndirect(pipeline, d.tileArgs, kSslrArgsBytes);
+            pc.dispatchIndirect(pipeline, d.sslrArgs, kRayListDispatchArgsBytes);
         });
     return trace.out;
 }

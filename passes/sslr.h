@@ -1,7 +1,7 @@
 #pragma once
 // Pass 3 of the reflection pipeline (issue 5): screen-space reflections.
-// One compute pass, dispatched indirectly over ray generation's SSLR tile
-// list (8x8 tiles), traces each ray leader of the SSLR and hybrid pixels
+// One compute pass, dispatched indirectly over ray generation's SSLR ray
+// list (one invocation per ray), traces each ray leader of the SSLR and hybrid pixels
 // across the depth buffer: a linear march of large steps with a per-pixel
 // random start offset, then binary refinement (Far Cry 6 talk, DESIGN.md
 // section 3). It writes the lit colour at the hit and a confidence in
@@ -12,7 +12,7 @@
 //   passes::SslrPipelines sslrPipelines(ctx);           // once
 //   each frame, after the ray generation:
 //     const auto sslr = passes::addSslrPass(graph, sslrPipelines, {gbuf, rays, frame, camera}, {});
-//     ... RT: dispatchIndirect(sslr.rtArgs, kRtDispatchArgsBytes) over sslr.rtRayList ...
+//     ... RT: dispatchIndirect(sslr.rtArgs, kRayListDispatchArgsBytes) over sslr.rtRayList ...
 
 #include "gpu/context.h"
 #include "gpu/pipeline.h"
@@ -78,7 +78,7 @@ struct SslrOutputs {
     rg::Texture confidence;  // kSslrConfidenceFormat, [0, 1]
     rg::Texture hitDebug;    // kSslrHitDebugFormat: hit uv, confidence, hit (debug view "sslr_hits")
     rg::Buffer rtRayList;    // ray generation's RT ray list with the unresolved hybrid rays appended
-    rg::Buffer rtArgs;       // its args (glint/ray_generation_shared.h kRtList*)
+    rg::Buffer rtArgs;       // its args (glint/ray_generation_shared.h kRayList*)
     rg::Texture litPyramid;  // the cone trace's colour pyramid (invalid without cone trace)
     uint32_t width = 0;
     uint32_t height = 0;

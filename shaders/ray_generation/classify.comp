@@ -3,8 +3,8 @@
 // workgroup per 8x8 tile. Each pixel is classified (sky, env, SSLR,
 // hybrid, RT), draws one GGX visible-normal reflection ray, and rough
 // pixels of a 2x2 quad share the quad leader's ray; the tile then appends
-// itself to the SSLR tile list and its RT pixels' ray leaders to the RT ray
-// list, counting both in their indirect args.
+// its SSLR and hybrid pixels' ray leaders to the SSLR ray list and its RT
+// pixels' leaders to the RT ray list, counting both in their args.
 #extension GL_GOOGLE_include_directive : require
 #extension GL_EXT_scalar_block_layout : require
 
@@ -19,9 +19,9 @@ layout(set = 0, binding = 1) uniform sampler2D normalTexture;
 layout(set = 0, binding = 2) uniform sampler2D roughnessMetalTexture;
 layout(set = 0, binding = 3, scalar) writeonly buffer Rays { PackedRay rays[]; };
 layout(set = 0, binding = 4, scalar) writeonly buffer Classes { uint classes[]; };
-layout(set = 0, binding = 5, scalar) writeonly buffer SslrTiles { uint sslrTiles[]; };
+layout(set = 0, binding = 5, scalar) writeonly buffer SslrRays { PackedRay sslrRays[]; };
 layout(set = 0, binding = 6, scalar) writeonly buffer RtRays { PackedRay rtRays[]; };
-layout(set = 0, binding = 7, scalar) buffer Args { uint args[]; };
+layout(set = 0, binding = 7, scalar) buffer SslrArgs { uint sslrArgs[]; };
 layout(set = 0, binding = 8, rgba8) uniform writeonly image2D classDebug;
 layout(set = 0, binding = 9, scalar) buffer RtArgs { uint rtArgs[]; };
 // The feedback pass's kTileMode* per tile (glint/feedback_shared.h); read
@@ -33,9 +33,10 @@ layout(push_constant, scalar) uniform Constants { RayGenerationConstants pc; };
 shared uint sharedClass[64];
 shared uint sharedRough[64];  // 1: may share its quad's ray
 shared uint sharedDirection[64];
-shared uint sharedSslr;
-shared uint sharedRtCount;  // RT ray leaders of the tile
-shared uint sharedRtBase;   // their first slot in the RT list
+shared uint sharedSslrCount;  // SSLR and hybrid ray leaders of the tile
+shared uint sharedSslrBase;   // their first slot in the SSLR list
+shared uint sharedRtCount;    // RT ray leaders of the tile
+shared uint sharedRtBase;     // their first slot in the RT list
 
 // Colours of the classes for the debug view: black sky, grey env, blue
 // SSLR, purple hybrid, red RT.
@@ -75,7 +76,7 @@ void main() {
     const uint lane = gl_LocalInvocationIndex;
     const bool inside = pixel.x < pc.size.x && pixel.y < pc.size.y;
     if (lane == 0u) {
-        sharedSslr = 0u;
+        sharedSslrCount = 0u;
         sharedRtCount = 0u;
     }
 
@@ -143,36 +144,43 @@ void main() {
         }
         rays[index] = ray;
         imageStore(classDebug, ivec2(pixel), kClassColours[pixelClass]);
-        if (pixelClass == kPixelSslr || pixelClass == kPixelHybrid) {
-            atomicOr(sharedSslr, 1u);
-        }
     }
-    // RT ray leaders take consecutive slots of the tile's range in the RT
-    // list: one global atomic per tile, not per ray.
-    const bool rtLeader = inside && pixelClass == kPixelRt && !reused;
+    // Ray leaders take consecutive slots of the tile's range in their list:
+    // one global atomic per tile and list, not per ray.
+    const bool leader = inside && pixelClass >= kPixelSslr && !reused;
+    const bool rtLeader = leader && pixelClass == kPixelRt;
+    const bool sslrLeader = leader && !rtLeader;
     uint localSlot = 0u;
     if (rtLeader) {
         localSlot = atomicAdd(sharedRtCount, 1u);
+    } else if (sslrLeader) {
+        localSlot = atomicAdd(sharedSslrCount, 1u);
     }
     barrier();
 
     if (lane == 0u) {
-        const uint tile = gl_WorkGroupID.x | (gl_WorkGroupID.y << 16u);
-        if (sharedSslr != 0u) {
-            sslrTiles[atomicAdd(args[kSslrArgsOffset], 1u)] = tile;
+        if (sharedSslrCount != 0u) {
+            const uint base = atomicAdd(sslrArgs[kRayListCountOffset], sharedSslrCount);
+            sharedSslrBase = base;
+            const uint end = base + sharedSslrCount;
+            atomicMax(sslrArgs[kRayListDispatchOffset], (end + kRayListGroupSize - 1u) / kRayListGroupSize);
         }
         if (sharedRtCount != 0u) {
-            const uint base = atomicAdd(rtArgs[kRtListCountOffset], sharedRtCount);
+            const uint base = atomicAdd(rtArgs[kRayListCountOffset], sharedRtCount);
             sharedRtBase = base;
             const uint end = base + sharedRtCount;
-            atomicMax(rtArgs[kRtListDispatchOffset], (end + kRtListGroupSize - 1u) / kRtListGroupSize);
+            atomicMax(rtArgs[kRayListDispatchOffset], (end + kRayListGroupSize - 1u) / kRayListGroupSize);
         }
     }
     barrier();
-    if (rtLeader) {
+    if (leader) {
         PackedRay ray;
         ray.pixelFlags = packRayPixel(pixel, false);
         ray.direction = direction;
-        rtRays[sharedRtBase + localSlot] = ray;
+        if (rtLeader) {
+            rtRays[sharedRtBase + localSlot] = ray;
+        } else {
+            sslrRays[sharedSslrBase + localSlot] = ray;
+        }
     }
 }

@@ -41,6 +41,6 @@ void main() {
         atomicAdd(counts[lane], sharedCounts[lane]);
     }
     if (lane == 0u && gl_WorkGroupID.xy == uvec2(0u) && pc.rtListCounted != 0u) {
-        counts[kCountRtRays] = rtArgs[kRtListCountOffset];
+        counts[kCountRtRays] = rtArgs[kRayListCountOffset];
     }
 }

@@ -2,7 +2,7 @@
 // Ray-traced hits and lighting (passes/rt_trace.h), ray query backend:
 // one invocation per RT list entry, dispatched indirectly from the list's
 // args (word 0); invocations past the list's length (word
-// kRtListCountOffset) trace nothing. Everything but the two traversals is
+// kRayListCountOffset) trace nothing. Everything but the two traversals is
 // glint/rt_trace.glsl, shared with the ray tracing pipeline backend.
 #extension GL_EXT_ray_query : require
 #extension GL_GOOGLE_include_directive : require
@@ -47,7 +47,7 @@ bool rtTraceOccluded(vec3 origin, vec3 direction, float tMax) {
 
 void main() {
     const uint index = gl_GlobalInvocationID.x;
-    if (index >= rayListArgs[kRtListCountOffset]) {
+    if (index >= rayListArgs[kRayListCountOffset]) {
         return;
     }
     rtTraceListEntry(index);

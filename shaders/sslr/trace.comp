@@ -1,7 +1,7 @@
 #version 460
-// Screen-space reflections (passes/sslr.h): one 8x8 workgroup per tile of
-// ray generation's SSLR list (dispatched indirectly from its args). Each
-// ray leader of an SSLR or hybrid pixel marches its ray across the depth
+// Screen-space reflections (passes/sslr.h): one invocation per entry of
+// ray generation's SSLR ray list (dispatched indirectly from its args).
+// Each ray leader of an SSLR or hybrid pixel marches its ray across the depth
 // buffer in screen space: kLinearSteps large steps with a per-pixel random
 // start offset, then a binary search between the last step in front of the
 // surface and the first behind it (the Far Cry 6 talk's linear-then-refine
@@ -15,14 +15,14 @@
 #include "glint/sampling.glsl"
 #include "glint/sslr_shared.h"
 
-layout(local_size_x = 8, local_size_y = 8) in;
+layout(local_size_x = kRayListGroupSize) in;
 
 layout(set = 0, binding = 0) uniform sampler2D depthTexture;
 layout(set = 0, binding = 1) uniform sampler2D normalTexture;
 layout(set = 0, binding = 2) uniform sampler2D litTexture;
 layout(set = 0, binding = 3, scalar) readonly buffer Rays { PackedRay rays[]; };
 layout(set = 0, binding = 4, scalar) readonly buffer Classes { uint classes[]; };
-layout(set = 0, binding = 5, scalar) readonly buffer SslrTiles { uint sslrTiles[]; };
+layout(set = 0, binding = 5, scalar) readonly buffer SslrRays { PackedRay sslrRays[]; };
 layout(set = 0, binding = 6, rgba16f) uniform writeonly image2D radianceImage;
 // R16F is not among the formats every device can store with a format
 // qualifier; the context enables shaderStorageImageWriteWithoutFormat.
@@ -34,6 +34,8 @@ layout(set = 0, binding = 11) uniform sampler2D roughnessMetalTexture;
 // The lit colour's box-filtered mip chain (pyramid_*.comp), sampled
 // trilinearly by the cone trace.
 layout(set = 0, binding = 12) uniform sampler2D pyramidTexture;
+// The SSLR list's args: its length at kRayListCountOffset.
+layout(set = 0, binding = 13, scalar) readonly buffer SslrArgs { uint sslrArgs[]; };
 
 layout(push_constant, scalar) uniform Constants { SslrConstants pc; };
 
@@ -79,20 +81,19 @@ void writeResult(ivec2 pixel, vec3 radiance, float confidence, vec2 hitUv, bool 
 }
 
 void main() {
-    const uint tile = sslrTiles[gl_WorkGroupID.x];
-    const uvec2 pixel = uvec2(tile & 0xFFFFu, tile >> 16u) * kTileSize + gl_LocalInvocationID.xy;
+    const uint entry = gl_GlobalInvocationID.x;
+    if (entry >= sslrArgs[kRayListCountOffset]) {
+        return;
+    }
+    // Leaders only (followers read their leader's result,
+    // ray_generation_shared.h), each an SSLR or hybrid pixel.
+    const PackedRay ray = sslrRays[entry];
+    const uvec2 pixel = unpackRayPixel(ray.pixelFlags);
     if (pixel.x >= pc.size.x || pixel.y >= pc.size.y) {
         return;
     }
     const uint index = pixel.y * pc.size.x + pixel.x;
     const uint pixelClass = classes[index];
-    const PackedRay ray = rays[index];
-    // Followers read their leader's result (ray_generation_shared.h); RT
-    // pixels of a mixed tile belong to the RT pass.
-    if ((pixelClass != kPixelSslr && pixelClass != kPixelHybrid) || ray.pixelFlags == kNoRay ||
-        (ray.pixelFlags & kRayReused) != 0u) {
-        return;
-    }
     const ivec2 p = ivec2(pixel);
     const vec2 centre = vec2(pixel) + 0.5;
     const vec3 origin = viewPosition(centre, texelFetch(depthTexture, p, 0).x);
@@ -233,8 +234,8 @@ void main() {
     // (DESIGN.md section 3), where the ray tracer could find nothing better.
     if (pixelClass == kPixelHybrid && confidence < pc.confidenceThreshold) {
         // Appended after ray generation's RT rays (glint/ray_generation_shared.h).
-        const uint slot = atomicAdd(rtArgs[kRtListCountOffset], 1u);
+        const uint slot = atomicAdd(rtArgs[kRayListCountOffset], 1u);
         rtRays[slot] = ray;
-        atomicMax(rtArgs[kRtListDispatchOffset], slot / kRtListGroupSize + 1u);
+        atomicMax(rtArgs[kRayListDispatchOffset], slot / kRayListGroupSize + 1u);
     }
 }

@@ -48,10 +48,10 @@ constexpr size_t kReadbacks = 6;
 struct RayFrame {
     std::vector<shader::PackedRay> rays;
     std::vector<uint32_t> classes;
-    std::vector<uint32_t> sslrTiles;  // the whole buffer; the args say how much is listed
+    std::vector<shader::PackedRay> sslrRays;  // the whole buffer; the args say how much is listed
     std::vector<shader::PackedRay> rtRays;
-    std::array<uint32_t, shader::kIndirectArgsWords> args{};
-    std::array<uint32_t, shader::kRtListArgsWords> rtArgs{};
+    std::array<uint32_t, shader::kRayListArgsWords> sslrArgs{};
+    std::array<uint32_t, shader::kRayListArgsWords> rtArgs{};
 
     size_t at(uint32_t x, uint32_t y) const { return size_t(y) * kSize + x; }
 };
@@ -61,13 +61,12 @@ struct RayFrame {
 class Readback {
 public:
     explicit Readback(gpu::Context& ctx) {
-        const uint64_t tiles = (kSize / shader::kTileSize) * (kSize / shader::kTileSize);
         const std::array<uint64_t, kReadbacks> bytes = {kSize * kSize * sizeof(shader::PackedRay),
                                                         kSize * kSize * 4,
-                                                        tiles * 4,
                                                         kSize * kSize * sizeof(shader::PackedRay),
-                                                        shader::kIndirectArgsWords * 4,
-                                                        shader::kRtListArgsWords * 4};
+                                                        kSize * kSize * sizeof(shader::PackedRay),
+                                                        shader::kRayListArgsWords * 4,
+                                                        shader::kRayListArgsWords * 4};
         for (size_t i = 0; i < buffers_.size(); ++i) {
             buffers_[i] = gpu::Buffer(ctx, {bytes[i], VK_BUFFER_USAGE_TRANSFER_DST_BIT, gpu::MemoryUsage::Readback,
                                             "ray_generation_test.readback" + std::to_string(i)});
@@ -79,8 +78,8 @@ public:
             std::array<rg::Buffer, kReadbacks> sources;
             std::array<rg::Buffer, kReadbacks> targets;
         };
-        const std::array<rg::Buffer, kReadbacks> sources = {out.rays,   out.classes,      out.sslrTiles,
-                                                            out.rtRays, out.indirectArgs, out.rtArgs};
+        const std::array<rg::Buffer, kReadbacks> sources = {out.rays,   out.classes,  out.sslrRays,
+                                                            out.rtRays, out.sslrArgs, out.rtArgs};
         std::array<rg::Buffer, kReadbacks> imports;
         const rg::BoundaryState lastCopy = rg::BoundaryState::of(rg::Access::TransferDst);
         for (size_t i = 0; i < imports.size(); ++i) {
@@ -116,9 +115,9 @@ public:
         };
         copy(f.rays, buffers_[0]);
         copy(f.classes, buffers_[1]);
-        copy(f.sslrTiles, buffers_[2]);
+        copy(f.sslrRays, buffers_[2]);
         copy(f.rtRays, buffers_[3]);
-        std::memcpy(f.args.data(), buffers_[4].mapped(), sizeof(f.args));
+        std::memcpy(f.sslrArgs.data(), buffers_[4].mapped(), sizeof(f.sslrArgs));
         std::memcpy(f.rtArgs.data(), buffers_[5].mapped(), sizeof(f.rtArgs));
         return f;
     }
@@ -350,7 +349,7 @@ TEST_CASE("roughness above the cutoff gives no ray, and no tile is listed") {
             REQUIRE(f.rays[i].pixelFlags == shader::kNoRay);
         }
     }
-    CHECK(f.args == std::array<uint32_t, 3>{0, 1, 1});
+    CHECK(f.sslrArgs == std::array<uint32_t, 6>{0, 1, 1, 0, 1, 1});
     CHECK(f.rtArgs == std::array<uint32_t, 6>{0, 1, 1, 0, 1, 1});
 }
 
@@ -391,25 +390,24 @@ TEST_CASE("the same frame index gives the same rays") {
     }
 }
 
-TEST_CASE("the distance split classes pixels, and tile lists and indirect args agree with a CPU count") {
+TEST_CASE("the distance split classes pixels, and ray lists and indirect args agree with a CPU count") {
     test::GpuTest gpu;
     passes::RayGenerationSettings settings;
     settings.rtMaxDistance = 3.0f;
     settings.sslrMinDistance = 8.0f;
     const RayFrame f = generate(gpu, floorScene(0.05f), {0}, settings).front();
     constexpr uint32_t kTiles = kSize / shader::kTileSize;
-    std::set<uint32_t> sslr, rtLeaders;
+    std::set<uint32_t> sslrLeaders, rtLeaders;
     std::array<uint32_t, shader::kPixelClassCount> counts{};
     for (uint32_t y = 0; y < kSize; ++y) {
         for (uint32_t x = 0; x < kSize; ++x) {
             const uint32_t c = f.classes[f.at(x, y)];
             REQUIRE(c < shader::kPixelClassCount);
             ++counts[c];
-            const uint32_t tile = (x / shader::kTileSize) | ((y / shader::kTileSize) << 16);
-            if (c == shader::kPixelSslr || c == shader::kPixelHybrid) sslr.insert(tile);
             const shader::PackedRay& ray = f.rays[f.at(x, y)];
-            if (c == shader::kPixelRt && ray.pixelFlags == shader::packRayPixel({x, y}, false)) {
-                rtLeaders.insert(ray.pixelFlags);
+            if (ray.pixelFlags == shader::packRayPixel({x, y}, false)) {
+                if (c == shader::kPixelRt) rtLeaders.insert(ray.pixelFlags);
+                if (c == shader::kPixelSslr || c == shader::kPixelHybrid) sslrLeaders.insert(ray.pixelFlags);
             }
             if (!isFloor(y)) continue;
             // The floor y = -1 along view ray d is at distance 1 / -d.y.
@@ -425,31 +423,31 @@ TEST_CASE("the distance split classes pixels, and tile lists and indirect args a
     CHECK(counts[shader::kPixelHybrid] > 0);
     CHECK(counts[shader::kPixelSslr] > 0);
     CHECK(counts[shader::kPixelSky] == kSize * kSize / 2);
-    REQUIRE(f.args[0] == sslr.size());
-    CHECK(f.args[1] == 1);
-    CHECK(f.args[2] == 1);
-    CHECK(sslr.size() < kTiles * kTiles);
-    const std::set<uint32_t> listedSslr(f.sslrTiles.begin(), f.sslrTiles.begin() + f.args[0]);
-    CHECK(listedSslr == sslr);  // and, being sets of the listed size, no duplicates
-    CHECK(listedSslr.size() == f.args[0]);
-    // The RT list holds each RT ray leader once, with its own ray; the
+    CHECK(sslrLeaders.size() < kTiles * kTiles * shader::kTileSize * shader::kTileSize);
+    // Each list holds each of its ray leaders once, with its own ray; the
     // dispatch covers it in 64-wide groups and the trace-rays command is
     // {count, 1, 1}.
-    const uint32_t count = f.rtArgs[shader::kRtListCountOffset];
-    REQUIRE(count == rtLeaders.size());
-    CHECK(f.rtArgs[0] == (count + shader::kRtListGroupSize - 1) / shader::kRtListGroupSize);
-    CHECK(f.rtArgs[1] == 1);
-    CHECK(f.rtArgs[2] == 1);
-    CHECK(f.rtArgs[4] == 1);
-    CHECK(f.rtArgs[5] == 1);
-    std::set<uint32_t> listedRt;
-    for (uint32_t k = 0; k < count; ++k) {
-        const shader::PackedRay& listed = f.rtRays[k];
-        listedRt.insert(listed.pixelFlags);
-        const glm::uvec2 p = shader::unpackRayPixel(listed.pixelFlags);
-        REQUIRE(listed.direction == f.rays[f.at(p.x, p.y)].direction);
-    }
-    CHECK(listedRt == rtLeaders);
+    const auto checkList = [&](const char* what, const std::array<uint32_t, shader::kRayListArgsWords>& args,
+                               const std::vector<shader::PackedRay>& list, const std::set<uint32_t>& leaders) {
+        INFO(what << " list");
+        const uint32_t count = args[shader::kRayListCountOffset];
+        REQUIRE(count == leaders.size());
+        CHECK(args[0] == (count + shader::kRayListGroupSize - 1) / shader::kRayListGroupSize);
+        CHECK(args[1] == 1);
+        CHECK(args[2] == 1);
+        CHECK(args[4] == 1);
+        CHECK(args[5] == 1);
+        std::set<uint32_t> listed;
+        for (uint32_t k = 0; k < count; ++k) {
+            const shader::PackedRay& entry = list[k];
+            listed.insert(entry.pixelFlags);
+            const glm::uvec2 p = shader::unpackRayPixel(entry.pixelFlags);
+            REQUIRE(entry.direction == f.rays[f.at(p.x, p.y)].direction);
+        }
+        CHECK(listed == leaders);  // and, being sets of the listed size, no duplicates
+    };
+    checkList("SSLR", f.sslrArgs, f.sslrRays, sslrLeaders);
+    checkList("RT", f.rtArgs, f.rtRays, rtLeaders);
 }
 
 TEST_CASE("rough 2x2 quads share their leader's ray, and the leader rotates with the frame") {
@@ -518,15 +516,15 @@ TEST_CASE("the ssr and rt modes send every traced pixel one way, and the RT list
             }
         }
         CHECK(traced == kSize * kSize / 2);
-        const uint32_t count = f.rtArgs[shader::kRtListCountOffset];
+        const uint32_t count = f.rtArgs[shader::kRayListCountOffset];
         if (mode == passes::ReflectionMode::Ssr) {
             CHECK(count == 0);
             CHECK(f.rtArgs[0] == 0);
-            CHECK(f.args[0] == kSize / shader::kTileSize * kSize / shader::kTileSize / 2);
+            CHECK(f.sslrArgs[shader::kRayListCountOffset] == leaders);
         } else {
             CHECK(count == leaders);
-            CHECK(f.rtArgs[0] == (count + shader::kRtListGroupSize - 1) / shader::kRtListGroupSize);
-            CHECK(f.args[0] == 0);
+            CHECK(f.rtArgs[0] == (count + shader::kRayListGroupSize - 1) / shader::kRayListGroupSize);
+            CHECK(f.sslrArgs[shader::kRayListCountOffset] == 0);
         }
     }
 }

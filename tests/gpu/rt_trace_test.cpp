@@ -282,7 +282,7 @@ public:
         const VkDeviceSize capacity = VkDeviceSize(kSize) * kSize * sizeof(shader::PackedRay);
         rays_ = gpu::Buffer(ctx, {capacity, VK_BUFFER_USAGE_STORAGE_BUFFER_BIT, gpu::MemoryUsage::Upload,
                                   "rt_test.ray_list"});
-        args_ = gpu::Buffer(ctx, {shader::kRtListArgsWords * sizeof(uint32_t),
+        args_ = gpu::Buffer(ctx, {shader::kRayListArgsWords * sizeof(uint32_t),
                                   VK_BUFFER_USAGE_STORAGE_BUFFER_BIT | VK_BUFFER_USAGE_INDIRECT_BUFFER_BIT,
                                   gpu::MemoryUsage::Upload, "rt_test.ray_list_args"});
         const VkDeviceSize pixels = VkDeviceSize(kSize) * kSize;
@@ -313,8 +313,8 @@ public:
         REQUIRE(list.entries.size() <= size_t(kSize) * kSize);
         REQUIRE(list.count <= list.entries.size());
         std::memcpy(rays_.mapped(), list.entries.data(), list.entries.size() * sizeof(shader::PackedRay));
-        const uint32_t groups = (list.count + shader::kRtListGroupSize - 1) / shader::kRtListGroupSize;
-        const std::array<uint32_t, shader::kRtListArgsWords> argWords = {groups, 1, 1, list.count, 1, 1};
+        const uint32_t groups = (list.count + shader::kRayListGroupSize - 1) / shader::kRayListGroupSize;
+        const std::array<uint32_t, shader::kRayListArgsWords> argWords = {groups, 1, 1, list.count, 1, 1};
         std::memcpy(args_.mapped(), argWords.data(), sizeof(argWords));
 
         // The graph orders each frame after the previous one as if it ran

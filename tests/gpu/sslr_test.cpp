@@ -48,7 +48,7 @@ struct SslrFrame {
     std::vector<shader::PackedRay> rays;
     std::vector<uint32_t> classes;
     std::vector<shader::PackedRay> rtRays;
-    std::array<uint32_t, shader::kRtListArgsWords> rtArgs{};
+    std::array<uint32_t, shader::kRayListArgsWords> rtArgs{};
     std::vector<glm::vec4> radiance;
     std::vector<float> confidence;
     std::vector<glm::vec4> hitDebug;
@@ -68,7 +68,7 @@ public:
         const uint64_t pixels = kSize * kSize;
         const std::array<uint64_t, kBuffers + kTextures> bytes = {
             pixels * sizeof(shader::PackedRay), pixels * 4, pixels * sizeof(shader::PackedRay),
-            shader::kRtListArgsWords * 4, pixels * 8, pixels * 2, pixels * 8, pixels * 8};
+            shader::kRayListArgsWords * 4, pixels * 8, pixels * 2, pixels * 8, pixels * 8};
         for (size_t i = 0; i < buffers_.size(); ++i) {
             buffers_[i] = gpu::Buffer(ctx, {bytes[i], VK_BUFFER_USAGE_TRANSFER_DST_BIT, gpu::MemoryUsage::Readback,
                                             "sslr_test.readback" + std::to_string(i)});
@@ -348,10 +348,10 @@ TEST_CASE("SSLR lists exactly the hybrid rays below the confidence threshold for
             }
         }
     }
-    const uint32_t count = f.rtArgs[shader::kRtListCountOffset];
+    const uint32_t count = f.rtArgs[shader::kRayListCountOffset];
     REQUIRE(count == expected.size());
     REQUIRE(count > 0);
-    CHECK(f.rtArgs[0] == (count + shader::kRtListGroupSize - 1) / shader::kRtListGroupSize);
+    CHECK(f.rtArgs[0] == (count + shader::kRayListGroupSize - 1) / shader::kRayListGroupSize);
     CHECK(f.rtArgs[1] == 1u);
     CHECK(f.rtArgs[2] == 1u);
     CHECK(f.rtArgs[4] == 1u);
@@ -382,7 +382,7 @@ TEST_CASE("rays from a mirror wall back toward the camera leave the screen with 
     const passes::SslrSettings settings;
     const SslrFrame f = trace(gpu, 2, settings, 0.0f);
     std::set<uint32_t> listed;
-    for (uint32_t k = 0; k < f.rtArgs[shader::kRtListCountOffset]; ++k) listed.insert(f.rtRays[k].pixelFlags);
+    for (uint32_t k = 0; k < f.rtArgs[shader::kRayListCountOffset]; ++k) listed.insert(f.rtRays[k].pixelFlags);
     uint32_t checked = 0;
     const float wallTopPixel = wallPixel({0.0f, kWallTop}).y;
     for (uint32_t y = 0; y < kSize; ++y) {

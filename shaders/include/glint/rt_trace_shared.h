@@ -2,7 +2,7 @@
 // shaders/rt_trace/*): constants and the scene constants block, shared by
 // GLSL and C++. Buffers use scalar layout.
 //
-// Inputs: the RT ray list (glint/ray_generation_shared.h, kRtList*): each
+// Inputs: the RT ray list (glint/ray_generation_shared.h, kRayList*): each
 // entry's ray leaves the G-buffer surface at the pixel its pixelFlags name,
 // along unpackRayDirection(direction).
 // Outputs, per pixel (every pixel no listed ray names keeps the cleared 0):

@@ -9,7 +9,7 @@
 //   hitDebug    xy = hit uv, z = confidence, w = 1 on a hit
 // RT hand-off: each hybrid ray whose confidence is below the threshold is
 // appended to ray generation's RT ray list (glint/ray_generation_shared.h,
-// kRtList*), after the RT pixels' rays.
+// kRayList*), after the RT pixels' rays.
 #ifndef GLINT_SSLR_SHARED_H
 #define GLINT_SSLR_SHARED_H
 
