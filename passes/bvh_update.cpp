@@ -104,6 +104,15 @@ struct BvhManager::FrameWork {
     std::optional<gpu::AccelBuild> tlasBuild;
     std::shared_ptr<gpu::Buffer> poolCopySource;  // the outgrown pool, copied into the new one first
     VkDeviceSize poolCopyBytes = 0;
+    // Geometry that enters the GPU this frame: host-written staging copied
+    // into its device-local buffer at the start of the pass, on the pass's
+    // own queue, so a first entry into range never blocks the host on a
+    // submission of its own.
+    struct Upload {
+        std::shared_ptr<gpu::Buffer> staging;
+        const gpu::Buffer* target = nullptr;
+    };
+    std::vector<Upload> uploads;
     // Particles: empty without (then nothing below is recorded).
     std::vector<shader::ParticleData> particles;
     shader::ParticleBillboardParams billboard{};
@@ -178,7 +187,8 @@ void BvhManager::bind(rg::FrameResources& resources, const BvhUpdateOutputs& out
 // Uploads and growth
 // ---------------------------------------------------------------------------
 
-const BvhManager::SourceGeometry& BvhManager::sourceGeometry(uint32_t mesh, uint32_t lod, uint32_t geometry) {
+const BvhManager::SourceGeometry& BvhManager::sourceGeometry(uint32_t mesh, uint32_t lod, uint32_t geometry,
+                                                             FrameWork& work) {
     auto& slot = geometries_[{mesh, lod, geometry}];
     if (slot) {
         return *slot;
@@ -199,11 +209,18 @@ const BvhManager::SourceGeometry& BvhManager::sourceGeometry(uint32_t mesh, uint
     }
     auto source = std::make_unique<SourceGeometry>();
     source->triangleCount = g.triangleCount();
+    // The buffers are filled by the frame's pass (FrameWork::uploads); the
+    // staging lives until that frame has finished.
+    std::vector<std::pair<std::shared_ptr<gpu::Buffer>, gpu::Buffer*>> staged;
     const auto upload = [&](const void* data, size_t bytes, const std::string& what) {
-        return gpu::createBufferWithData(ctx_,
-                                         {std::max<VkDeviceSize>(bytes, 4), VK_BUFFER_USAGE_STORAGE_BUFFER_BIT,
-                                          gpu::MemoryUsage::DeviceLocal, name + what, true},
-                                         data);
+        const VkDeviceSize size = std::max<VkDeviceSize>(bytes, 4);
+        auto staging = std::make_shared<gpu::Buffer>(
+            ctx_, gpu::BufferDesc{size, VK_BUFFER_USAGE_TRANSFER_SRC_BIT, gpu::MemoryUsage::Upload,
+                                  name + what + ".staging", true});
+        std::memcpy(staging->mapped(), data, bytes);
+        staged.push_back({staging, nullptr});
+        return gpu::Buffer(ctx_, {size, VK_BUFFER_USAGE_STORAGE_BUFFER_BIT | VK_BUFFER_USAGE_TRANSFER_DST_BIT,
+                                  gpu::MemoryUsage::DeviceLocal, name + what, true});
     };
     source->vertices = upload(vertices.data(), vertices.size() * sizeof(vertices[0]), ".vertices");
     source->indices = upload(g.indices.data(), g.indices.size() * sizeof(uint32_t), ".indices");
@@ -219,11 +236,19 @@ const BvhManager::SourceGeometry& BvhManager::sourceGeometry(uint32_t mesh, uint
         stats_.geometryBytes += source->skin.size();
     }
     ++stats_.uploadedGeometries;
+    staged[0].second = &source->vertices;
+    staged[1].second = &source->indices;
+    if (source->skin) staged[2].second = &source->skin;
+    for (auto& [staging, target] : staged) {
+        stats_.uploadBytes += staging->size();
+        retired_.push_back({frame_, staging});
+        work.uploads.push_back({std::move(staging), target});
+    }
     slot = std::move(source);
     return *slot;
 }
 
-BvhManager::ResidentBlas& BvhManager::createBlas(const scene::BlasDesc& desc) {
+BvhManager::ResidentBlas& BvhManager::createBlas(const scene::BlasDesc& desc, FrameWork& work) {
     auto blas = std::make_unique<ResidentBlas>();
     blas->desc = desc;
     const std::string name = "bvh.blas" + std::to_string(desc.id) + "." + scene_.meshes.at(desc.mesh).name;
@@ -233,7 +258,7 @@ BvhManager::ResidentBlas& BvhManager::createBlas(const scene::BlasDesc& desc) {
     std::vector<gpu::TriangleGeometry> triangles;
     VkDeviceSize first = 0;
     for (const scene::BlasGeometry& g : desc.geometries) {
-        blas->sources.push_back(&sourceGeometry(desc.mesh, desc.lod, g.meshGeometry));
+        blas->sources.push_back(&sourceGeometry(desc.mesh, desc.lod, g.meshGeometry, work));
         gpu::TriangleGeometry t;
         t.vertices = blas->positions.address() + first * sizeof(glm::vec3);
         t.vertexCount = 3 * g.triangleCount;
@@ -474,7 +499,7 @@ std::shared_ptr<BvhManager::FrameWork> BvhManager::prepare(const scene::BvhPlan&
             blases_.erase(it);
             it = blases_.end();
         }
-        ResidentBlas& blas = it != blases_.end() ? *it->second : createBlas(*desc);
+        ResidentBlas& blas = it != blases_.end() ? *it->second : createBlas(*desc, *work);
         blas.builtInFrame = frame_;
         ++(resident ? stats_.blasRebuilds : stats_.blasBuilds);
 
@@ -592,9 +617,14 @@ void BvhManager::record(FrameWork& work, rg::PassContext& pc, const BvhUpdateOut
                            VK_ACCESS_2_SHADER_STORAGE_READ_BIT | VK_ACCESS_2_SHADER_STORAGE_WRITE_BIT |
                            VK_ACCESS_2_SHADER_READ_BIT | VK_ACCESS_2_TRANSFER_READ_BIT | VK_ACCESS_2_TRANSFER_WRITE_BIT);
 
-    // Copies: the outgrown pool into the new one, the offset table, the particles.
-    if (work.poolCopySource || !work.offsets.empty() || particles) {
+    // Copies: new geometry, the outgrown pool into the new one, the offset
+    // table, the particles.
+    if (!work.uploads.empty() || work.poolCopySource || !work.offsets.empty() || particles) {
         gpu::ScopedLabel label(ctx_, cmd, "bvh.copies");
+        for (const FrameWork::Upload& upload : work.uploads) {
+            const VkBufferCopy region{0, 0, upload.staging->size()};
+            vkCmdCopyBuffer(cmd, upload.staging->handle(), upload.target->handle(), 1, &region);
+        }
         if (work.poolCopySource) {
             const VkBufferCopy region{0, 0, work.poolCopyBytes};
             vkCmdCopyBuffer(cmd, work.poolCopySource->handle(), pool.handle(), 1, &region);

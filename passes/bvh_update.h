@@ -3,14 +3,17 @@
 //
 // BvhManager owns what lives across frames: the reflection-LOD geometry of
 // every mesh a BLAS was built from (uploaded once, material sampled at the
-// vertices on the CPU), one AccelerationStructure per resident BLAS, the
-// unwrapped build positions of the deformable ones, the one primitive pool
-// (PackedPrimitive per triangle, glint/packing.h), the primitive offset
-// buffer, the TLAS and its per-frame instance buffers.
+// vertices on the CPU, copied from staging inside the update pass of the
+// frame that first builds it: no submission of its own, no host wait), one
+// AccelerationStructure per resident BLAS, the unwrapped build positions of
+// the deformable ones, the one primitive pool (PackedPrimitive per
+// triangle, glint/packing.h), the primitive offset buffer, the TLAS and its
+// per-frame instance buffers.
 //
 // addBvhUpdatePass() declares the frame's builds as ONE render-graph pass on
 // the async compute queue (the graphics queue on one-queue devices, or where
 // BvhUpdateOptions::queue says Graphics):
+//   copies (new geometry, the offset table, ...) -> barrier ->
 //   pack dispatches (positions + packed primitives, skinning included)
 //   -> barrier -> BLAS builds -> barrier -> TLAS build,
 // with build scratch from the graph.
@@ -94,6 +97,7 @@ struct BvhGpuStats {
     uint64_t poolBytes = 0;           // allocated (capacity), not just used
     uint64_t positionBytes = 0;       // unwrapped build positions (deformable BLASes, and static ones until built)
     uint64_t geometryBytes = 0;       // uploaded vertices, indices and skin data
+    uint64_t uploadBytes = 0;         // staged for those uploads, all frames (copied inside the update pass)
     uint64_t scratchBytes = 0;        // this frame's scratch request to the graph
     uint64_t totalBlasBuilds = 0;     // first builds and rebuilds, all frames
     // Particles: this frame's particle BLAS/TLAS builds (1 or 0: none
@@ -163,8 +167,8 @@ private:
     void prepareParticles(const scene::BvhPlan& plan, const scene::Camera& camera, FrameWork& work);
     void recordParticleQuads(const FrameWork& work, VkCommandBuffer cmd, const gpu::Buffer& particles);
     void record(FrameWork& work, rg::PassContext& pc, const BvhUpdateOutputs& handles);
-    const SourceGeometry& sourceGeometry(uint32_t mesh, uint32_t lod, uint32_t geometry);
-    ResidentBlas& createBlas(const scene::BlasDesc& desc);
+    const SourceGeometry& sourceGeometry(uint32_t mesh, uint32_t lod, uint32_t geometry, FrameWork& work);
+    ResidentBlas& createBlas(const scene::BlasDesc& desc, FrameWork& work);
     void ensurePool(uint32_t triangles, FrameWork& work);
     void ensureTlas(uint32_t instances);
     void ensureOffsets(size_t entries);

@@ -69,6 +69,7 @@ void TimelineSemaphore::wait(uint64_t value, uint64_t timeoutNs) const {
 
 void submitAndWait(Context& ctx, const Queue& queue, std::string_view what,
                    const std::function<void(VkCommandBuffer)>& record) {
+    ctx.countBlockingSubmit();
     CommandPool pool(ctx, queue.family, what);
     VkCommandBuffer cmd = pool.allocate();
     VkCommandBufferBeginInfo begin{VK_STRUCTURE_TYPE_COMMAND_BUFFER_BEGIN_INFO};

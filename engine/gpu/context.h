@@ -120,6 +120,10 @@ public:
     const Queue& computeQueue() const { return compute_ ? *compute_ : graphics_; }
 
     bool validationEnabled() const { return validation_; }
+    // Submissions the host waited for on the spot (gpu::submitAndWait:
+    // uploads, readbacks, one-off work): per-frame code should make none.
+    uint64_t blockingSubmits() const { return blockingSubmits_; }
+    void countBlockingSubmit() { ++blockingSubmits_; }
     ValidationLog& validation() { return *log_; }
     // Shared so the log can be read after the Context (and its device) is gone.
     std::shared_ptr<ValidationLog> validationLog() const { return log_; }
@@ -140,6 +144,7 @@ private:
 
     bool validation_ = false;
     bool debugUtils_ = false;
+    uint64_t blockingSubmits_ = 0;
     std::shared_ptr<ValidationLog> log_;
     VkInstance instance_ = VK_NULL_HANDLE;
     VkDebugUtilsMessengerEXT messenger_ = VK_NULL_HANDLE;

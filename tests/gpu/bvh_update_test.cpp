@@ -518,7 +518,17 @@ TEST_CASE("frames in flight: BLASes evicted and rebuilt, the pool grown, static 
     for (size_t f = 0; f < std::size(path); ++f) {
         CAPTURE(f);
         rig.camera = path[f];
+        // Objects entering range for the first time (frames 1-3) have their
+        // geometry copied inside the update pass: no blocking submission.
+        const uint64_t blockingBefore = rig.gpu.ctx().blockingSubmits();
+        const uint32_t uploadedBefore = rig.bvh->stats().uploadedGeometries;
         plan = rig.run({}, false);
+        if (f > 0) {
+            CHECK(rig.gpu.ctx().blockingSubmits() == blockingBefore);
+        }
+        if (f == 1) {
+            CHECK(rig.bvh->stats().uploadedGeometries > uploadedBefore);
+        }
         builds += plan.stats.built;
         drops += plan.stats.dropped;
         mirror.resize(std::max<size_t>(mirror.size(), plan.poolTriangles));
