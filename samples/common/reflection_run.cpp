@@ -272,6 +272,7 @@ ReflectionRunResult runReflections(gpu::Context& ctx, scene::Scene& scene, const
 
     const auto start = std::chrono::steady_clock::now();
     auto lastReport = start;
+    uint64_t blockingAfterFirst = 0;
     for (uint32_t i = 0; i < options.frames; ++i) {
         // The reference stands still: one pose, one scene time; only the
         // frame index (the noise) moves.
@@ -329,6 +330,7 @@ ReflectionRunResult runReflections(gpu::Context& ctx, scene::Scene& scene, const
         }
 
         result.framesRun = i + 1;
+        if (i == 0) blockingAfterFirst = ctx.blockingSubmits();
         if (check) {
             executor.waitIdle();
             const double mean = meanReflection(resolved, w * h);
@@ -362,6 +364,7 @@ ReflectionRunResult runReflections(gpu::Context& ctx, scene::Scene& scene, const
     }
     executor.waitIdle();
     if (options.frames == 1 || !options.timeEveryFrame) collectTimings();
+    result.blockingSubmits = ctx.blockingSubmits() - blockingAfterFirst;
 
     for (const std::string& name : passOrder) {
         result.passes.push_back({name, passQueues[name], median(passTimes[name]),
@@ -423,6 +426,9 @@ std::string statsJson(const gpu::Context& ctx, const ReflectionRunOptions& optio
     j["total_ms"] = r.totalMs ? json(*r.totalMs) : json(nullptr);
     j["frame_wall_ms"] = r.frameWallMs ? json(*r.frameWallMs) : json(nullptr);
     j["rays"] = {{"sslr", r.sslrRays}, {"rt", r.rtRays}};
+    // Host-blocking submissions after the first frame (uploads, one-off
+    // work): a steady frame makes none.
+    j["blocking_submits"] = r.blockingSubmits;
     const double pixels = double(options.width) * options.height;
     const auto share = [&](uint32_t c) { return c < r.pixelClasses.size() ? double(r.pixelClasses[c]) / pixels : 0.0; };
     j["pixel_classes"] = {{"ssr", share(shader::kPixelSslr)}, {"hybrid", share(shader::kPixelHybrid)},

@@ -80,6 +80,8 @@ struct ReflectionRunResult {
     std::optional<double> totalMs;       // median per-frame sum of all passes
     std::optional<double> reflectionCpuMs;  // host-serial timing only: as reflectionMs, in process CPU time
     uint32_t framesTimed = 0;
+    // gpu::submitAndWait calls after the first frame (the readbacks included).
+    uint64_t blockingSubmits = 0;
     // Median host time from declaring a frame to its completion (with
     // host-serial pass times, including their waits).
     std::optional<double> frameWallMs;
