@@ -264,7 +264,7 @@ void EnvironmentMap::prefilter(const scene::Texture& image) {
         texels += uint64_t(std::max(width >> level, 1u)) * std::max(height >> level, 1u);
     }
     stats_.bytes = texels * 8;
-    spdlog::info("environment '{}': {}x{} prefiltered to {}x{} in {} roughness levels ({} samples) in {:.1f} ms", name,
+    spdlog::info("environment '{}': {}x{} prefiltered to {}x{} in {} roughness levels ({} samples, doubled per level) in {:.1f} ms", name,
                  image.width, image.height, width, height, levels, base.samples, ms);
     spdlog::debug("environment '{}': source chain {} mips, SH from mip {}, irradiance up {:.3f} {:.3f} {:.3f}", name,
                   sourceMips, irradianceMip, irradianceSh_[0].x, irradianceSh_[0].y, irradianceSh_[0].z);
