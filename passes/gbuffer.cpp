@@ -4,6 +4,7 @@
 #include "gpu/descriptors.h"
 #include "gpu/error.h"
 #include "graph/executor.h"
+#include "passes/environment.h"
 #include "scene/packed_primitives.h"
 
 #include "glint/gbuffer_shared.h"
@@ -35,10 +36,13 @@ std::vector<gpu::Binding> geometryBindings() {
 
 // The G-buffer's pipelines add the shadow map (shaders/gbuffer/shadow.glsl);
 // the shadow map's own pipeline cannot bind what it renders.
+// and the prefiltered environment (glint/environment.glsl).
 constexpr uint32_t kShadowMapBinding = 5;
+constexpr uint32_t kEnvironmentBinding = 6;
 std::vector<gpu::Binding> gbufferBindings() {
     std::vector<gpu::Binding> bindings = geometryBindings();
     bindings.push_back({kShadowMapBinding, VK_DESCRIPTOR_TYPE_COMBINED_IMAGE_SAMPLER, VK_SHADER_STAGE_FRAGMENT_BIT});
+    bindings.push_back({kEnvironmentBinding, VK_DESCRIPTOR_TYPE_COMBINED_IMAGE_SAMPLER, VK_SHADER_STAGE_FRAGMENT_BIT});
     return bindings;
 }
 
@@ -253,6 +257,7 @@ GBufferRenderer::GBufferRenderer(gpu::Context& ctx, const scene::Scene& scene, u
 
     nearest_ = gpu::Sampler(ctx, {VK_FILTER_NEAREST, VK_SAMPLER_MIPMAP_MODE_NEAREST,
                                   VK_SAMPLER_ADDRESS_MODE_CLAMP_TO_EDGE, 0.0f, "gbuffer.nearest"});
+    environmentSampler_ = createEnvironmentSampler(ctx, "gbuffer.environment");
 
     // Every mesh's LOD 0 into one vertex and one index buffer: one binding
     // for the whole frame, draws differ only in their ranges.
@@ -331,7 +336,7 @@ std::shared_ptr<GBufferRenderer::FrameWork> GBufferRenderer::prepare(const GBuff
     f.cameraPosition = glm::vec4(camera.position, 1.0f);
     f.size = glm::vec2(camera.resolution);
 
-    f.lighting = sceneLighting(scene_, settings.lighting);
+    f.lighting = inputs.lighting ? *inputs.lighting : sceneLighting(scene_, settings.lighting);
     f.shadow = fitSunShadow(scene_, camera, settings.shadow);
     stats_.shadow = f.shadow;
 
@@ -426,7 +431,8 @@ void GBufferRenderer::recordShadowMap(const FrameWork& work, rg::PassContext& pc
     vkCmdEndRendering(cmd);
 }
 
-void GBufferRenderer::record(const FrameWork& work, rg::PassContext& pc, const GBufferOutputs& targets) {
+void GBufferRenderer::record(const FrameWork& work, rg::PassContext& pc, const GBufferOutputs& targets,
+                             rg::Texture environment) {
     const VkCommandBuffer cmd = pc.cmd();
     FrameSlot& slot = *slots_[work.slot];
 
@@ -466,15 +472,24 @@ void GBufferRenderer::record(const FrameWork& work, rg::PassContext& pc, const G
     vkCmdSetScissor(cmd, 0, 1, &scissor);
 
     const auto pushBindings = [&](const gpu::Pipeline& pipeline) {
-        gpu::PushDescriptors(pipeline)
-            .storageBuffer(0, slot.frame)
+        gpu::PushDescriptors push(pipeline);
+        push.storageBuffer(0, slot.frame)
             .storageBuffer(1, slot.instances)
             .storageBuffer(2, vertices_)
             .storageBuffer(3, slot.joints)
             .storageBuffer(4, slot.previousJoints)
             .sampledImage(kShadowMapBinding, pc.view(targets.shadowMap), nearest_.handle(),
-                          pc.layout(targets.shadowMap))
-            .push(ctx_, cmd);
+                          pc.layout(targets.shadowMap));
+        // The procedural sky reads no texture: the shadow map, which the
+        // pass reads anyway, fills the environment's binding.
+        if (environment.valid()) {
+            push.sampledImage(kEnvironmentBinding, pc.view(environment), environmentSampler_.handle(),
+                              pc.layout(environment));
+        } else {
+            push.sampledImage(kEnvironmentBinding, pc.view(targets.shadowMap), nearest_.handle(),
+                              pc.layout(targets.shadowMap));
+        }
+        push.push(ctx_, cmd);
     };
 
     stats_.draws = 0;
@@ -509,6 +524,10 @@ GBufferOutputs addGBufferPass(rg::Graph& graph, GBufferRenderer& renderer, const
                             std::to_string(height) + "; both sides must be positive");
     }
     std::shared_ptr<GBufferRenderer::FrameWork> work = renderer.prepare(inputs, settings);
+    if (work->frame.lighting.environment.x != 0.0f && !inputs.environment.valid()) {
+        throw gpu::GpuError("G-buffer: the lighting looks up an environment image but no environment texture was given "
+                            "(passes::importEnvironment)");
+    }
 
     // With shadows off the map is one cleared texel: the G-buffer's
     // pipelines keep one layout and the frame one shape.
@@ -542,11 +561,16 @@ GBufferOutputs addGBufferPass(rg::Graph& graph, GBufferRenderer& renderer, const
             d.motion = target("gbuffer.motion", kGBufferMotionFormat, rg::Access::ColorAttachment);
             d.lit = target("gbuffer.lit", kGBufferLitFormat, rg::Access::ColorAttachment);
             d.shadowMap = b.read(shadow.map, rg::Access::SampledRead);
+            if (inputs.environment.valid()) {
+                b.read(inputs.environment, rg::Access::SampledRead);
+            }
             d.width = width;
             d.height = height;
             d.shadowResolution = shadowSize;
         },
-        [&renderer, work](const GBufferOutputs& d, rg::PassContext& pc) { renderer.record(*work, pc, d); });
+        [&renderer, work, environment = inputs.environment](const GBufferOutputs& d, rg::PassContext& pc) {
+            renderer.record(*work, pc, d, environment);
+        });
     return out;
 }
 

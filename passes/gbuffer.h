@@ -37,6 +37,7 @@
 
 #include <cstdint>
 #include <memory>
+#include <optional>
 #include <vector>
 
 namespace glint::passes {
@@ -54,6 +55,13 @@ inline constexpr VkFormat kGBufferShadowMapFormat = VK_FORMAT_D32_SFLOAT;
 struct GBufferInputs {
     // This and last frame's matrices; its resolution is the G-buffer's size.
     scene::Camera camera;
+    // The sun and the environment the sky pixels and the ambient light use
+    // (EnvironmentMap::lighting, passes/environment.h); none:
+    // sceneLighting(scene, settings.lighting), the procedural path.
+    std::optional<shader::SceneLighting> lighting;
+    // The prefiltered environment (importEnvironment); needed when
+    // `lighting` says an image is looked up, else left invalid.
+    rg::Texture environment;
 };
 
 // The sun's shadow map. Biases are in shadow texels (the world size of one
@@ -152,7 +160,7 @@ private:
     // first, calls it.
     void upload(const FrameWork& work);
     void recordShadowMap(const FrameWork& work, rg::PassContext& pc, rg::Texture shadowMap);
-    void record(const FrameWork& work, rg::PassContext& pc, const GBufferOutputs& targets);
+    void record(const FrameWork& work, rg::PassContext& pc, const GBufferOutputs& targets, rg::Texture environment);
     void ensureCapacity(gpu::Buffer& buffer, VkDeviceSize bytes, const char* name);
 
     gpu::Context& ctx_;
@@ -163,6 +171,7 @@ private:
     gpu::Pipeline skyPipeline_;
     gpu::Pipeline shadowPipeline_;
     gpu::Sampler nearest_;  // completes the shadow map's descriptor; reads are texelFetch
+    gpu::Sampler environmentSampler_;
     gpu::Buffer vertices_;  // GBufferVertex, every geometry of every mesh's LOD 0
     gpu::Buffer indices_;
     std::vector<std::vector<DrawRange>> meshDraws_;  // per mesh: its LOD-0 geometries

@@ -3,6 +3,7 @@
 #include "gpu/descriptors.h"
 #include "gpu/error.h"
 #include "graph/executor.h"
+#include "passes/environment.h"
 
 #include "glint/integrate_shared.h"
 #include "glint/ray_generation_shared.h"
@@ -24,7 +25,7 @@ constexpr uint32_t kBindingDepth = 0, kBindingNormal = 1, kBindingRoughness = 2,
                    kBindingRays = 4, kBindingClasses = 5, kBindingRadiance = 6, kBindingHitDistance = 7,
                    kBindingSource = 8, kBindingReprojected = 9, kBindingCounters = 10, kBindingSslrRadiance = 11,
                    kBindingSslrConfidence = 12, kBindingSslrHit = 13, kBindingRtRadiance = 14,
-                   kBindingRtHitDistance = 15, kBindingParticles = 16;
+                   kBindingRtHitDistance = 15, kBindingParticles = 16, kBindingEnvironment = 17;
 
 std::string variantShader(uint32_t variant) {
     const bool sslr = (variant & kVariantSslr) != 0;
@@ -44,6 +45,7 @@ std::vector<gpu::Binding> variantBindings(uint32_t variant) {
         {kBindingRays, kStorage, kStage},      {kBindingClasses, kStorage, kStage},
         {kBindingRadiance, kImage, kStage},    {kBindingHitDistance, kImage, kStage},
         {kBindingSource, kImage, kStage},      {kBindingParticles, kSampled, kStage},
+        {kBindingEnvironment, kSampled, kStage},
     };
     if ((variant & kVariantFeedback) != 0) {
         bindings.push_back({kBindingReprojected, kStorage, kStage});
@@ -78,7 +80,8 @@ IntegratePipelines::IntegratePipelines(gpu::Context& ctx)
       // Every read is a texelFetch; the sampler only completes the combined
       // descriptor.
       nearest_(ctx, {VK_FILTER_NEAREST, VK_SAMPLER_MIPMAP_MODE_NEAREST, VK_SAMPLER_ADDRESS_MODE_CLAMP_TO_EDGE, 0.0f,
-                     "integrate.nearest"}) {}
+                     "integrate.nearest"}),
+      environmentSampler_(createEnvironmentSampler(ctx, "integrate.environment")) {}
 
 IntegrateOutputs addIntegratePass(rg::Graph& graph, IntegratePipelines& pipelines, const IntegrateInputs& inputs,
                                   const IntegrateSettings& settings) {
@@ -98,6 +101,10 @@ IntegrateOutputs addIntegratePass(rg::Graph& graph, IntegratePipelines& pipeline
     if (hasFeedback && (!feedback.reprojected.valid() || feedback.tilesX != rays.tilesX ||
                         feedback.tilesY != rays.tilesY)) {
         throw gpu::GpuError("addIntegratePass: the feedback outputs must come from this frame's G-buffer size");
+    }
+    if (inputs.lighting.environment.x != 0.0f && !inputs.environment.valid()) {
+        throw gpu::GpuError("addIntegratePass: the lighting looks up an environment image but no environment texture "
+                            "was given (passes::importEnvironment)");
     }
     const bool hasRt = inputs.rtRadiance.valid();
     const bool hasParticles = inputs.particles.valid();
@@ -138,7 +145,8 @@ IntegrateOutputs addIntegratePass(rg::Graph& graph, IntegratePipelines& pipeline
         rg::Texture depth, normal, roughnessMetal;
         rg::Buffer constants, rays, classes, reprojected;
         rg::Texture sslrRadiance, sslrConfidence, sslrHit, rtRadiance, rtHitDistance;
-        rg::Texture particles;  // the particle trace, or the normal as a stand-in (never read)
+        rg::Texture particles;    // the particle trace, or the normal as a stand-in (never read)
+        rg::Texture environment;  // the prefiltered image, or the normal as a stand-in (never read)
         IntegrateOutputs out;
     };
     const IntegrateData& integrate = graph.addPass<IntegrateData>(
@@ -151,6 +159,7 @@ IntegrateOutputs addIntegratePass(rg::Graph& graph, IntegratePipelines& pipeline
             // in the constants rather than twice the variants); without
             // them a texture this pass reads anyway fills the binding.
             d.particles = hasParticles ? b.read(inputs.particles, rg::Access::SampledRead) : d.normal;
+            d.environment = inputs.environment.valid() ? b.read(inputs.environment, rg::Access::SampledRead) : d.normal;
             d.constants = b.read(upload.constants, rg::Access::StorageRead);
             d.rays = b.read(rays.rays, rg::Access::StorageRead);
             d.classes = b.read(rays.classes, rg::Access::StorageRead);
@@ -191,7 +200,10 @@ IntegrateOutputs addIntegratePass(rg::Graph& graph, IntegratePipelines& pipeline
                 .storageImage(kBindingRadiance, pc.view(d.out.radiance))
                 .storageImage(kBindingHitDistance, pc.view(d.out.hitDistance))
                 .storageImage(kBindingSource, pc.view(d.out.sourceDebug))
-                .sampledImage(kBindingParticles, pc.view(d.particles), sampler, pc.layout(d.particles));
+                .sampledImage(kBindingParticles, pc.view(d.particles), sampler, pc.layout(d.particles))
+                .sampledImage(kBindingEnvironment, pc.view(d.environment),
+                              d.environment == d.normal ? sampler : pipelines.environmentSampler_.handle(),
+                              pc.layout(d.environment));
             if ((variant & kVariantFeedback) != 0) {
                 push.storageBuffer(kBindingReprojected, pc.buffer(d.reprojected))
                     .storageBuffer(kBindingCounters, pc.buffer(d.out.counters));

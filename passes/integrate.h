@@ -70,7 +70,10 @@ struct IntegrateInputs {
     // (its leader's particles, as for the traces); the hit distance stays
     // the reflected surface's.
     rg::Texture particles;
-    shader::SceneLighting lighting;    // passes::sceneLighting(...)
+    shader::SceneLighting lighting;    // EnvironmentMap::lighting or passes::sceneLighting(...)
+    // The prefiltered environment (passes/environment.h, SampledRead);
+    // needed when `lighting` looks up an image, else left invalid.
+    rg::Texture environment;
     scene::Camera camera;              // the G-buffer's; its unjittered matrices rebuild positions
 };
 
@@ -104,6 +107,7 @@ private:
     // Indexed by (SSLR bound) | (RT bound) << 1 | (feedback bound) << 2.
     std::array<gpu::Pipeline, 8> variants_;
     gpu::Sampler nearest_;
+    gpu::Sampler environmentSampler_;
 };
 
 // Declares the pass (see the top of this file) on the graphics queue, with

@@ -3,11 +3,15 @@
 // them (glint/gbuffer_shared.h's SceneLighting): the G-buffer's lit colour,
 // the ray-traced hits and the environment fallback of the reflections all
 // take it from here, so a surface seen directly and in a reflection gets
-// the same light (glint/brdf.glsl).
+// the same light (glint/brdf.glsl, glint/environment.glsl). An
+// equirectangular image is looked up through passes/environment.h's
+// EnvironmentMap, whose lighting() adds the image's fields.
 
 #include "scene/scene.h"
 
 #include "glint/gbuffer_shared.h"
+
+#include <array>
 
 namespace glint::passes {
 
@@ -22,9 +26,21 @@ struct LightingSettings {
     float ambientScale = 1.0f;
 };
 
+// Zenith, horizon and ground radiance, unscaled.
+using SkyColors = std::array<glm::vec3, 3>;
+
 // The procedural sky's three colours, or for an equirectangular image the
 // solid-angle-weighted mean radiance of its upper cap, horizon band and
-// lower hemisphere (O(texels): compute it once per scene, not per pixel).
+// lower hemisphere, non-finite texels skipped (O(texels): compute it once
+// per environment, as EnvironmentMap does, not per frame).
+SkyColors environmentSkyColors(const scene::Environment& environment);
+
+// The sun and `sky` scaled by the environment's intensity; environment.x = 0
+// (the shaders take the procedural sky's path with these colours).
+shader::SceneLighting sceneLighting(const scene::Scene& scene, const SkyColors& sky,
+                                    const LightingSettings& settings = {});
+// The same with environmentSkyColors(scene.environment): walks an image's
+// texels on every call.
 shader::SceneLighting sceneLighting(const scene::Scene& scene, const LightingSettings& settings = {});
 
 } // namespace glint::passes

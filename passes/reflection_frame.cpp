@@ -96,6 +96,7 @@ ReflectionRenderer::ReflectionRenderer(gpu::Context& ctx, const scene::Scene& sc
                                        const ReflectionRendererOptions& options)
     : ctx_(ctx),
       scene_(scene),
+      environment_(ctx, scene, options.environment),
       gbuffer_(ctx, scene, options.framesInFlight),
       planner_(options.bvh),
       bvh_(ctx, scene, options.framesInFlight, options.bvhUpdate),
@@ -120,6 +121,7 @@ void ReflectionRenderer::bind(rg::FrameResources& resources, const ReflectionFra
     if (frame.bvh) {
         bvh_.bind(resources, *frame.bvh);
     }
+    environment_.bind(resources, frame.environment);
 }
 
 ReflectionFrame ReflectionRenderer::addFrame(rg::Graph& graph, const scene::Camera& camera,
@@ -128,9 +130,13 @@ ReflectionFrame ReflectionRenderer::addFrame(rg::Graph& graph, const scene::Came
     const uint64_t frameIndex = camera.frameIndex;
     const bool traces = mode != ReflectionMode::Ssr;
     const bool screenSpace = mode != ReflectionMode::Rt;
-    const shader::SceneLighting lighting = sceneLighting(scene_, settings.gbuffer.lighting);
+    // The sky colours and the prefiltered image are the environment map's,
+    // computed once per environment, not per frame.
+    environment_.update();
+    const shader::SceneLighting lighting = environment_.lighting(settings.gbuffer.lighting);
 
     ReflectionFrame f;
+    f.environment = importEnvironment(graph, environment_);
     f.mode = mode;
     f.width = camera.resolution.x;
     f.height = camera.resolution.y;
@@ -142,7 +148,7 @@ ReflectionFrame ReflectionRenderer::addFrame(rg::Graph& graph, const scene::Came
         f.bvh = addBvhUpdatePass(graph, bvh_, plan, camera);
     }
     // 1. G-buffer.
-    f.gbuffer = addGBufferPass(graph, gbuffer_, {camera}, settings.gbuffer);
+    f.gbuffer = addGBufferPass(graph, gbuffer_, {camera, lighting, f.environment}, settings.gbuffer);
     // 6 (of last frame). Feedback: only the hybrid band follows tile modes.
     RayGenerationInputs rayInputs{f.gbuffer, frameIndex, camera};
     if (mode == ReflectionMode::Hybrid) {
@@ -170,6 +176,7 @@ ReflectionFrame ReflectionRenderer::addFrame(rg::Graph& graph, const scene::Came
         rtInputs.rayListArgs = rtArgs;
         rtInputs.bvh = *f.bvh;
         rtInputs.lighting = lighting;
+        rtInputs.environment = f.environment;
         rtInputs.camera = camera;
         rtInputs.frameIndex = frameIndex;
         f.rt = addRtTracePass(graph, rt_, rtInputs, settings.rt);
@@ -206,6 +213,7 @@ ReflectionFrame ReflectionRenderer::addFrame(rg::Graph& graph, const scene::Came
         integrateInputs.feedback = *f.feedback;
     }
     integrateInputs.lighting = lighting;
+    integrateInputs.environment = f.environment;
     integrateInputs.camera = camera;
     if (f.particles) {
         integrateInputs.particles = f.particles->radiance;

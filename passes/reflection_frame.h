@@ -25,6 +25,7 @@
 #include "graph/graph.h"
 #include "passes/bvh_update.h"
 #include "passes/composite.h"
+#include "passes/environment.h"
 #include "passes/feedback.h"
 #include "passes/gbuffer.h"
 #include "passes/integrate.h"
@@ -57,6 +58,7 @@ struct ReflectionRendererOptions {
     RtBackend backend = RtBackend::Auto;
     scene::BvhSettings bvh;
     BvhUpdateOptions bvhUpdate;
+    EnvironmentSettings environment;  // the prefilter of an equirectangular environment
 };
 
 struct ReflectionFrameSettings {
@@ -92,6 +94,9 @@ struct ReflectionFrame {
     IntegrateOutputs integrate;
     TemporalOutputs temporal;
     CompositeOutputs output;  // RGBA8, sRGB-encoded: the image or the debug view
+    // The prefiltered environment image (passes/environment.h); invalid for
+    // the procedural sky.
+    rg::Texture environment;
     // When ReflectionFrameSettings::countRays: kReflectionCountWords uints,
     // glint/reflection_frame_shared.h.
     rg::Buffer counts;
@@ -121,7 +126,7 @@ public:
     // the same passes whether or not the caller reads it back: the graph
     // plans history images from this frame's own uses (graph.h).
     ReflectionFrame addFrame(rg::Graph& graph, const scene::Camera& camera, const ReflectionFrameSettings& settings);
-    // Binds the frame's imports (the BVH's objects).
+    // Binds the frame's imports (the BVH's objects, the environment).
     void bind(rg::FrameResources& resources, const ReflectionFrame& frame) const;
 
     RtBackend backend() const { return rt_.backend(); }
@@ -129,10 +134,14 @@ public:
     // Of the last frame that declared BVH work (none in ssr mode).
     const scene::BvhStats& bvhPlanStats() const { return lastPlanStats_; }
     const BvhGpuStats& bvhGpuStats() const { return bvh_.stats(); }
+    const EnvironmentStats& environmentStats() const { return environment_.stats(); }
 
 private:
     gpu::Context& ctx_;
     const scene::Scene& scene_;
+    // Prefiltered when the renderer is created and when addFrame sees a new
+    // environment (EnvironmentMap::update).
+    EnvironmentMap environment_;
     GBufferRenderer gbuffer_;
     scene::BvhPlanner planner_;
     BvhManager bvh_;

@@ -3,6 +3,7 @@
 #include "gpu/descriptors.h"
 #include "gpu/error.h"
 #include "graph/executor.h"
+#include "passes/environment.h"
 
 #include "glint/ray_generation_shared.h"
 #include "glint/rt_trace_shared.h"
@@ -36,6 +37,7 @@ enum Binding : uint32_t {
     kConstants,
     kRadiance,
     kHitDistance,
+    kEnvironment,
     kBindingCount
 };
 
@@ -44,7 +46,7 @@ std::vector<gpu::Binding> traceBindings(VkShaderStageFlags stages) {
     for (uint32_t i = 0; i < kBindingCount; ++i) {
         VkDescriptorType type = VK_DESCRIPTOR_TYPE_STORAGE_BUFFER;
         if (i == kTlas) type = VK_DESCRIPTOR_TYPE_ACCELERATION_STRUCTURE_KHR;
-        if (i >= kDepth && i <= kRoughnessMetal) type = VK_DESCRIPTOR_TYPE_COMBINED_IMAGE_SAMPLER;
+        if ((i >= kDepth && i <= kRoughnessMetal) || i == kEnvironment) type = VK_DESCRIPTOR_TYPE_COMBINED_IMAGE_SAMPLER;
         if (i == kRadiance || i == kHitDistance) type = VK_DESCRIPTOR_TYPE_STORAGE_IMAGE;
         bindings.push_back({i, type, stages});
     }
@@ -112,6 +114,7 @@ RtTracePipelines::RtTracePipelines(gpu::Context& ctx, RtBackend backend)
       // descriptors.
       nearest_(ctx, {VK_FILTER_NEAREST, VK_SAMPLER_MIPMAP_MODE_NEAREST, VK_SAMPLER_ADDRESS_MODE_CLAMP_TO_EDGE, 0.0f,
                      "rt_trace.nearest"}),
+      environmentSampler_(createEnvironmentSampler(ctx, "rt_trace.environment")),
       clearer_(ctx) {
     VkPhysicalDeviceProperties properties{};
     vkGetPhysicalDeviceProperties(ctx.physicalDevice(), &properties);
@@ -193,6 +196,10 @@ RtTraceOutputs addRtTracePass(rg::Graph& graph, RtTracePipelines& pipelines, con
     constants.inverseViewProjection = glm::mat4(glm::inverse(viewProjection));
     constants.cameraPosition = glm::vec4(inputs.camera.position, 1.0f);
     constants.lighting = inputs.lighting;
+    if (inputs.lighting.environment.x != 0.0f && !inputs.environment.valid()) {
+        throw gpu::GpuError("rt_trace: the lighting looks up an environment image but no environment texture was given "
+                            "(passes::importEnvironment)");
+    }
     constants.size = {gbuf.width, gbuf.height};
     constants.maxDistance = settings.maxDistance;
     constants.shortRangeRoughness = settings.shortRangeRoughness;
@@ -232,6 +239,7 @@ RtTraceOutputs addRtTracePass(rg::Graph& graph, RtTracePipelines& pipelines, con
 
     struct TraceData {
         rg::Texture depth, normal, roughnessMetal;
+        rg::Texture environment;  // the prefiltered image, or the normal as a stand-in (never read)
         rg::Buffer rayList, rayListArgs, pool, offsets, constants;
         rg::AccelStruct tlas;
         RtTraceOutputs out;
@@ -243,6 +251,8 @@ RtTraceOutputs addRtTracePass(rg::Graph& graph, RtTracePipelines& pipelines, con
             d.depth = b.read(gbuf.depth, rg::Access::SampledRead);
             d.normal = b.read(gbuf.normal, rg::Access::SampledRead);
             d.roughnessMetal = b.read(gbuf.roughnessMetal, rg::Access::SampledRead);
+            // The procedural sky reads no texture: the normal fills the binding.
+            d.environment = inputs.environment.valid() ? b.read(inputs.environment, rg::Access::SampledRead) : d.normal;
             d.rayList = b.read(inputs.rayList, rg::Access::StorageRead);
             // The indirect command, and the list's length for the ray query
             // backend's last, partial group.
@@ -260,9 +270,12 @@ RtTraceOutputs addRtTracePass(rg::Graph& graph, RtTracePipelines& pipelines, con
         [&pipelines, backend](const TraceData& d, rg::PassContext& pc) {
             const gpu::Pipeline& pipeline = backend == RtBackend::RayQuery ? *pipelines.query_ : *pipelines.pipeline_;
             const VkSampler sampler = pipelines.nearest_.handle();
+            const VkSampler environmentSampler =
+                d.environment == d.normal ? sampler : pipelines.environmentSampler_.handle();
             pipeline.bind(pc.cmd());
             gpu::PushDescriptors(pipeline)
                 .accelerationStructure(kTlas, pc.accel(d.tlas).handle())
+                .sampledImage(kEnvironment, pc.view(d.environment), environmentSampler, pc.layout(d.environment))
                 .sampledImage(kDepth, pc.view(d.depth), sampler, pc.layout(d.depth))
                 .sampledImage(kNormal, pc.view(d.normal), sampler, pc.layout(d.normal))
                 .sampledImage(kRoughnessMetal, pc.view(d.roughnessMetal), sampler, pc.layout(d.roughnessMetal))

@@ -57,13 +57,17 @@ struct RtTraceInputs {
     rg::Buffer rayList;              // shader::PackedRay entries (glint/ray_generation_shared.h)
     rg::Buffer rayListArgs;          // kRayListArgsWords uints, layout in ray_generation_shared.h (IndirectArgs)
     BvhUpdateOutputs bvh;            // tlas (AccelRead), primitivePool, primitiveOffsets (StorageRead)
-    shader::SceneLighting lighting;  // passes::sceneLighting(scene, gbufferSettings.lighting)
+    shader::SceneLighting lighting;  // EnvironmentMap::lighting or passes::sceneLighting(scene, gbufferSettings.lighting)
     // The G-buffer's camera. Origins are reconstructed with the jittered
     // matrices it was rasterised with (passes/rt_trace.cpp says why).
     scene::Camera camera;
     // The trace draws no random numbers (the rays carry ray generation's
     // noise); kept so every pass of a frame is declared alike.
     uint64_t frameIndex = 0;
+    // The prefiltered environment (passes/environment.h, SampledRead) for
+    // misses and the hits' ambient light; needed when `lighting` looks up an
+    // image, else left invalid.
+    rg::Texture environment;
 };
 
 struct RtTraceSettings {
@@ -139,6 +143,7 @@ private:
     std::optional<gpu::Pipeline> pipeline_;
     std::optional<gpu::ShaderBindingTable> sbt_;
     gpu::Sampler nearest_;
+    gpu::Sampler environmentSampler_;
     ImageClearer clearer_;
 };
 

@@ -4,6 +4,9 @@
 
 #include <spdlog/spdlog.h>
 
+#include <algorithm>
+#include <string>
+
 namespace glint::gpu {
 
 // ---------------------------------------------------------------- CommandPool
@@ -218,15 +221,20 @@ std::vector<std::byte> readbackBuffer(Context& ctx, const Buffer& src, const Que
 }
 
 std::vector<std::byte> readbackImage(Context& ctx, const Image& src, VkImageLayout layout,
-                                     VkPipelineStageFlags2 lastStage, VkAccessFlags2 lastAccess) {
-    const VkExtent3D e = src.extent();
+                                     VkPipelineStageFlags2 lastStage, VkAccessFlags2 lastAccess, uint32_t mip) {
+    if (mip >= src.desc().mips) {
+        throw GpuError("readback of image '" + src.desc().name + "': no mip " + std::to_string(mip) + " (it has " +
+                       std::to_string(src.desc().mips) + ")");
+    }
+    const VkExtent3D full = src.extent();
+    const VkExtent3D e{std::max(full.width >> mip, 1u), std::max(full.height >> mip, 1u), std::max(full.depth >> mip, 1u)};
     const VkDeviceSize size = VkDeviceSize(e.width) * e.height * e.depth * bytesPerTexel(src.format());
     Buffer staging(ctx, {size, VK_BUFFER_USAGE_TRANSFER_DST_BIT, MemoryUsage::Readback, src.desc().name + ".readback"});
     submitAndWait(ctx, ctx.graphicsQueue(), "readback " + src.desc().name, [&](VkCommandBuffer cmd) {
         imageBarrier(cmd, src, layout, VK_IMAGE_LAYOUT_TRANSFER_SRC_OPTIMAL, lastStage, lastAccess,
                      VK_PIPELINE_STAGE_2_COPY_BIT, VK_ACCESS_2_TRANSFER_READ_BIT);
         VkBufferImageCopy region{};
-        region.imageSubresource = {src.aspect(), 0, 0, 1};
+        region.imageSubresource = {src.aspect(), mip, 0, 1};
         region.imageExtent = e;
         vkCmdCopyImageToBuffer(cmd, src.handle(), VK_IMAGE_LAYOUT_TRANSFER_SRC_OPTIMAL, staging.handle(), 1, &region);
         imageBarrier(cmd, src, VK_IMAGE_LAYOUT_TRANSFER_SRC_OPTIMAL, layout, VK_PIPELINE_STAGE_2_COPY_BIT, 0, lastStage, 0);

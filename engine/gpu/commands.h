@@ -89,9 +89,9 @@ template <typename T> std::vector<T> readbackBufferAs(Context& ctx, const Buffer
     std::memcpy(out.data(), bytes.data(), out.size() * sizeof(T));
     return out;
 }
-// Copies mip 0, layer 0 of `src`, currently in `layout` (left there), and
-// returns tightly packed texels.
+// Copies mip `mip`, layer 0 of `src`, currently in `layout` (every mip; left
+// there), and returns tightly packed texels.
 std::vector<std::byte> readbackImage(Context& ctx, const Image& src, VkImageLayout layout,
-                                     VkPipelineStageFlags2 lastStage, VkAccessFlags2 lastAccess);
+                                     VkPipelineStageFlags2 lastStage, VkAccessFlags2 lastAccess, uint32_t mip = 0);
 
 } // namespace glint::gpu

@@ -8,6 +8,7 @@
 
 #include <vulkan/vulkan.h>
 
+#include <optional>
 #include <span>
 #include <string>
 #include <vector>
@@ -115,6 +116,9 @@ struct SamplerDesc {
     VkSamplerAddressMode address = VK_SAMPLER_ADDRESS_MODE_CLAMP_TO_EDGE;
     float maxLod = VK_LOD_CLAMP_NONE;
     std::string name;
+    // V and W where they differ from `address` (an equirectangular image
+    // repeats in u and clamps at the poles).
+    std::optional<VkSamplerAddressMode> addressV;
 };
 
 class Sampler {

@@ -9,6 +9,7 @@
 #include "common/reflection_run.h"
 #include "passes/smoke_trace.h"
 #include "scene/builtin_scenes.h"
+#include "scene/image_io.h"
 
 #include <spdlog/spdlog.h>
 
@@ -25,10 +26,15 @@ constexpr const char* kUsage =
     "usage: glint-render [--scene plaza|hard-cases|smoke|FILE.gltf|FILE.glb] [--mode hybrid|ssr|rt|reference]\n"
     "                    [--size WxH|N] [--frames N] [--out IMAGE.png] [--debug-view NAME] [--stats FILE.json]\n"
     "                    [--backend auto|query|pipeline] [--bvh-queue async|graphics] [--time SECONDS]\n"
-    "                    [--camera NAME|INDEX] [--pass-timer auto|gpu|host]\n"
+    "                    [--camera NAME|INDEX] [--environment FILE.hdr] [--pass-timer auto|gpu|host]\n"
     "                    [--set NAME=VALUE[,NAME=VALUE...]]\n"
     "                    [--tolerance REL] [--seed N] [--max-frames N] (reference mode)\n"
-    "                    [--list-debug-views] [--list-parameters] [--validate]";
+    "                    [--list-debug-views] [--list-parameters] [--validate]\n"
+    "--pass-timer: GPU timestamps, or each pass submitted alone and timed on the host (auto: host on a CPU\n"
+    "                    device such as lavapipe, whose timestamps do not cover compute dispatches)\n"
+    "--environment FILE.hdr: light and reflect the scene with an equirectangular HDR image (Radiance .hdr, twice\n"
+    "                    as wide as high; -Z at its centre, +Y at its top) in place of the scene's sky, prefiltered\n"
+    "                    by roughness on the GPU once (its sun, intensity and rotation stay the scene's)";
 
 float parseSeconds(const std::string& text) {
     try {
@@ -60,8 +66,8 @@ int renderSmoke(gpu::Context& ctx, const std::filesystem::path& outDir, uint32_t
 int main(int argc, char** argv) {
     return app::runMain("glint-render", [&] {
         app::Args args(argc, argv, kUsage,
-                       {"scene", "mode", "size", "frames", "out", "debug-view", "stats", "backend", "time", "set", "tolerance", "pass-timer",
-                        "seed", "max-frames", "camera", "bvh-queue"},
+                       {"scene", "mode", "size", "frames", "out", "debug-view", "stats", "backend", "time", "set",
+                        "tolerance", "seed", "max-frames", "camera", "bvh-queue", "environment", "pass-timer"},
                        {"list-debug-views", "list-parameters"});
         if (args.has("list-parameters")) {
             for (const app::Parameter& p : app::parameters()) {
@@ -158,6 +164,12 @@ int main(int argc, char** argv) {
             return renderSmoke(ctx, out.extension() == ".png" ? out.parent_path() : out, width, height);
         }
         scene::Scene scene = scene::loadScene(sceneName);
+        if (args.has("environment")) {
+            // Errors name the file (scene::SceneError): missing, unreadable, not 2:1.
+            const scene::Environment image = scene::loadEquirectangularEnvironment(args.get("environment", ""));
+            scene.environment.kind = image.kind;
+            scene.environment.image = image.image;
+        }
         // --camera: a glTF camera or a built-in preset, held still (frames
         // beyond the first orbit it slowly); without it, a file's first
         // camera or framing view, or a built-in scene's path.

@@ -14,6 +14,9 @@ layout(set = 0, binding = 2, scalar) readonly buffer Vertices { GBufferVertex ve
 layout(set = 0, binding = 3, scalar) readonly buffer Joints { mat4 joints[]; };
 layout(set = 0, binding = 4, scalar) readonly buffer PreviousJoints { mat4 previousJoints[]; };
 layout(push_constant, scalar) uniform Push { GBufferDraw draw; };
+// The prefiltered environment (glint/environment.glsl, declared by
+// glint/brdf.glsl in the shaders that light); binding 5 is the shadow map.
+#define GLINT_ENVIRONMENT_BINDING 6
 
 // Linear blend skinning with the same guards as the BVH's pack pass: zero
 // weights and joints past the instance's skin contribute nothing.

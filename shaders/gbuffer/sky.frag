@@ -27,5 +27,5 @@ void main() {
     outMotion = clip.w > 0.0 && previousClip.w > 0.0
                     ? (previousClip.xy / previousClip.w - clip.xy / clip.w) * 0.5 * frame.size
                     : vec2(0.0);
-    outLit = vec4(skyRadiance(frame.lighting, dir), 0.0);
+    outLit = vec4(environmentRadiance(frame.lighting, dir, 0.0), 0.0);
 }

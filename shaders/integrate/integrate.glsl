@@ -15,6 +15,8 @@
 #include "glint/gbuffer_shared.h"
 #include "glint/integrate_shared.h"
 #include "glint/ray_generation_shared.h"
+// The prefiltered environment (glint/environment.glsl).
+#define GLINT_ENVIRONMENT_BINDING 17
 #include "glint/brdf.glsl"
 
 layout(local_size_x = 8, local_size_y = 8) in;

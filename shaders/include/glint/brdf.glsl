@@ -5,7 +5,9 @@
 // Specular: GGX / Trowbridge-Reitz distribution, height-correlated Smith
 // visibility and Schlick Fresnel, as Filament writes them ("Physically Based
 // Rendering in Filament", sections 4.4-4.6), alpha = roughness^2. Diffuse:
-// Lambert. Needs glint/gbuffer_shared.h (SceneLighting) first.
+// Lambert. Needs glint/gbuffer_shared.h (SceneLighting) first; with
+// GLINT_ENVIRONMENT_BINDING defined also the environment's lookups
+// (glint/environment.glsl) and shadeSurface.
 #ifndef GLINT_BRDF_GLSL
 #define GLINT_BRDF_GLSL
 
@@ -50,37 +52,10 @@ vec3 diffuseColor(Surface s) {
     return s.albedo * (1.0 - s.metallic);
 }
 
-// Radiance of the gradient sky in direction `dir` (unit): ground below the
-// horizon, horizon to zenith above it.
-vec3 skyRadiance(SceneLighting l, vec3 dir) {
-    const float y = clamp(dir.y, -1.0, 1.0);
-    if (y < 0.0) {
-        // A short blend below the horizon keeps the seam from aliasing.
-        return mix(l.skyHorizon.rgb, l.skyGround.rgb, clamp(-y * 10.0, 0.0, 1.0));
-    }
-    return mix(l.skyHorizon.rgb, l.skyZenith.rgb, sqrt(y));
-}
-
-// Irradiance from the sky on a surface facing `n`, cosine-weighted: the
-// classic hemisphere-light approximation, blending the irradiance of a
-// surface facing straight up (sky only) and straight down (ground only).
-vec3 skyIrradiance(SceneLighting l, vec3 n) {
-    const vec3 up = kPi * mix(l.skyHorizon.rgb, l.skyZenith.rgb, 0.5);
-    const vec3 down = kPi * l.skyGround.rgb;
-    return mix(down, up, 0.5 + 0.5 * clamp(n.y, -1.0, 1.0));
-}
-
-// Radiance the environment reflects towards a surface of perceptual
-// `roughness` around the mirror direction `dir` (unit): the sky itself for
-// a mirror, blending towards the cosine-weighted irradiance over pi as the
-// GGX lobe widens (alpha = roughness^2 reaches a hemisphere near 1). The
-// gradient sky is smooth, so this stands in for a roughness-prefiltered
-// environment map; ray-traced misses, the SSLR fallback and the
-// environment-only pixels all use it, so they agree.
-vec3 environmentRadiance(SceneLighting l, vec3 dir, float roughness) {
-    const float alpha = clamp(roughness * roughness, 0.0, 1.0);
-    return mix(skyRadiance(l, dir), skyIrradiance(l, dir) / kPi, alpha);
-}
+#ifdef GLINT_ENVIRONMENT_BINDING
+// The environment's lookups (the sky, its irradiance, the prefiltered
+// image): shaders that light surfaces bind it.
+#include "glint/environment.glsl"
 
 // Sun (diffuse + specular) and diffuse sky light leaving `s` towards `toViewer`
 // (unit). `sunVisibility` is 1 unshadowed, 0 in shadow. Specular sky light
@@ -100,8 +75,9 @@ vec3 shadeSurface(SceneLighting l, Surface s, vec3 toViewer, float sunVisibility
     const vec3 specular = F * (ggxDistribution(NoH, alpha) * smithVisibility(NoV, NoL, alpha));
     const vec3 diffuse = diffuseColor(s) / kPi;
     const vec3 sun = (diffuse + specular) * l.sunIrradiance.rgb * (NoL * sunVisibility);
-    const vec3 ambient = diffuseColor(s) / kPi * skyIrradiance(l, n);
+    const vec3 ambient = diffuseColor(s) / kPi * environmentIrradiance(l, n);
     return sun + ambient;
 }
+#endif
 
 #endif

@@ -54,15 +54,24 @@ struct GBufferInstance {
     uint pad1;
 };
 
-// The sun and the procedural sky in the units of the lit output (see
+// The sun and the environment in the units of the lit output (see
 // GBufferSettings in passes/gbuffer.h). Shared with the hit shaders that
-// light reflections the same way.
+// light reflections the same way; glint/environment.glsl looks the
+// environment up (240 bytes).
 struct SceneLighting {
     vec4 sunDirection;   // xyz: unit, towards the sun
     vec4 sunIrradiance;  // rgb: at normal incidence
-    vec4 skyZenith;      // rgb radiance
+    vec4 skyZenith;      // rgb radiance of the procedural sky (an image's mean, unused by the shaders)
     vec4 skyHorizon;
     vec4 skyGround;
+    // x: 1 = the prefiltered image (passes/environment.h) is bound and
+    // looked up, 0 = the procedural sky above; y: the image's scale
+    // (intensity times the ambient scale); z: the image's last level
+    // (glint/environment_shared.h); w: its rotation about +Y, radians.
+    vec4 environment;
+    // rgb: the image's irradiance as nine SH coefficients, cosine-convolved
+    // and unscaled (glint/environment_shared.h); zero for the procedural sky.
+    vec4 irradianceSh[9];
 };
 
 // The sun's shadow map this frame (passes/gbuffer.cpp fits it; the
@@ -114,6 +123,7 @@ static_assert(sizeof(glint::shader::GBufferVertex) == 72);
 static_assert(sizeof(glint::shader::GBufferInstance) == 144);
 static_assert(sizeof(glint::shader::GBufferDraw) == 8);
 static_assert(sizeof(glint::shader::GBufferShadow) == 112);
+static_assert(sizeof(glint::shader::SceneLighting) == 240);
 #endif
 
 #endif

@@ -63,7 +63,7 @@ GLINT_FUNC uint chooseReflectionTrace(float sslrConfidence, float confidenceThre
 }
 
 // Per-frame constants (a storage buffer: with the lighting they outgrow the
-// 128 bytes of push constants every device has; 192 bytes).
+// 128 bytes of push constants every device has; 352 bytes).
 struct IntegrateConstants {
     mat4 inverseViewProjection;  // unjittered, the G-buffer's camera
     vec4 cameraPosition;
@@ -79,7 +79,7 @@ struct IntegrateConstants {
 GLINT_END
 
 #ifdef __cplusplus
-static_assert(sizeof(glint::shader::IntegrateConstants) == 192);
+static_assert(sizeof(glint::shader::IntegrateConstants) == 352);
 #endif
 
 #endif

@@ -17,6 +17,9 @@
 #extension GL_EXT_scalar_block_layout : require
 
 #include "glint/gbuffer_shared.h"
+// The prefiltered environment (glint/environment.glsl): misses and the
+// hits' ambient light.
+#define GLINT_ENVIRONMENT_BINDING 11
 #include "glint/brdf.glsl"
 #include "glint/packing.h"
 #include "glint/ray_generation_shared.h"

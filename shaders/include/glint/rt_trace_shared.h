@@ -63,7 +63,7 @@ GLINT_CONST float kRtOriginMinimum = 1.0f / 32.0f;
 // size, so the list's dispatch command (word 0) fits it.
 GLINT_CONST uint kRtTraceGroupSize = 64u;
 
-// Scene constants of one frame (200 bytes: more than push constants
+// Scene constants of one frame (360 bytes: more than push constants
 // guarantee, so a small buffer the pass fills with vkCmdUpdateBuffer).
 struct RtTraceConstants {
     mat4 inverseViewProjection;  // of the G-buffer's rasterisation (jittered): its depth -> world
@@ -83,7 +83,7 @@ struct RtTraceConstants {
 GLINT_END
 
 #ifdef __cplusplus
-static_assert(sizeof(glint::shader::RtTraceConstants) == 200);
+static_assert(sizeof(glint::shader::RtTraceConstants) == 360);
 #endif
 
 #endif
