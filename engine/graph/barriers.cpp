@@ -147,9 +147,12 @@ struct UseInfoTable {
     }
 };
 
+// Built during static initialisation (from the constant-initialised access
+// table), so the lookup needs no guard.
+const UseInfoTable kUseInfo;
+
 const UseInfo& useInfoOf(Access a, ResourceKind k, Pipeline p) {
-    static const UseInfoTable table;
-    return table.info[static_cast<uint32_t>(a)][static_cast<uint32_t>(k)][static_cast<uint32_t>(p)];
+    return kUseInfo.info[static_cast<uint32_t>(a)][static_cast<uint32_t>(k)][static_cast<uint32_t>(p)];
 }
 
 struct Visibility {
@@ -299,6 +302,7 @@ struct Scratch {
     std::vector<uint32_t> deferred;
     std::vector<uint32_t> imports;
     std::vector<uint64_t> cuts;
+    std::vector<uint64_t> cutsScratch;
     std::vector<EndState> tree;
     std::vector<std::vector<uint32_t>> heapMembers;
 };
@@ -511,7 +515,7 @@ private:
                 cuts.push_back(st_.plan.resources[r].offset);
                 cuts.push_back(st_.plan.resources[r].offset + st_.plan.resources[r].size);
             }
-            std::sort(cuts.begin(), cuts.end());
+            radixSort(cuts, scratch_.cutsScratch, [](uint64_t cut) { return cut; });
             cuts.erase(std::unique(cuts.begin(), cuts.end()), cuts.end());
             const size_t pieces = cuts.size() - 1;
             size_t width = 1;
