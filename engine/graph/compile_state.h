@@ -79,6 +79,11 @@ void placeBarriersAndBatches(CompileState& state);
 template <class T, class Key>
 void radixSort(std::vector<T>& items, std::vector<T>& scratch, Key key) {
     constexpr uint32_t kBits = 8, kBuckets = 1u << kBits;
+    // Small graphs: clearing the buckets would cost more than the sort.
+    if (items.size() < 4 * kBuckets) {
+        std::stable_sort(items.begin(), items.end(), [&](const T& a, const T& b) { return key(a) < key(b); });
+        return;
+    }
     uint64_t largest = 0;
     for (const T& item : items) largest |= key(item);
     scratch.resize(items.size());
