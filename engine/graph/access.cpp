@@ -245,19 +245,26 @@ std::string_view toString(ResourceKind k) {
     return "?";
 }
 
-bool accessNeedsContents(Access a) { return row(a).needsContents; }
-bool accessWrites(Access a) { return row(a).writes; }
-bool accessIsBoundaryOnly(Access a) { return row(a).boundaryOnly; }
-bool accessNeedsRaster(Access a) { return row(a).needsRaster; }
-
-bool accessAllowedOn(Access a, ResourceKind k) { return (row(a).on & (1u << static_cast<uint32_t>(k))) != 0; }
-
-bool queueSupports(Queue q, Access a, Pipeline p) {
-    if (q == Queue::Graphics) return true;
-    return p != Pipeline::Raster && !row(a).needsRaster;
-}
-
 namespace detail {
+
+namespace {
+constexpr std::array<AccessRules, kAccessCount> makeAccessRules() {
+    std::array<AccessRules, kAccessCount> rules{};
+    for (uint32_t a = 0; a < kAccessCount; ++a) {
+        const Row& r = kTable[a];
+        rules[a] = {r.on, r.needsContents, r.writes, r.boundaryOnly, r.needsRaster};
+    }
+    return rules;
+}
+constexpr std::array<AccessRules, kAccessCount> kRules = makeAccessRules();
+} // namespace
+
+constexpr AccessRules kAccessRules[kAccessCount] = {
+    kRules[0], kRules[1], kRules[2],  kRules[3],  kRules[4],  kRules[5],  kRules[6],  kRules[7],
+    kRules[8], kRules[9], kRules[10], kRules[11], kRules[12], kRules[13], kRules[14],
+};
+static_assert(kAccessCount == 15, "kAccessRules lists every row");
+
 constexpr ScopeLut kScopeLut = makeScopeLut();
 } // namespace detail
 

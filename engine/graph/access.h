@@ -91,19 +91,35 @@ std::string_view toString(Queue);
 std::string_view toString(Pipeline);
 std::string_view toString(ResourceKind);
 
+namespace detail {
+// The table's rules for declaring a use, inline: Builder checks every use.
+struct AccessRules {
+    uint8_t on = 0; // bit per ResourceKind it applies to
+    bool needsContents = false;
+    bool writes = false;
+    bool boundaryOnly = false;
+    bool needsRaster = false;
+};
+extern const AccessRules kAccessRules[kAccessCount];
+} // namespace detail
+
 // Whether a use needs the resource to hold data already (reading something
 // nobody wrote is an error). Attachments and storage writes do not: a first
 // use may clear.
-bool accessNeedsContents(Access);
-bool accessWrites(Access);
+inline bool accessNeedsContents(Access a) { return detail::kAccessRules[static_cast<uint32_t>(a)].needsContents; }
+inline bool accessWrites(Access a) { return detail::kAccessRules[static_cast<uint32_t>(a)].writes; }
 // Boundary-only kinds (None, Present) cannot be declared by passes.
-bool accessIsBoundaryOnly(Access);
-bool accessAllowedOn(Access, ResourceKind);
+inline bool accessIsBoundaryOnly(Access a) { return detail::kAccessRules[static_cast<uint32_t>(a)].boundaryOnly; }
+inline bool accessAllowedOn(Access a, ResourceKind k) {
+    return (detail::kAccessRules[static_cast<uint32_t>(a)].on & (1u << static_cast<uint32_t>(k))) != 0;
+}
 // Attachments need a raster pipeline.
-bool accessNeedsRaster(Access);
+inline bool accessNeedsRaster(Access a) { return detail::kAccessRules[static_cast<uint32_t>(a)].needsRaster; }
 // What a queue can do: async compute queues have no raster pipeline and no
 // attachments.
-bool queueSupports(Queue, Access, Pipeline);
+inline bool queueSupports(Queue q, Access a, Pipeline p) {
+    return q == Queue::Graphics || (p != Pipeline::Raster && !accessNeedsRaster(a));
+}
 
 // Stage/access/layout of one kind used on one resource kind from one
 // pipeline. Layout is VK_IMAGE_LAYOUT_UNDEFINED for buffers and structures.

@@ -162,7 +162,7 @@ void aliasMemory(CompileState& st) {
     }
 
     std::vector<uint64_t> offsets;
-    std::vector<uint32_t> byOffset;
+    std::vector<uint32_t> byOffset, sortScratch;
     for (uint32_t h = 0; h < keys.size(); ++h) {
         std::vector<Item>& items = heapItems[h];
         // Ties on first use: larger first, so big resources get the low bytes.
@@ -190,9 +190,11 @@ void aliasMemory(CompileState& st) {
         if (!alias) continue;
         // Sweep by offset: a resource is aliased when it starts below the end
         // of an earlier one or the next one starts below its end.
+        // (Which of several resources at one offset comes first does not
+        // change the outcome: each is aliased by the other.)
         byOffset.resize(items.size());
         for (uint32_t i = 0; i < items.size(); ++i) byOffset[i] = i;
-        std::sort(byOffset.begin(), byOffset.end(), [&](uint32_t a, uint32_t b) { return offsets[a] < offsets[b]; });
+        radixSort(byOffset, sortScratch, [&](uint32_t i) { return offsets[i]; });
         uint64_t reach = 0;
         for (uint32_t i = 0; i < byOffset.size(); ++i) {
             const uint32_t a = byOffset[i];

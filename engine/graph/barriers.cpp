@@ -147,9 +147,12 @@ struct UseInfoTable {
     }
 };
 
+// Built during static initialisation (from the constant-initialised access
+// table), so the lookup needs no guard.
+const UseInfoTable kUseInfo;
+
 const UseInfo& useInfoOf(Access a, ResourceKind k, Pipeline p) {
-    static const UseInfoTable table;
-    return table.info[static_cast<uint32_t>(a)][static_cast<uint32_t>(k)][static_cast<uint32_t>(p)];
+    return kUseInfo.info[static_cast<uint32_t>(a)][static_cast<uint32_t>(k)][static_cast<uint32_t>(p)];
 }
 
 struct Visibility {
@@ -284,6 +287,12 @@ struct Final {
     uint32_t firstNeed;
 };
 
+struct FinalImport {
+    uint32_t resource;
+    uint32_t queue; // boundary queue of its final state
+    SyncScope scope;
+};
+
 // compile() runs every frame: the walk keeps its working memory per thread
 // so a frame's compile reuses last frame's allocations instead of asking
 // the allocator (and the kernel, for fresh pages) again.
@@ -296,9 +305,11 @@ struct Scratch {
     std::vector<Need> needs;
     std::vector<uint32_t> useNeed;
     std::vector<Final> finals;
+    std::vector<FinalImport> finalImports;
     std::vector<uint32_t> deferred;
     std::vector<uint32_t> imports;
     std::vector<uint64_t> cuts;
+    std::vector<uint64_t> cutsScratch;
     std::vector<EndState> tree;
     std::vector<std::vector<uint32_t>> heapMembers;
 };
@@ -511,7 +522,7 @@ private:
                 cuts.push_back(st_.plan.resources[r].offset);
                 cuts.push_back(st_.plan.resources[r].offset + st_.plan.resources[r].size);
             }
-            std::sort(cuts.begin(), cuts.end());
+            radixSort(cuts, scratch_.cutsScratch, [](uint64_t cut) { return cut; });
             cuts.erase(std::unique(cuts.begin(), cuts.end()), cuts.end());
             const size_t pieces = cuts.size() - 1;
             size_t width = 1;
@@ -845,7 +856,7 @@ private:
         const uint32_t p = st_.order[pos];
         const ir::Pass& pass = d_.passes[p];
         const uint32_t q = queueIndex(st_.queueOf[p]);
-        pending_[0] = pending_[1] = WaitRequest{};
+        clearPending();
         auto analysePass = [&] {
             needs_.clear();
             useNeed_.clear();
@@ -880,19 +891,31 @@ private:
     // ---- Frame end --------------------------------------------------------------
 
     void finalStates() {
+        // The imports that end in a state someone cares about, with that
+        // state's queue and scope, looked up once.
+        std::vector<FinalImport>& targets = scratch_.finalImports;
+        targets.clear();
+        for (uint32_t r : imports_) {
+            const ir::Resource& res = d_.resources[r];
+            if (!res.hasFinal) continue;
+            if (!res.final.isRaw && res.final.access == Access::None) continue; // the caller does not care
+            if (!st_.lifetimes[r].used() && res.hasInitial && res.initial == res.final) continue;
+            FinalImport& target = targets.emplace_back();
+            target.resource = r;
+            target.queue = queueIndex(st_.boundaryQueue(res.final.queue));
+            target.scope = boundaryScope(res.final, res.kind);
+        }
         for (uint32_t qi = 0; qi < kQueueCount; ++qi) {
             const auto q = static_cast<Queue>(qi);
-            pending_[0] = pending_[1] = WaitRequest{};
+            clearPending();
             auto analyseFinals = [&] {
                 finals_.clear();
                 needs_.clear();
-                for (uint32_t r : imports_) {
+                for (const FinalImport& target : targets) {
+                    if (target.queue != qi) continue;
+                    const uint32_t r = target.resource;
                     const ir::Resource& res = d_.resources[r];
-                    if (!res.hasFinal) continue;
-                    if (!res.final.isRaw && res.final.access == Access::None) continue; // the caller does not care
-                    if (!st_.lifetimes[r].used() && res.hasInitial && res.initial == res.final) continue;
-                    if (st_.boundaryQueue(res.final.queue) != q) continue;
-                    const SyncScope s = boundaryScope(res.final, res.kind);
+                    const SyncScope& s = target.scope;
                     const bool texture = res.kind == ResourceKind::Texture;
                     const auto first = static_cast<uint32_t>(needs_.size());
                     forCells(res, wholeOf(res),
@@ -918,6 +941,11 @@ private:
             batches_.setEndBarriers(q, firstBarrier, static_cast<uint32_t>(st_.plan.barriers.size()) - firstBarrier);
         }
     }
+
+    // A request's other fields mean nothing while it is inactive. (Clearing
+    // the flag alone also spares a store-forwarding stall per pass that
+    // copying a fresh WaitRequest costs.)
+    void clearPending() { pending_[0].active = pending_[1].active = false; }
 
     static Subresource wholeOf(const ir::Resource& r) {
         return r.kind == ResourceKind::Texture ? Subresource{0, r.texture.mips, 0, r.texture.layers}

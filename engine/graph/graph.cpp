@@ -105,11 +105,7 @@ void Graph::reserve(uint32_t passes, uint32_t resources, uint32_t uses) {
     d.written.reserve(resources);
 }
 
-ir::Declaration& Graph::mutableDecl() {
-    // A compiled Plan shares the declaration; keep its view frozen.
-    if (decl_.use_count() > 1) decl_ = std::make_shared<ir::Declaration>(*decl_);
-    return *decl_;
-}
+void Graph::unshareDecl() { decl_ = std::make_shared<ir::Declaration>(*decl_); }
 
 // Resources are built in place: moving a Resource into the vector costs
 // more than everything else declaring it does.
@@ -247,7 +243,18 @@ std::pair<uint32_t, uint32_t> Graph::addHistory(std::string_view name, ResourceK
     return {previous, current};
 }
 
-const ir::Resource& Graph::checkHandle(ResourceKind kind, uint32_t index, uint32_t graph, std::string_view pass) const {
+// Every use checks its handle: the common case stays inline, the messages
+// live in throwBadHandle.
+inline const ir::Resource& Graph::checkHandle(ResourceKind kind, uint32_t index, uint32_t graph,
+                                              std::string_view pass) const {
+    const ir::Declaration& d = *decl_;
+    if (graph != d.graphId || index >= d.resources.size() || d.resources[index].kind != kind) [[unlikely]]
+        throwBadHandle(kind, index, graph, pass);
+    return d.resources[index];
+}
+
+void Graph::throwBadHandle([[maybe_unused]] ResourceKind kind, uint32_t index, uint32_t graph,
+                           std::string_view pass) const {
     const ir::Declaration& d = *decl_;
     if (graph != d.graphId || index >= d.resources.size()) {
         const std::string what = graph == 0 ? "an invalid (default-constructed) handle"
@@ -256,10 +263,8 @@ const ir::Resource& Graph::checkHandle(ResourceKind kind, uint32_t index, uint32
         throw GraphError(ErrorKind::ForeignHandle, std::string(pass), "#" + std::to_string(index), "uses " + what);
     }
     const ir::Resource& r = d.resources[index];
-    if (r.kind != kind)
-        throw GraphError(ErrorKind::ForeignHandle, std::string(pass), r.name,
-                         "handle kind does not match the resource (a " + std::string(toString(r.kind)) + ")");
-    return r;
+    throw GraphError(ErrorKind::ForeignHandle, std::string(pass), r.name,
+                     "handle kind does not match the resource (a " + std::string(toString(r.kind)) + ")");
 }
 
 void Graph::markOutput(Texture t) { markOutput(ResourceKind::Texture, t.index, t.version, t.graph); }

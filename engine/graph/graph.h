@@ -167,7 +167,13 @@ private:
     void abortPass(uint32_t pass);
     PassId endPass(uint32_t pass);
 
-    ir::Declaration& mutableDecl();
+    // A compiled Plan shares the declaration; the first change after a
+    // compile copies it so the plan's view stays frozen.
+    ir::Declaration& mutableDecl() {
+        if (decl_.use_count() > 1) unshareDecl();
+        return *decl_;
+    }
+    void unshareDecl();
     uint32_t newResource(std::string_view name, ResourceKind kind, ir::Origin origin);
     void finishResource(uint32_t index);
     uint32_t addImport(std::string_view name, ResourceKind kind, const std::optional<BoundaryState>& initial,
@@ -177,6 +183,7 @@ private:
                  Subresource range, bool write);
     void markOutput(ResourceKind kind, uint32_t index, uint32_t version, uint32_t graph);
     const ir::Resource& checkHandle(ResourceKind kind, uint32_t index, uint32_t graph, std::string_view pass) const;
+    [[noreturn]] void throwBadHandle(ResourceKind kind, uint32_t index, uint32_t graph, std::string_view pass) const;
 
     QueueCaps caps_;
     // Shared with the Plans compiled from it (they need the names and execute

@@ -18,7 +18,9 @@ uint64_t alignUp(uint64_t v, uint64_t a) { return (v + a - 1) / a * a; }
 
 } // namespace
 
-FormatBlock formatBlock(VkFormat f) {
+namespace {
+
+constexpr FormatBlock blockOf(VkFormat f) {
     switch (f) {
         case VK_FORMAT_R8_UNORM:
         case VK_FORMAT_R8_SNORM:
@@ -93,6 +95,24 @@ FormatBlock formatBlock(VkFormat f) {
         default:
             return {0, 0, 0};
     }
+}
+
+// The switch as a table over the core formats (every format above is one):
+// compile() sizes every transient every frame.
+constexpr uint32_t kCoreFormats = VK_FORMAT_ASTC_12x12_SRGB_BLOCK + 1;
+struct BlockTable {
+    FormatBlock block[kCoreFormats] = {};
+    constexpr BlockTable() {
+        for (uint32_t f = 0; f < kCoreFormats; ++f) block[f] = blockOf(static_cast<VkFormat>(f));
+    }
+};
+constexpr BlockTable kBlocks;
+
+} // namespace
+
+FormatBlock formatBlock(VkFormat f) {
+    const auto index = static_cast<uint32_t>(f);
+    return index < kCoreFormats ? kBlocks.block[index] : blockOf(f);
 }
 
 VkImageAspectFlags aspectOf(VkFormat f) {
