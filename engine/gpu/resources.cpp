@@ -151,7 +151,31 @@ void Image::create(Context& ctx, const MemoryRange* placed) {
         memoryFor(ctx, req, placed, MemoryUsage::DeviceLocal, /*linear=*/false, "image", desc_.name, allocation_);
     check(vkBindImageMemory(ctx.device(), image, range.memory, range.offset), "vkBindImageMemory '" + desc_.name + "'");
     ctx.setName(image, VK_OBJECT_TYPE_IMAGE, desc_.name);
+    createViews(ctx);
+}
 
+namespace {
+// The deleter of an external image: its owner destroys it.
+void keepExternalImage(VkDevice, VkImage, const VkAllocationCallbacks*) {}
+} // namespace
+
+Image Image::external(Context& ctx, VkImage image, const ImageDesc& desc) {
+    if (image == VK_NULL_HANDLE) {
+        throw GpuError("external image '" + desc.name + "': null VkImage");
+    }
+    if (desc.width == 0 || desc.height == 0 || desc.depth == 0 || desc.mips == 0 || desc.layers == 0) {
+        throw GpuError("external image '" + desc.name + "': zero extent, mip count or layer count");
+    }
+    Image out;
+    out.desc_ = desc;
+    out.external_ = true;
+    out.image_ = Unique<VkImage>(ctx.device(), image, keepExternalImage);
+    out.createViews(ctx);
+    return out;
+}
+
+void Image::createViews(Context& ctx) {
+    const VkImage image = image_.get();
     // Transfer-only images (staging, readback targets) cannot have views.
     constexpr VkImageUsageFlags kViewUsage = VK_IMAGE_USAGE_SAMPLED_BIT | VK_IMAGE_USAGE_STORAGE_BIT |
                                              VK_IMAGE_USAGE_COLOR_ATTACHMENT_BIT |

@@ -84,6 +84,13 @@ public:
 
     static VkMemoryRequirements requirements(Context& ctx, const ImageDesc& desc);
 
+    // A non-owning wrapper of an image created elsewhere (a swapchain image):
+    // it owns the views it makes, never the image or its memory. `desc`
+    // describes the image as created (usage decides whether a view is made);
+    // the owner keeps the image alive while the wrapper is in use.
+    static Image external(Context& ctx, VkImage image, const ImageDesc& desc);
+    bool isExternal() const { return external_; }
+
     VkImage handle() const { return image_.get(); }
     explicit operator bool() const { return static_cast<bool>(image_); }
     // A view of every mip and layer (null for transfer-only images).
@@ -98,8 +105,10 @@ public:
 
 private:
     void create(Context& ctx, const MemoryRange* placed);
+    void createViews(Context& ctx);
 
     ImageDesc desc_;
+    bool external_ = false;
     Allocation allocation_;  // declared first: released after the image and view
     Unique<VkImage> image_;
     Unique<VkImageView> view_;

@@ -154,10 +154,13 @@ constexpr std::array<Row, kAccessCount> kTable = {{
      .on = kOnAccel,
      .shader = true,
      .accelAccess = VK_ACCESS_2_ACCELERATION_STRUCTURE_READ_BIT_KHR},
+    // No access: presentation reads through the semaphore. Its stages are
+    // the semaphore signal's (kSemaphoreSignalStages says why).
     {.name = "Present",
      .needsContents = true,
      .boundaryOnly = true,
      .on = kOnTexture,
+     .stages = kSemaphoreSignalStages,
      .layout = VK_IMAGE_LAYOUT_PRESENT_SRC_KHR},
 }};
 

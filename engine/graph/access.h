@@ -27,10 +27,20 @@ enum class Access : uint8_t {
     AccelBuildInput, // buffers: vertex/index/instance input; structures: update source, BLAS under a TLAS
     AccelBuildWrite, // structures: build or update target; buffers: build scratch
     AccelRead,       // ray query (compute/raster) or trace rays (ray-tracing pipeline)
-    Present,         // boundary states only: handed to the presentation engine
+    Present,         // boundary states only: handed to the presentation engine (see kSemaphoreSignalStages)
     Count
 };
 inline constexpr uint32_t kAccessCount = static_cast<uint32_t>(Access::Count);
+
+// The stage mask the executor signals semaphores with (its timelines and the
+// caller's binary semaphores, FrameResources::signalSemaphore). The Present
+// boundary state ends at these stages: presentation needs no access mask
+// (vkQueuePresentKHR makes the image visible to the presentation engine),
+// but the layout transition into PRESENT_SRC_KHR must be in the signal's
+// first synchronisation scope, so the final barrier's destination stages
+// must meet the signal's stage mask (a NONE destination leaves the
+// transition outside it: a present-after-write hazard).
+inline constexpr VkPipelineStageFlags2 kSemaphoreSignalStages = VK_PIPELINE_STAGE_2_ALL_COMMANDS_BIT;
 
 // Several read kinds of one subresource in one pass (depth test plus
 // sampling the same depth) merge into one use; a set holds them.
@@ -56,11 +66,13 @@ struct SyncScope {
 // a queue that runs no pass in the plan stands for the other queue.
 //
 // Most states are an access kind. The escape hatch, raw(), takes explicit
-// masks for states no kind names; the common one is a swapchain image whose
-// acquire semaphore is waited at COLOR_ATTACHMENT_OUTPUT:
-//   BoundaryState::raw(VK_PIPELINE_STAGE_2_COLOR_ATTACHMENT_OUTPUT_BIT, 0,
-//                      VK_IMAGE_LAYOUT_UNDEFINED)
-// so the first layout transition is ordered after that wait.
+// masks for states no kind names. A swapchain image goes from acquired() to
+// of(Access::Present):
+//   graph.importTexture("swapchain", {desc,
+//       BoundaryState::acquired(VK_PIPELINE_STAGE_2_COLOR_ATTACHMENT_OUTPUT_BIT),
+//       BoundaryState::of(Access::Present)});
+// with FrameResources::waitSemaphore / signalSemaphore naming the acquire
+// and render-finished semaphores (graph/executor.h).
 struct BoundaryState {
     Access access = Access::None;
     Queue queue = Queue::Graphics;
@@ -74,6 +86,13 @@ struct BoundaryState {
     static constexpr BoundaryState raw(VkPipelineStageFlags2 stages, VkAccessFlags2 access, VkImageLayout layout,
                                        Queue q = Queue::Graphics) {
         return BoundaryState{Access::None, q, Pipeline::Compute, true, SyncScope{stages, access, layout}};
+    }
+    // Made available by a semaphore the frame waits on at `waitStages` (a
+    // swapchain image after vkAcquireNextImageKHR): contents undefined, and
+    // the first barrier starts from `waitStages`, so its layout transition
+    // is ordered after the wait. Name the stages of the image's first use.
+    static constexpr BoundaryState acquired(VkPipelineStageFlags2 waitStages, Queue q = Queue::Graphics) {
+        return raw(waitStages, VK_ACCESS_2_NONE, VK_IMAGE_LAYOUT_UNDEFINED, q);
     }
     friend constexpr bool operator==(const BoundaryState& a, const BoundaryState& b) {
         if (a.isRaw != b.isRaw || a.queue != b.queue) return false;

@@ -67,6 +67,20 @@ void FrameResources::bind(AccelStruct handle, const gpu::AccelerationStructure& 
     accels_[handle.index] = &accel;
 }
 
+void FrameResources::waitSemaphore(Texture image, VkSemaphore semaphore, VkPipelineStageFlags2 stages,
+                                   uint64_t value) {
+    waits_.push_back({image.index, semaphore, stages, value});
+}
+void FrameResources::waitSemaphore(VkSemaphore semaphore, VkPipelineStageFlags2 stages, uint64_t value) {
+    waits_.push_back({kNoIndex, semaphore, stages, value});
+}
+void FrameResources::signalSemaphore(Texture image, VkSemaphore semaphore, uint64_t value) {
+    signals_.push_back({image.index, semaphore, kSemaphoreSignalStages, value});
+}
+void FrameResources::signalSemaphore(VkSemaphore semaphore, uint64_t value) {
+    signals_.push_back({kNoIndex, semaphore, kSemaphoreSignalStages, value});
+}
+
 // ---------------------------------------------------------------- internal state
 
 // Transient memory and the resources placed in it. `key` is everything that,
@@ -512,7 +526,88 @@ void Executor::recordBarriers(VkCommandBuffer cmd, const Plan& plan, std::span<c
     vkCmdPipelineBarrier2(cmd, &dep);
 }
 
-void Executor::run(const Plan& plan, const FrameResources& imports) {
+// The caller's semaphores, placed on the plan's batches (indexed like
+// Plan::batches); `unplaced` when the plan has no batch at all.
+struct Executor::ExternalSync {
+    std::vector<std::vector<VkSemaphoreSubmitInfo>> waits;
+    std::vector<std::vector<VkSemaphoreSubmitInfo>> signals;
+    std::vector<VkSemaphoreSubmitInfo> unplacedWaits;
+    std::vector<VkSemaphoreSubmitInfo> unplacedSignals;
+};
+
+Executor::ExternalSync Executor::placeSemaphores(const Plan& plan, const FrameResources& imports) const {
+    ExternalSync out;
+    if (imports.waits_.empty() && imports.signals_.empty()) {
+        return out;
+    }
+    out.waits.resize(plan.batches.size());
+    out.signals.resize(plan.batches.size());
+    const auto& decl = *plan.declaration;
+    const auto importedTexture = [&](uint32_t r, const char* what) -> const ir::Resource& {
+        if (r >= decl.resources.size() || decl.resources[r].kind != ResourceKind::Texture ||
+            decl.resources[r].origin != ir::Origin::Imported) {
+            throw gpu::GpuError(std::string("render graph: FrameResources::") + what +
+                                " names a texture that is not an import of this plan");
+        }
+        return decl.resources[r];
+    };
+    const auto info = [](const FrameResources::SemaphoreUse& u, VkPipelineStageFlags2 stages) {
+        VkSemaphoreSubmitInfo i{VK_STRUCTURE_TYPE_SEMAPHORE_SUBMIT_INFO};
+        i.semaphore = u.semaphore;
+        i.value = u.value;
+        i.stageMask = stages;
+        return i;
+    };
+    const uint32_t lastBatch = plan.batches.empty() ? kNoIndex : static_cast<uint32_t>(plan.batches.size() - 1);
+
+    for (const FrameResources::SemaphoreUse& w : imports.waits_) {
+        uint32_t batch = plan.batches.empty() ? kNoIndex : 0;
+        VkPipelineStageFlags2 stages = w.stages;
+        if (w.texture != kNoIndex) {
+            const ir::Resource& res = importedTexture(w.texture, "waitSemaphore");
+            const Plan::WaitPoint point = plan.firstUseOf(w.texture);
+            if (point.batch != kNoIndex) batch = point.batch;
+            if (stages == 0) {
+                if (!res.hasInitial || boundaryScope(res.initial, ResourceKind::Texture).stages == 0) {
+                    throw gpu::GpuError("render graph: '" + res.name +
+                                        "' waits on a semaphore, but its initial state names no stage, so its first "
+                                        "layout transition would not wait for it: import it with "
+                                        "BoundaryState::acquired(stages of its first use)");
+                }
+                stages = point.stages;
+            }
+        }
+        if (stages == 0) {
+            throw gpu::GpuError("render graph: FrameResources::waitSemaphore without a stage mask");
+        }
+        (batch == kNoIndex ? out.unplacedWaits : out.waits[batch]).push_back(info(w, stages));
+    }
+
+    for (const FrameResources::SemaphoreUse& sg : imports.signals_) {
+        uint32_t batch = lastBatch;
+        if (sg.texture != kNoIndex) {
+            importedTexture(sg.texture, "signalSemaphore");
+            if (const uint32_t ending = plan.batchEnding(sg.texture); ending != kNoIndex) batch = ending;
+        }
+        (batch == kNoIndex ? out.unplacedSignals : out.signals[batch]).push_back(info(sg, sg.stages));
+    }
+    return out;
+}
+
+void Executor::wait(const SubmittedFrame& frame) const {
+    for (uint32_t q = 0; q < kQueueCount; ++q) {
+        if (frame.timelineValue[q] != 0) timelines_[q].wait(frame.timelineValue[q]);
+    }
+}
+
+bool Executor::finished(const SubmittedFrame& frame) const {
+    for (uint32_t q = 0; q < kQueueCount; ++q) {
+        if (frame.timelineValue[q] != 0 && timelines_[q].value() < frame.timelineValue[q]) return false;
+    }
+    return true;
+}
+
+SubmittedFrame Executor::run(const Plan& plan, const FrameResources& imports) {
     if (!plan.declaration) {
         throw gpu::GpuError("render graph: run() got an empty Plan");
     }
@@ -544,6 +639,7 @@ void Executor::run(const Plan& plan, const FrameResources& imports) {
     prepareTransients(plan);
     prepareHistory(plan);
     bindResources(plan, imports);
+    const ExternalSync external = placeSemaphores(plan, imports);
 
     // ---- timeline values: this frame's batches count up from where the
     // previous frame ended on each queue (the plan may change between frames,
@@ -554,7 +650,8 @@ void Executor::run(const Plan& plan, const FrameResources& imports) {
     PassContext ctx(*this, gpu_);
     ctx.frame_ = frame_;
     const bool hostTimed = passTimer_ == PassTimer::HostSerial;
-    for (const Batch& batch : plan.batches) {
+    for (uint32_t batchIndex = 0; batchIndex < plan.batches.size(); ++batchIndex) {
+        const Batch& batch = plan.batches[batchIndex];
         const uint32_t qi = static_cast<uint32_t>(batch.queue);
         const VkQueue queue = queueOf(batch.queue).queue;
         ctx.queue_ = batch.queue;
@@ -579,10 +676,16 @@ void Executor::run(const Plan& plan, const FrameResources& imports) {
             info.stageMask = w.stages;
             waits.push_back(info);
         }
-        VkSemaphoreSubmitInfo signal{VK_STRUCTURE_TYPE_SEMAPHORE_SUBMIT_INFO};
-        signal.semaphore = timelines_[qi].handle();
-        signal.value = base[qi] + batch.ordinal + 1;
-        signal.stageMask = VK_PIPELINE_STAGE_2_ALL_COMMANDS_BIT;
+        // The queue's timeline first, then the caller's semaphores placed here.
+        const uint64_t signalValue = base[qi] + batch.ordinal + 1;
+        std::vector<VkSemaphoreSubmitInfo> signals(1, {VK_STRUCTURE_TYPE_SEMAPHORE_SUBMIT_INFO});
+        signals[0].semaphore = timelines_[qi].handle();
+        signals[0].value = signalValue;
+        signals[0].stageMask = kSemaphoreSignalStages;
+        if (!external.waits.empty()) {
+            waits.insert(waits.end(), external.waits[batchIndex].begin(), external.waits[batchIndex].end());
+            signals.insert(signals.end(), external.signals[batchIndex].begin(), external.signals[batchIndex].end());
+        }
 
         // One command buffer per batch; with host-timed passes, one per pass
         // (the batch's waits on the first, its signal on the last).
@@ -607,8 +710,8 @@ void Executor::run(const Plan& plan, const FrameResources& imports) {
             info.commandBufferInfoCount = 1;
             info.pCommandBufferInfos = &cmdInfo;
             if (last) {
-                info.signalSemaphoreInfoCount = 1;
-                info.pSignalSemaphoreInfos = &signal;
+                info.signalSemaphoreInfoCount = static_cast<uint32_t>(signals.size());
+                info.pSignalSemaphoreInfos = signals.data();
             }
             gpu::check(vkQueueSubmit2(queue, 1, &info, VK_NULL_HANDLE),
                        "vkQueueSubmit2 (render graph, " + std::string(toString(batch.queue)) + " batch " +
@@ -675,14 +778,29 @@ void Executor::run(const Plan& plan, const FrameResources& imports) {
             recordBarriers(cmd, plan, plan.barriersAfter(batch));
             submit(true);
         }
-        lastSignal_[qi] = std::max(lastSignal_[qi], signal.value);
+        lastSignal_[qi] = std::max(lastSignal_[qi], signalValue);
     }
+    if (!external.unplacedWaits.empty() || !external.unplacedSignals.empty()) {
+        // No batch to carry them: a submission of their own keeps the
+        // caller's semaphores balanced (an acquire waited, a present signalled).
+        VkSubmitInfo2 info{VK_STRUCTURE_TYPE_SUBMIT_INFO_2};
+        info.waitSemaphoreInfoCount = static_cast<uint32_t>(external.unplacedWaits.size());
+        info.pWaitSemaphoreInfos = external.unplacedWaits.data();
+        info.signalSemaphoreInfoCount = static_cast<uint32_t>(external.unplacedSignals.size());
+        info.pSignalSemaphoreInfos = external.unplacedSignals.data();
+        gpu::check(vkQueueSubmit2(gpu_.graphicsQueue().queue, 1, &info, VK_NULL_HANDLE),
+                   "vkQueueSubmit2 (render graph, semaphores of an empty plan)");
+    }
+    SubmittedFrame submitted;
+    submitted.frame = frame_;
     for (uint32_t q = 0; q < kQueueCount; ++q) {
         previousBase_[q] = base[q];
         slot.endValue[q] = lastSignal_[q];
+        submitted.timelineValue[q] = lastSignal_[q];
     }
     ++frame_;
     ++stats_.frames;
+    return submitted;
 }
 
 std::vector<PassTiming> Executor::timings() const {

@@ -8,9 +8,31 @@
 //     ... addPass(...) ...
 //     rg::Plan plan = graph.compile(executor.compileOptions());
 //     rg::FrameResources imports;                 // this frame's imports
-//     imports.bind(swapchainHandle, swapchainImage);
-//     executor.run(plan, imports);
+//     imports.bind(sceneHandle, sceneBuffer);
+//     rg::SubmittedFrame done = executor.run(plan, imports);
 //   executor.waitIdle(); executor.timings();       // per-pass GPU times
+//
+// A swapchain image (any image the graph does not own, waited for and
+// handed on through binary semaphores):
+//   const VkImage vk = swapchainImages[index];     // after vkAcquireNextImageKHR(acquired)
+//   gpu::Image image = gpu::Image::external(gpu, vk, desc);  // non-owning; keep one per swapchain image
+//   rg::Texture target = graph.importTexture("swapchain", {size,
+//       rg::BoundaryState::acquired(VK_PIPELINE_STAGE_2_COLOR_ATTACHMENT_OUTPUT_BIT),
+//       rg::BoundaryState::of(rg::Access::Present)});
+//   ... passes write `target` ...
+//   imports.bind(target, image);
+//   imports.waitSemaphore(target, acquired);       // by the batch of its first use
+//   imports.signalSemaphore(target, renderFinished);  // by the batch that ends it in PRESENT_SRC
+//   rg::SubmittedFrame frame = executor.run(plan, imports);
+//   vkQueuePresentKHR(... waits renderFinished ...);
+//   later: executor.wait(frame) before reusing what belonged to that frame
+//   (its acquire semaphore, a readback buffer).
+// The batch holding the image's first use waits on the semaphore at the
+// stages of that use and of the initial state (where its first barrier
+// starts, so the layout transition follows the wait). The batch that
+// records the image's final barrier (PRESENT_SRC, destination stages
+// kSemaphoreSignalStages) signals at kSemaphoreSignalStages, so the
+// transition is inside the signal's scope; the verifier checks that order.
 //
 // What it keeps across frames:
 // - transient memory: one allocation per plan heap, with the transients
@@ -22,7 +44,9 @@
 // - per frame in flight: command pools, timestamp queries; one timeline
 //   semaphore per queue.
 // Frames in flight: run() blocks only until the frame that last used the
-// same slot (framesInFlight frames ago) has finished on the GPU.
+// same slot (framesInFlight frames ago) has finished on the GPU. Resources
+// the caller binds are its own to keep alive until the SubmittedFrame that
+// used them has finished (wait(), finished()).
 
 #include "graph/compile.h"
 #include "graph/plan.h"
@@ -46,19 +70,53 @@ namespace glint::rg {
 // The queue description compile() needs, from the device's capabilities.
 QueueCaps queueCapsOf(const gpu::Capabilities& caps);
 
-// The caller's resources for one frame, bound to the handles that imported them.
+// The caller's resources for one frame, bound to the handles that imported
+// them, and the semaphores (binary or timeline) that tie the frame to work
+// outside the graph: a swapchain image's acquire and present.
 class FrameResources {
 public:
     void bind(Texture handle, const gpu::Image& image);
     void bind(Buffer handle, const gpu::Buffer& buffer);
     void bind(AccelStruct handle, const gpu::AccelerationStructure& accel);
 
+    // The batch holding the first use of `image` waits on `semaphore` at
+    // `stages`; 0 takes the stages of that use and of the import's initial
+    // state, which must name a stage (BoundaryState::acquired): the first
+    // barrier starts there, so its layout transition follows the wait. An
+    // import no pass uses waits in the frame's first batch.
+    void waitSemaphore(Texture image, VkSemaphore semaphore, VkPipelineStageFlags2 stages = 0, uint64_t value = 0);
+    // The frame's first batch (submission order) waits on `semaphore` at `stages`.
+    void waitSemaphore(VkSemaphore semaphore, VkPipelineStageFlags2 stages, uint64_t value = 0);
+    // The batch that leaves `image` in its final state (records its final
+    // barrier, or else holds its last use) signals `semaphore` at
+    // kSemaphoreSignalStages. An import no pass uses: the frame's last batch.
+    void signalSemaphore(Texture image, VkSemaphore semaphore, uint64_t value = 0);
+    // The frame's last batch (submission order) signals `semaphore`. With
+    // two queues the other queue may still be working: wait for a
+    // SubmittedFrame to know the whole frame is done.
+    void signalSemaphore(VkSemaphore semaphore, uint64_t value = 0);
+
 private:
     friend class Executor;
+    struct SemaphoreUse {
+        uint32_t texture = kNoIndex;  // kNoIndex: the frame's first / last batch
+        VkSemaphore semaphore = VK_NULL_HANDLE;
+        VkPipelineStageFlags2 stages = 0;
+        uint64_t value = 0;  // timeline semaphores only
+    };
     std::map<uint32_t, const gpu::Image*> images_;
     std::map<uint32_t, const gpu::Buffer*> buffers_;
     std::map<uint32_t, const gpu::AccelerationStructure*> accels_;
+    std::vector<SemaphoreUse> waits_;
+    std::vector<SemaphoreUse> signals_;
     uint32_t graph_ = 0;
+};
+
+// What run() submitted: the timeline value each queue reaches when the
+// frame's work on it is done (0: the frame put nothing there).
+struct SubmittedFrame {
+    uint64_t frame = 0;
+    uint64_t timelineValue[kQueueCount] = {0, 0};
 };
 
 // What a pass's execute callback records with.
@@ -136,9 +194,13 @@ public:
     CompileOptions compileOptions(bool aliasing = true) const;
 
     // Records and submits one frame of `plan`.
-    void run(const Plan& plan, const FrameResources& imports = {});
+    SubmittedFrame run(const Plan& plan, const FrameResources& imports = {});
     // Waits for every submitted frame.
     void waitIdle();
+    // Waits until `frame`'s work is done on every queue (its semaphore
+    // waits included, so a binary semaphore it waited on may be reused).
+    void wait(const SubmittedFrame& frame) const;
+    bool finished(const SubmittedFrame& frame) const;
     // Per-pass GPU times of the most recent frame that has completed, in
     // submission order (after waitIdle(): the last frame run).
     std::vector<PassTiming> timings() const;
@@ -161,6 +223,8 @@ private:
     void prepareHistory(const Plan& plan);
     void bindResources(const Plan& plan, const FrameResources& imports);
     void recordBarriers(VkCommandBuffer cmd, const Plan& plan, std::span<const Barrier> barriers) const;
+    struct ExternalSync;
+    ExternalSync placeSemaphores(const Plan& plan, const FrameResources& imports) const;
     const gpu::Queue& queueOf(Queue q) const;
     const Physical& physical(uint32_t resource, std::string_view pass) const;
 

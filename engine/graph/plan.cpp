@@ -1,5 +1,7 @@
 #include "graph/plan.h"
 
+#include "graph/access.h"
+
 namespace glint::rg {
 
 std::span<const ir::Use> Plan::uses(const PlannedPass& p) const {
@@ -23,6 +25,35 @@ std::optional<uint64_t> Plan::waitValue(uint64_t frame, const SemaphoreWait& w) 
     if (w.frameOffset < 0 && frame < static_cast<uint64_t>(-w.frameOffset)) return std::nullopt;
     const uint64_t target = frame + static_cast<uint64_t>(static_cast<int64_t>(w.frameOffset));
     return target * batchCount(w.queue) + w.batch + 1;
+}
+
+Plan::WaitPoint Plan::firstUseOf(uint32_t resource) const {
+    WaitPoint out;
+    if (resource >= resources.size()) return out;
+    const ResourceKind kind = resources[resource].kind;
+    for (const PlannedPass& p : passes) {
+        for (const ir::Use& use : uses(p))
+            if (use.resource == resource) out.stages |= accessScope(use.kinds, kind, pipeline(p)).stages;
+        if (out.stages) {
+            out.batch = p.batch;
+            break;
+        }
+    }
+    const ir::Resource& r = declaration->resources[resource];
+    if (r.origin == ir::Origin::Imported && r.hasInitial) out.stages |= boundaryScope(r.initial, kind).stages;
+    return out;
+}
+
+uint32_t Plan::batchEnding(uint32_t resource) const {
+    uint32_t end = kNoIndex, lastUse = kNoIndex;
+    for (uint32_t b = 0; b < batches.size(); ++b) {
+        for (const Barrier& barrier : barriersAfter(batches[b]))
+            if (barrier.resource == resource) end = b;
+        for (const PlannedPass& p : passesOf(batches[b]))
+            for (const ir::Use& use : uses(p))
+                if (use.resource == resource) lastUse = b;
+    }
+    return end != kNoIndex ? end : lastUse;
 }
 
 const PlannedPass* Plan::findPass(std::string_view name) const {

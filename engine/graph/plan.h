@@ -163,6 +163,20 @@ struct Plan {
     uint64_t signalValue(uint64_t frame, const Batch& b) const;
     std::optional<uint64_t> waitValue(uint64_t frame, const SemaphoreWait& w) const;
 
+    // Where a caller's semaphores for an import go (FrameResources::
+    // waitSemaphore / signalSemaphore, e.g. a swapchain image's acquire and
+    // render-finished): the batch of its first use in submission order, with
+    // the stages to wait at (that use's, plus the initial state's, where the
+    // import's first barrier starts); and the batch that leaves it in its
+    // final state (records its final barrier, else holds its last use).
+    // Batch kNoIndex: no pass uses it (and no barrier touches it).
+    struct WaitPoint {
+        uint32_t batch = kNoIndex;
+        VkPipelineStageFlags2 stages = 0;
+    };
+    WaitPoint firstUseOf(uint32_t resource) const;
+    uint32_t batchEnding(uint32_t resource) const;
+
     // Lookup by name, for tests and tools; nullptr when absent or culled.
     const PlannedPass* findPass(std::string_view name) const;
     uint32_t findResource(std::string_view name) const; // kNoIndex when absent

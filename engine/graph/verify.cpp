@@ -885,6 +885,9 @@ private:
     // Each import must end as its final state says: in its layout, with every
     // use either described by the state (its queue, within its stages and
     // write access) or ordered before it -- and, if it reads, visible to it.
+    // A layout transition is no use a state can describe: it must be ordered
+    // before the state's stages (for Present, the semaphore signal's: the
+    // presentation engine must find the image in PRESENT_SRC).
     void checkFinalStates(Queue queue, uint32_t f, bool hasBatch) {
         const auto q = static_cast<uint32_t>(queue);
         for (uint32_t r = 0; r < d_.resources.size(); ++r) {
@@ -911,6 +914,13 @@ private:
                 }
                 if (!cell.hasWrite) continue;
                 const Event& w = cell.write;
+                if (w.barrier != kNoIndex) {
+                    if (!within(stages, w.chain[q]))
+                        fail(Kind::FinalState, f,
+                             "the layout transition of " + cellName(r, c) + " by barrier " + barrierWhere(w.barrier) +
+                                 " is not ordered before its final state");
+                    continue;
+                }
                 const bool described = w.queue == q && within(w.stages, stages) && within(w.access, access);
                 if (described) continue;
                 const bool ordered = within(stages, w.chain[q]);

@@ -93,20 +93,24 @@ ImGuiLayer::~ImGuiLayer() {
     ImGui::DestroyContext();
 }
 
-void ImGuiLayer::setTarget(const gpu::Image& target) {
-    framebuffer_.reset();
-    const VkImageView view = target.view();
-    VkFramebufferCreateInfo info{VK_STRUCTURE_TYPE_FRAMEBUFFER_CREATE_INFO};
-    info.renderPass = renderPass_.get();
-    info.attachmentCount = 1;
-    info.pAttachments = &view;
-    info.width = target.desc().width;
-    info.height = target.desc().height;
-    info.layers = 1;
-    VkFramebuffer framebuffer = VK_NULL_HANDLE;
-    gpu::check(vkCreateFramebuffer(ctx_.device(), &info, nullptr, &framebuffer), "vkCreateFramebuffer (ImGui)");
-    framebuffer_ = gpu::Unique<VkFramebuffer>(ctx_.device(), framebuffer, vkDestroyFramebuffer);
-    extent_ = {info.width, info.height};
+void ImGuiLayer::setTargets(std::span<const gpu::Image* const> targets) {
+    framebuffers_.clear();
+    extent_ = {};
+    for (const gpu::Image* target : targets) {
+        const VkImageView view = target->view();
+        VkFramebufferCreateInfo info{VK_STRUCTURE_TYPE_FRAMEBUFFER_CREATE_INFO};
+        info.renderPass = renderPass_.get();
+        info.attachmentCount = 1;
+        info.pAttachments = &view;
+        info.width = target->desc().width;
+        info.height = target->desc().height;
+        info.layers = 1;
+        VkFramebuffer framebuffer = VK_NULL_HANDLE;
+        gpu::check(vkCreateFramebuffer(ctx_.device(), &info, nullptr, &framebuffer), "vkCreateFramebuffer (ImGui)");
+        framebuffers_.emplace_back(view, gpu::Unique<VkFramebuffer>(ctx_.device(), framebuffer, vkDestroyFramebuffer));
+        // All targets share one size (the swapchain's).
+        extent_ = {info.width, info.height};
+    }
 }
 
 void ImGuiLayer::setMinImageCount(uint32_t count) { ImGui_ImplVulkan_SetMinImageCount(std::max(count, 2u)); }
@@ -127,10 +131,17 @@ void ImGuiLayer::begin() {
 
 void ImGuiLayer::end() { ImGui::Render(); }
 
-void ImGuiLayer::record(VkCommandBuffer cmd) const {
+void ImGuiLayer::record(VkCommandBuffer cmd, const gpu::Image& target) const {
+    VkFramebuffer framebuffer = VK_NULL_HANDLE;
+    for (const auto& [view, fb] : framebuffers_) {
+        if (view == target.view()) framebuffer = fb.get();
+    }
+    if (framebuffer == VK_NULL_HANDLE) {
+        throw gpu::GpuError("ImGui: '" + target.desc().name + "' is not one of the UI's targets (setTargets)");
+    }
     VkRenderPassBeginInfo begin{VK_STRUCTURE_TYPE_RENDER_PASS_BEGIN_INFO};
     begin.renderPass = renderPass_.get();
-    begin.framebuffer = framebuffer_.get();
+    begin.framebuffer = framebuffer;
     begin.renderArea = {{0, 0}, extent_};
     vkCmdBeginRenderPass(cmd, &begin, VK_SUBPASS_CONTENTS_INLINE);
     ImGui_ImplVulkan_RenderDrawData(ImGui::GetDrawData(), cmd);

@@ -13,6 +13,10 @@
 
 #include <vulkan/vulkan.h>
 
+#include <span>
+#include <utility>
+#include <vector>
+
 struct GLFWwindow;
 
 namespace glint::viewer {
@@ -29,22 +33,23 @@ public:
     ImGuiLayer(const ImGuiLayer&) = delete;
     ImGuiLayer& operator=(const ImGuiLayer&) = delete;
 
-    // Draws into `target` from now on (a new framebuffer); device idle.
-    void setTarget(const gpu::Image& target);
+    // The images it may draw into (one framebuffer each: the swapchain's
+    // images, or the viewer's compose image); device idle.
+    void setTargets(std::span<const gpu::Image* const> targets);
     // After a swapchain change; device idle.
     void setMinImageCount(uint32_t count);
 
     // Starts a UI frame (input from GLFW); build windows after it, then end().
     void begin();
     void end();
-    // Records the last ended frame's draw lists into the target.
-    void record(VkCommandBuffer cmd) const;
+    // Records the last ended frame's draw lists into `target`, one of the targets.
+    void record(VkCommandBuffer cmd, const gpu::Image& target) const;
 
 private:
     gpu::Context& ctx_;
     gpu::Unique<VkDescriptorPool> pool_;
     gpu::Unique<VkRenderPass> renderPass_;
-    gpu::Unique<VkFramebuffer> framebuffer_;
+    std::vector<std::pair<VkImageView, gpu::Unique<VkFramebuffer>>> framebuffers_;
     VkExtent2D extent_{};
     bool glfwReady_ = false;
     bool vulkanReady_ = false;

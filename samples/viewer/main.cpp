@@ -3,25 +3,20 @@
 // glint-render and the benchmark use.
 //
 // One frame:
-//   1. the render graph: the reflection frame, then "viewer.blit" copies its
-//      output into the viewer's target image and "viewer.imgui" draws the
-//      panel over it; executor.run() submits it.
-//   2. our own small submission copies the target into the acquired
-//      swapchain image, waiting for the acquire semaphore and signalling the
-//      present semaphore, then vkQueuePresentKHR.
-//
-// Why the second step, rather than importing the swapchain image into the
-// graph: the executor submits its batches with its own timeline semaphores
-// only (graph/executor.h), so it cannot wait for an acquire semaphore or
-// signal a present one, and gpu::Image cannot wrap an image it did not
-// create. The target is an ordinary image the graph imports (entering and
-// leaving in TransferSrc, the state our copy reads it in); the copy is
-// later in submission order on the same graphics queue, so the graph's
-// final barrier covers it, and the next frame's first barrier orders its
-// blit after our copy. The cost is one full-screen copy.
+//   1. acquire a swapchain image (its semaphore per frame slot);
+//   2. the render graph: the reflection frame, then "viewer.blit" copies its
+//      output into the acquired image and "viewer.imgui" draws the panel
+//      over it (present_passes.h). The image is imported through a
+//      non-owning gpu::Image; the executor makes the batch of its first use
+//      wait on the acquire semaphore, ends it in PRESENT_SRC and signals
+//      the image's render-finished semaphore from the batch that does;
+//   3. vkQueuePresentKHR waits on that semaphore.
+// A slot is reused once the executor says its frame is done
+// (rg::SubmittedFrame): its acquire semaphore and count readback are free.
 //
 // Colour: the output's bytes are sRGB-encoded; they travel unchanged
-// (UNORM to UNORM blit, raw copy), see swapchain.h.
+// (UNORM to UNORM blit, or a raw copy into an SRGB-only swapchain), see
+// swapchain.h.
 
 #include "common/app.h"
 #include "common/reflection_run.h"
@@ -57,12 +52,6 @@ using namespace glint;
 namespace {
 
 constexpr uint32_t kFramesInFlight = 2;
-// The stage our copy waits for the acquired image at; its first barrier
-// starts from the same stage, so the layout transition follows the wait.
-constexpr VkPipelineStageFlags2 kAcquireWaitStage = VK_PIPELINE_STAGE_2_ALL_TRANSFER_BIT;
-// The stage the present semaphore is signalled after; the last barrier on
-// the swapchain image ends at it.
-constexpr VkPipelineStageFlags2 kPresentSignalStage = VK_PIPELINE_STAGE_2_ALL_COMMANDS_BIT;
 
 // ---- GLFW: the library and one window
 
@@ -149,14 +138,12 @@ struct RayCounts {
     bool valid = false;
 };
 
-// Per frame in flight: what our own submission and the count readback use.
+// Per frame in flight: the acquire semaphore and the count readback.
 struct FrameSlot {
-    gpu::CommandPool pool;
     gpu::Unique<VkSemaphore> acquired;
-    // Signalled by our copy's submission: every earlier graphics-queue
-    // command (this frame's graph batches included) is complete, and the
-    // acquire wait is done, so the semaphore may be used again.
-    gpu::Unique<VkFence> done;
+    // The frame that used the slot last, until the slot is reused; none
+    // after the executor was replaced (the device was idle then).
+    std::optional<rg::SubmittedFrame> submitted;
     gpu::Buffer counts;
     bool countsPending = false;
 };
@@ -177,25 +164,19 @@ public:
         executor_ = std::make_unique<rg::Executor>(ctx_, kFramesInFlight);
         for (uint32_t i = 0; i < kFramesInFlight; ++i) {
             auto slot = std::make_unique<FrameSlot>();
-            slot->pool = gpu::CommandPool(ctx_, ctx_.graphicsQueue().family, "viewer.frame" + std::to_string(i));
             VkSemaphoreCreateInfo semaphoreInfo{VK_STRUCTURE_TYPE_SEMAPHORE_CREATE_INFO};
             VkSemaphore semaphore = VK_NULL_HANDLE;
             gpu::check(vkCreateSemaphore(ctx_.device(), &semaphoreInfo, nullptr, &semaphore), "vkCreateSemaphore");
             slot->acquired = gpu::Unique<VkSemaphore>(ctx_.device(), semaphore, vkDestroySemaphore);
-            VkFenceCreateInfo fenceInfo{VK_STRUCTURE_TYPE_FENCE_CREATE_INFO};
-            fenceInfo.flags = VK_FENCE_CREATE_SIGNALED_BIT;
-            VkFence fence = VK_NULL_HANDLE;
-            gpu::check(vkCreateFence(ctx_.device(), &fenceInfo, nullptr, &fence), "vkCreateFence");
-            slot->done = gpu::Unique<VkFence>(ctx_.device(), fence, vkDestroyFence);
+            ctx_.setName(semaphore, VK_OBJECT_TYPE_SEMAPHORE, "viewer.acquired" + std::to_string(i));
             slot->counts = gpu::Buffer(ctx_, {shader::kReflectionCountWords * 4u, VK_BUFFER_USAGE_TRANSFER_DST_BIT,
                                               gpu::MemoryUsage::Readback, "viewer.counts" + std::to_string(i)});
             slots_.push_back(std::move(slot));
         }
-        createTarget();
         imgui_ = std::make_unique<viewer::ImGuiLayer>(ctx_, window_.handle(), swapchain_.copyFormat(),
                                                       swapchain_.minImageCount(),
                                                       std::max(swapchain_.imageCount(), kFramesInFlight));
-        imgui_->setTarget(*target_);
+        createUiTargets();
         const scene::CameraPose start = pathPose(sceneTime_);
         fly_ = viewer::FlyCamera::lookingAlong(start);
         // Half the distance to what the path looks at per second: a helmet
@@ -236,20 +217,31 @@ private:
         return pose;
     }
 
-    void createTarget() {
-        const VkExtent2D e = swapchain_.extent();
-        target_.reset();
-        target_ = std::make_unique<gpu::Image>(
-            ctx_, gpu::ImageDesc{e.width, e.height, 1, 1, 1, swapchain_.copyFormat(),
-                                 VK_IMAGE_USAGE_TRANSFER_SRC_BIT | VK_IMAGE_USAGE_TRANSFER_DST_BIT |
-                                     VK_IMAGE_USAGE_COLOR_ATTACHMENT_BIT,
-                                 "viewer.target", false});
-        // Into the state every frame's graph expects it in (TransferSrc).
-        gpu::submitAndWait(ctx_, ctx_.graphicsQueue(), "viewer target layout", [&](VkCommandBuffer cmd) {
-            gpu::imageBarrier(cmd, *target_, VK_IMAGE_LAYOUT_UNDEFINED, VK_IMAGE_LAYOUT_TRANSFER_SRC_OPTIMAL,
-                              VK_PIPELINE_STAGE_2_NONE, 0, VK_PIPELINE_STAGE_2_ALL_TRANSFER_BIT,
-                              VK_ACCESS_2_TRANSFER_READ_BIT);
-        });
+    bool composeFirst() const { return swapchain_.copyFormat() != swapchain_.format(); }
+
+    // What the UI draws into: the swapchain's images, or (SRGB-only
+    // swapchains) the compose image the graph copies into them.
+    void createUiTargets() {
+        compose_.reset();
+        std::vector<const gpu::Image*> targets;
+        if (composeFirst()) {
+            const VkExtent2D e = swapchain_.extent();
+            compose_ = std::make_unique<gpu::Image>(
+                ctx_, gpu::ImageDesc{e.width, e.height, 1, 1, 1, swapchain_.copyFormat(),
+                                     VK_IMAGE_USAGE_TRANSFER_SRC_BIT | VK_IMAGE_USAGE_TRANSFER_DST_BIT |
+                                         VK_IMAGE_USAGE_COLOR_ATTACHMENT_BIT,
+                                     "viewer.compose", false});
+            // Into the state every frame's graph expects it in (TransferSrc).
+            gpu::submitAndWait(ctx_, ctx_.graphicsQueue(), "viewer compose layout", [&](VkCommandBuffer cmd) {
+                gpu::imageBarrier(cmd, *compose_, VK_IMAGE_LAYOUT_UNDEFINED, VK_IMAGE_LAYOUT_TRANSFER_SRC_OPTIMAL,
+                                  VK_PIPELINE_STAGE_2_NONE, 0, VK_PIPELINE_STAGE_2_ALL_TRANSFER_BIT,
+                                  VK_ACCESS_2_TRANSFER_READ_BIT);
+            });
+            targets.push_back(compose_.get());
+        } else {
+            for (uint32_t i = 0; i < swapchain_.imageCount(); ++i) targets.push_back(&swapchain_.wrapped(i));
+        }
+        imgui_->setTargets(targets);
     }
 
     // Device idle: read every readback still pending.
@@ -270,10 +262,10 @@ private:
     void recreateSwapchain(VkExtent2D size) {
         ctx_.waitIdle();
         readPendingCounts();
+        imgui_->setTargets({});  // their framebuffers go before the images' views
         swapchain_.recreate(size);
         sizedFor_ = size;
-        createTarget();
-        imgui_->setTarget(*target_);
+        createUiTargets();
         imgui_->setMinImageCount(swapchain_.minImageCount());
         // The executor keeps history images at the size it first made them;
         // a new one makes them at the new size (transients follow anyway).
@@ -291,6 +283,7 @@ private:
         readPendingCounts();
         executor_.reset();
         executor_ = std::make_unique<rg::Executor>(ctx_, kFramesInFlight);
+        for (auto& slot : slots_) slot->submitted.reset();  // the old executor's frames, all done
         resetHistory_ = true;
     }
 
@@ -504,12 +497,12 @@ private:
         const float dt = float(std::min(now - lastTime_, 0.1));  // a stall is not a teleport
         lastTime_ = now;
 
-        // The slot's previous frame (kFramesInFlight ago) is complete.
+        // The slot's previous frame (kFramesInFlight ago) is complete: its
+        // acquire wait is done (the semaphore is free) and its counts written.
         FrameSlot& slot = *slots_[frameIndex_ % slots_.size()];
-        const VkFence fence = slot.done.get();
-        gpu::check(vkWaitForFences(ctx_.device(), 1, &fence, VK_TRUE, 10'000'000'000ull), "vkWaitForFences (viewer)");
+        if (slot.submitted) executor_->wait(*slot.submitted);
+        slot.submitted.reset();
         readCounts(slot);
-        slot.pool.reset();
         if (const auto t = executor_->timings(); !t.empty()) timings_ = t;
 
         imgui_->begin();
@@ -530,6 +523,16 @@ private:
         }
         scene::advanceScene(scene_, sceneTime_, &camera_);
 
+        // ---- the image to draw into
+        const std::optional<uint32_t> image = swapchain_.acquire(slot.acquired.get());
+        if (!image) {
+            // Out of date: nothing was acquired or submitted; a new
+            // swapchain next frame.
+            needsRecreate_ = true;
+            ++frameIndex_;
+            return;
+        }
+
         // ---- the graph
         const std::string planShape = std::string(passes::modeName(options_.frame.mode)) + "/" +
                                       options_.frame.debugView + (countRays_ ? "/counted" : "");
@@ -549,15 +552,20 @@ private:
         viewer::ViewerPassesInputs viewerInputs;
         viewerInputs.output = reflections.output.color;
         viewerInputs.extent = extent;
-        viewerInputs.targetFormat = swapchain_.copyFormat();
+        viewerInputs.swapchainFormat = swapchain_.format();
+        viewerInputs.composeFormat = swapchain_.copyFormat();
         viewerInputs.drawUi = [layer = imgui_.get()](rg::PassContext& pc, rg::Texture uiTarget) {
             if (pc.layout(uiTarget) != viewer::kUiTargetLayout) {
                 throw gpu::GpuError("viewer.imgui: the graph gives the target a layout the UI render pass was "
                                     "not made for");
             }
-            layer->record(pc.cmd());
+            layer->record(pc.cmd(), pc.image(uiTarget));
         };
-        resources.bind(viewer::addViewerPasses(graph, viewerInputs), *target_);
+        const viewer::ViewerPasses viewerPasses = viewer::addViewerPasses(graph, viewerInputs);
+        resources.bind(viewerPasses.swapchain, swapchain_.wrapped(*image));
+        resources.waitSemaphore(viewerPasses.swapchain, slot.acquired.get());
+        resources.signalSemaphore(viewerPasses.swapchain, swapchain_.presentReady(*image));
+        if (viewerPasses.compose.valid()) resources.bind(viewerPasses.compose, *compose_);
         if (settings.countRays) {
             resources.bind(viewer::addCountsReadback(graph, reflections.counts, slot.counts.size()), slot.counts);
         }
@@ -567,91 +575,12 @@ private:
             const rg::VerifyReport report = rg::verify(plan);
             if (!report.ok()) throw std::runtime_error("render graph plan: " + report.text());
         }
-        executor_->run(plan, resources);
+        slot.submitted = executor_->run(plan, resources);
         slot.countsPending = settings.countRays;
 
-        // ---- present: acquire after submitting, so the GPU is busy while we may wait
-        const std::optional<uint32_t> image = swapchain_.acquire(slot.acquired.get());
-        if (!image) {
-            // Nothing waits for this frame's fence: wait for the device instead.
-            ctx_.waitIdle();
-            readPendingCounts();
-            needsRecreate_ = true;
-            ++frameIndex_;
-            return;
-        }
-        submitCopy(slot, *image);
+        // ---- present: waits on the semaphore the graph's last batch on the image signalled
         if (!swapchain_.present(*image)) needsRecreate_ = true;
         ++frameIndex_;
-    }
-
-    // Copies the target into swapchain image `index`: waits for the acquire,
-    // signals the present semaphore and the slot's fence.
-    void submitCopy(FrameSlot& slot, uint32_t index) {
-        const VkImage swapImage = swapchain_.image(index);
-        const VkExtent2D extent = swapchain_.extent();
-        VkCommandBuffer cmd = slot.pool.allocate();
-        VkCommandBufferBeginInfo begin{VK_STRUCTURE_TYPE_COMMAND_BUFFER_BEGIN_INFO};
-        begin.flags = VK_COMMAND_BUFFER_USAGE_ONE_TIME_SUBMIT_BIT;
-        gpu::check(vkBeginCommandBuffer(cmd, &begin), "vkBeginCommandBuffer (viewer present copy)");
-
-        VkImageMemoryBarrier2 toCopy{VK_STRUCTURE_TYPE_IMAGE_MEMORY_BARRIER_2};
-        toCopy.srcStageMask = kAcquireWaitStage;  // chained to the acquire semaphore's wait
-        toCopy.srcAccessMask = 0;
-        toCopy.dstStageMask = VK_PIPELINE_STAGE_2_ALL_TRANSFER_BIT;
-        toCopy.dstAccessMask = VK_ACCESS_2_TRANSFER_WRITE_BIT;
-        toCopy.oldLayout = VK_IMAGE_LAYOUT_UNDEFINED;  // the whole image is overwritten
-        toCopy.newLayout = VK_IMAGE_LAYOUT_TRANSFER_DST_OPTIMAL;
-        toCopy.srcQueueFamilyIndex = toCopy.dstQueueFamilyIndex = VK_QUEUE_FAMILY_IGNORED;
-        toCopy.image = swapImage;
-        toCopy.subresourceRange = {VK_IMAGE_ASPECT_COLOR_BIT, 0, 1, 0, 1};
-        VkDependencyInfo dep{VK_STRUCTURE_TYPE_DEPENDENCY_INFO};
-        dep.imageMemoryBarrierCount = 1;
-        dep.pImageMemoryBarriers = &toCopy;
-        vkCmdPipelineBarrier2(cmd, &dep);
-
-        // The target and the swapchain image share the UNORM bytes' texel
-        // size; a raw copy keeps the sRGB-encoded values as they are.
-        VkImageCopy region{};
-        region.srcSubresource = {VK_IMAGE_ASPECT_COLOR_BIT, 0, 0, 1};
-        region.dstSubresource = region.srcSubresource;
-        region.extent = {extent.width, extent.height, 1};
-        vkCmdCopyImage(cmd, target_->handle(), VK_IMAGE_LAYOUT_TRANSFER_SRC_OPTIMAL, swapImage,
-                       VK_IMAGE_LAYOUT_TRANSFER_DST_OPTIMAL, 1, &region);
-
-        VkImageMemoryBarrier2 toPresent = toCopy;
-        toPresent.srcStageMask = VK_PIPELINE_STAGE_2_ALL_TRANSFER_BIT;
-        toPresent.srcAccessMask = VK_ACCESS_2_TRANSFER_WRITE_BIT;
-        // Chained to the present semaphore's signal by the same stage, so
-        // the presentation engine sees the transition done (a NONE stage
-        // here leaves it outside the signal: a present-after-write hazard).
-        toPresent.dstStageMask = kPresentSignalStage;
-        toPresent.dstAccessMask = 0;
-        toPresent.oldLayout = VK_IMAGE_LAYOUT_TRANSFER_DST_OPTIMAL;
-        toPresent.newLayout = VK_IMAGE_LAYOUT_PRESENT_SRC_KHR;
-        dep.pImageMemoryBarriers = &toPresent;
-        vkCmdPipelineBarrier2(cmd, &dep);
-        gpu::check(vkEndCommandBuffer(cmd), "vkEndCommandBuffer (viewer present copy)");
-
-        VkSemaphoreSubmitInfo wait{VK_STRUCTURE_TYPE_SEMAPHORE_SUBMIT_INFO};
-        wait.semaphore = slot.acquired.get();
-        wait.stageMask = kAcquireWaitStage;
-        VkSemaphoreSubmitInfo signal{VK_STRUCTURE_TYPE_SEMAPHORE_SUBMIT_INFO};
-        signal.semaphore = swapchain_.presentReady(index);
-        signal.stageMask = kPresentSignalStage;
-        VkCommandBufferSubmitInfo cmdInfo{VK_STRUCTURE_TYPE_COMMAND_BUFFER_SUBMIT_INFO};
-        cmdInfo.commandBuffer = cmd;
-        VkSubmitInfo2 submit{VK_STRUCTURE_TYPE_SUBMIT_INFO_2};
-        submit.waitSemaphoreInfoCount = 1;
-        submit.pWaitSemaphoreInfos = &wait;
-        submit.commandBufferInfoCount = 1;
-        submit.pCommandBufferInfos = &cmdInfo;
-        submit.signalSemaphoreInfoCount = 1;
-        submit.pSignalSemaphoreInfos = &signal;
-        const VkFence fence = slot.done.get();
-        gpu::check(vkResetFences(ctx_.device(), 1, &fence), "vkResetFences (viewer)");
-        gpu::check(vkQueueSubmit2(ctx_.graphicsQueue().queue, 1, &submit, fence),
-                   "vkQueueSubmit2 (viewer present copy)");
     }
 
     gpu::Context& ctx_;
@@ -662,7 +591,7 @@ private:
     passes::ReflectionRendererOptions builtWith_;  // what renderer_ was built with
     viewer::Swapchain swapchain_;
     VkExtent2D sizedFor_;  // the window size the swapchain was made for
-    std::unique_ptr<gpu::Image> target_;
+    std::unique_ptr<gpu::Image> compose_;  // SRGB-only swapchains: the UNORM image the frame is composed in
     std::vector<std::unique_ptr<FrameSlot>> slots_;
     std::unique_ptr<passes::ReflectionRenderer> renderer_;
     std::unique_ptr<rg::Executor> executor_;

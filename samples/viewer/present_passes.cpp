@@ -13,11 +13,25 @@ constexpr rg::BoundaryState kHostRead =
 
 } // namespace
 
-rg::Texture addViewerPasses(rg::Graph& graph, const ViewerPassesInputs& in) {
-    const rg::BoundaryState copied = rg::BoundaryState::of(rg::Access::TransferSrc);
-    const rg::Texture imported = graph.importTexture(
-        "viewer.target",
-        {{.width = in.extent.width, .height = in.extent.height, .format = in.targetFormat}, copied, copied});
+ViewerPasses addViewerPasses(rg::Graph& graph, const ViewerPassesInputs& in) {
+    ViewerPasses out;
+    const rg::TextureDesc size{.width = in.extent.width, .height = in.extent.height};
+    rg::TextureDesc swapchainDesc = size;
+    swapchainDesc.format = in.swapchainFormat;
+    out.swapchain = graph.importTexture("viewer.swapchain",
+                                        {swapchainDesc, rg::BoundaryState::acquired(kAcquireWaitStages),
+                                         rg::BoundaryState::of(rg::Access::Present)});
+    const bool composeFirst = in.composeFormat != in.swapchainFormat;
+    rg::Texture target = out.swapchain;
+    if (composeFirst) {
+        // The viewer's own image, from frame to frame: it ends each frame
+        // read by the copy, and the next frame's blit waits for that read.
+        rg::TextureDesc composeDesc = size;
+        composeDesc.format = in.composeFormat;
+        const rg::BoundaryState copied = rg::BoundaryState::of(rg::Access::TransferSrc);
+        out.compose = graph.importTexture("viewer.compose", {composeDesc, copied, copied});
+        target = out.compose;
+    }
 
     struct BlitData {
         rg::Texture source, target;
@@ -27,7 +41,7 @@ rg::Texture addViewerPasses(rg::Graph& graph, const ViewerPassesInputs& in) {
         "viewer.blit", rg::Queue::Graphics,
         [&](rg::Builder& b, BlitData& d) {
             d.source = b.read(in.output, rg::Access::TransferSrc);
-            d.target = b.write(imported, rg::Access::TransferDst);
+            d.target = b.write(target, rg::Access::TransferDst);
         },
         [extent](const BlitData& d, rg::PassContext& pc) {
             // Same size, UNORM to UNORM: every byte arrives unchanged, only
@@ -44,7 +58,7 @@ rg::Texture addViewerPasses(rg::Graph& graph, const ViewerPassesInputs& in) {
     struct UiData {
         rg::Texture target;
     };
-    graph.addPass<UiData>(
+    const UiData& ui = graph.addPass<UiData>(
         "viewer.imgui", rg::Queue::Graphics,
         [&](rg::Builder& b, UiData& d) {
             b.setPipeline(rg::Pipeline::Raster);
@@ -53,7 +67,28 @@ rg::Texture addViewerPasses(rg::Graph& graph, const ViewerPassesInputs& in) {
         [drawUi = in.drawUi](const UiData& d, rg::PassContext& pc) {
             if (drawUi) drawUi(pc, d.target);
         });
-    return imported;
+
+    if (composeFirst) {
+        struct CopyData {
+            rg::Texture source, target;
+        };
+        graph.addPass<CopyData>(
+            "viewer.present_copy", rg::Queue::Graphics,
+            [&](rg::Builder& b, CopyData& d) {
+                d.source = b.read(ui.target, rg::Access::TransferSrc);
+                d.target = b.write(out.swapchain, rg::Access::TransferDst);
+            },
+            [extent](const CopyData& d, rg::PassContext& pc) {
+                // UNORM into SRGB of the same texel size: a copy moves bytes, never converts.
+                VkImageCopy region{};
+                region.srcSubresource = {VK_IMAGE_ASPECT_COLOR_BIT, 0, 0, 1};
+                region.dstSubresource = region.srcSubresource;
+                region.extent = {extent.width, extent.height, 1};
+                vkCmdCopyImage(pc.cmd(), pc.image(d.source).handle(), pc.layout(d.source),
+                               pc.image(d.target).handle(), pc.layout(d.target), 1, &region);
+            });
+    }
+    return out;
 }
 
 rg::Buffer addCountsReadback(rg::Graph& graph, rg::Buffer counts, uint64_t bytes) {

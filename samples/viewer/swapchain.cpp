@@ -22,6 +22,8 @@ VkFormat unormOf(VkFormat format) {
     }
 }
 
+constexpr VkImageUsageFlags kImageUsage = VK_IMAGE_USAGE_TRANSFER_DST_BIT | VK_IMAGE_USAGE_COLOR_ATTACHMENT_BIT;
+
 } // namespace
 
 Swapchain::Swapchain(gpu::Context& ctx, VkSurfaceKHR surface, VkExtent2D wanted) : ctx_(ctx), surface_(surface) {
@@ -68,9 +70,11 @@ void Swapchain::create(VkExtent2D wanted) {
     VkSurfaceCapabilitiesKHR caps;
     gpu::check(vkGetPhysicalDeviceSurfaceCapabilitiesKHR(ctx_.physicalDevice(), surface_, &caps),
                "vkGetPhysicalDeviceSurfaceCapabilitiesKHR");
+    // Colour attachment use is always supported; the blit (or the compose
+    // copy) writes them as a transfer destination.
     if (!(caps.supportedUsageFlags & VK_IMAGE_USAGE_TRANSFER_DST_BIT)) {
         throw gpu::GpuError(
-            "the window's swapchain images cannot be transfer destinations (the viewer copies into them)");
+            "the window's swapchain images cannot be transfer destinations (the viewer blits into them)");
     }
     // The surface's size where it has one; otherwise ours, within its limits.
     if (caps.currentExtent.width != std::numeric_limits<uint32_t>::max()) {
@@ -101,7 +105,7 @@ void Swapchain::create(VkExtent2D wanted) {
     info.imageColorSpace = colorSpace_;
     info.imageExtent = extent_;
     info.imageArrayLayers = 1;
-    info.imageUsage = VK_IMAGE_USAGE_TRANSFER_DST_BIT;
+    info.imageUsage = kImageUsage;
     info.imageSharingMode = VK_SHARING_MODE_EXCLUSIVE;
     info.preTransform = caps.currentTransform;
     info.compositeAlpha = alpha;
@@ -111,7 +115,9 @@ void Swapchain::create(VkExtent2D wanted) {
     info.oldSwapchain = swapchain_.get();
     VkSwapchainKHR swapchain = VK_NULL_HANDLE;
     gpu::check(vkCreateSwapchainKHR(ctx_.device(), &info, nullptr, &swapchain), "vkCreateSwapchainKHR");
-    // Replacing the old one destroys it (the device is idle).
+    // Replacing the old one destroys it (the device is idle); its images'
+    // wrappers (their views) go first.
+    wrapped_.clear();
     swapchain_ = gpu::Unique<VkSwapchainKHR>(ctx_.device(), swapchain, vkDestroySwapchainKHR);
 
     uint32_t count = 0;
@@ -121,6 +127,10 @@ void Swapchain::create(VkExtent2D wanted) {
 
     presentReady_.clear();
     for (uint32_t i = 0; i < count; ++i) {
+        wrapped_.push_back(gpu::Image::external(
+            ctx_, images_[i],
+            gpu::ImageDesc{extent_.width, extent_.height, 1, 1, 1, format_, kImageUsage,
+                           "viewer.swapchain" + std::to_string(i), false}));
         VkSemaphoreCreateInfo semaphoreInfo{VK_STRUCTURE_TYPE_SEMAPHORE_CREATE_INFO};
         VkSemaphore semaphore = VK_NULL_HANDLE;
         gpu::check(vkCreateSemaphore(ctx_.device(), &semaphoreInfo, nullptr, &semaphore), "vkCreateSemaphore");

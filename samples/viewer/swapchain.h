@@ -3,15 +3,21 @@
 //
 // Colour: the reflection frame's output holds sRGB-encoded bytes in an
 // RGBA8_UNORM image. The swapchain is asked for an 8-bit BGRA/RGBA format in
-// the sRGB colour space; the viewer writes those bytes unchanged (a UNORM
-// blit and a raw copy, never a conversion), so whether the swapchain's
-// format is the UNORM or the SRGB variant, the presentation engine gets the
-// encoded values once: no double encoding. copyFormat() is the UNORM
-// variant, for the image the viewer composes into (ImGui's colours are
-// sRGB-encoded too, so it blends them in that space, as ImGui expects).
+// the sRGB colour space, UNORM first; the viewer writes those bytes
+// unchanged (a UNORM blit, or a raw copy into an SRGB image, never a
+// conversion), so the presentation engine gets the encoded values once: no
+// double encoding. copyFormat() is the UNORM variant, the format the viewer
+// composes in (ImGui's colours are sRGB-encoded too, so it blends them in
+// that space, as ImGui expects); when it equals format(), the viewer draws
+// straight into the swapchain images (present_passes.h).
+//
+// The images are handed to the render graph through non-owning gpu::Image
+// wrappers (made with each swapchain, with a view each for the UI's
+// framebuffers).
 
 #include "gpu/context.h"
 #include "gpu/handle.h"
+#include "gpu/resources.h"
 
 #include <vulkan/vulkan.h>
 
@@ -39,6 +45,8 @@ public:
     uint32_t imageCount() const { return uint32_t(images_.size()); }
     uint32_t minImageCount() const { return minImageCount_; }
     VkImage image(uint32_t index) const { return images_.at(index); }
+    // Image `index` as a gpu::Image that does not own it, for FrameResources::bind.
+    const gpu::Image& wrapped(uint32_t index) const { return wrapped_.at(index); }
     // Signalled by the submission that finishes image `index`, waited by its
     // present. One per image: a semaphore handed to a present may be reused
     // only once that image is acquired again.
@@ -63,6 +71,7 @@ private:
     uint32_t minImageCount_ = 2;
     gpu::Unique<VkSwapchainKHR> swapchain_;
     std::vector<VkImage> images_;
+    std::vector<gpu::Image> wrapped_;
     std::vector<gpu::Unique<VkSemaphore>> presentReady_;
 };
 

@@ -16,6 +16,7 @@
 #include <set>
 #include <stdexcept>
 #include <string>
+#include <vector>
 
 using namespace glint;
 
@@ -132,63 +133,101 @@ TEST_CASE("the fly camera keeps the direction it starts from and moves along its
     CHECK(std::isfinite(glm::length(c.pose().target)));
 }
 
-TEST_CASE("the viewer's passes leave its target in TransferSrc for the present copy and verify clean") {
-    for (const bool countRays : {false, true}) {
-        rg::Graph graph(rg::synthetic::twoQueueCaps());
-        const VkExtent2D extent{96, 64};
-        struct Frame {
-            rg::Texture color;
-            rg::Buffer counts;
-        };
-        // Stands in for the reflection frame: a compute pass writing the
-        // RGBA8 output (and the counts).
-        const Frame& frame = graph.addPass<Frame>(
-            "composite", rg::Queue::Graphics,
-            [&](rg::Builder& b, Frame& d) {
-                d.color = b.write(b.createTexture("composite.color", {.width = extent.width, .height = extent.height,
-                                                                     .format = VK_FORMAT_R8G8B8A8_UNORM}),
-                                  rg::Access::StorageWrite);
-                d.counts = b.write(b.createBuffer("stats.counts", {28}), rg::Access::StorageWrite);
-            },
-            [](const Frame&, rg::PassContext&) {});
-        graph.markOutput(frame.color);
-        viewer::ViewerPassesInputs in;
-        in.output = frame.color;
-        in.extent = extent;
-        viewer::addViewerPasses(graph, in);
-        if (countRays) viewer::addCountsReadback(graph, frame.counts, 28);
+namespace {
 
-        const rg::Plan plan = graph.compile();
-        const rg::VerifyReport report = rg::verify(plan);
-        INFO(plan.toText());
-        INFO(report.text());
-        CHECK(report.ok());
-        CHECK(plan.findPass("viewer.blit") != nullptr);
-        CHECK(plan.findPass("viewer.imgui") != nullptr);
-        CHECK((plan.findPass("viewer.read_counts") != nullptr) == countRays);
+// The barriers after the frame's batches on `resource`.
+std::vector<rg::Barrier> endBarriersOn(const rg::Plan& plan, uint32_t resource) {
+    std::vector<rg::Barrier> out;
+    for (const rg::Batch& batch : plan.batches)
+        for (const rg::Barrier& b : plan.barriersAfter(batch))
+            if (b.resource == resource) out.push_back(b);
+    return out;
+}
 
-        // The UI pass sees the layout the UI render pass was made for.
-        CHECK(rg::accessScope(rg::Access::ColorAttachment, rg::ResourceKind::Texture, rg::Pipeline::Raster).layout ==
-              viewer::kUiTargetLayout);
-        // Leaves the target in TRANSFER_SRC_OPTIMAL, readable by transfers.
-        const uint32_t target = plan.findResource("viewer.target");
-        REQUIRE(target != rg::kNoIndex);
-        bool leftForCopy = false;
-        for (const rg::Batch& batch : plan.batches) {
-            for (const rg::Barrier& b : plan.barriersAfter(batch)) {
-                if (b.resource != target) continue;
-                leftForCopy = b.newLayout == VK_IMAGE_LAYOUT_TRANSFER_SRC_OPTIMAL &&
-                              (b.dstAccess & VK_ACCESS_2_TRANSFER_READ_BIT) &&
-                              (b.dstStages & VK_PIPELINE_STAGE_2_ALL_TRANSFER_BIT);
+} // namespace
+
+TEST_CASE("the viewer's passes draw into the acquired swapchain image, end it in PRESENT_SRC and verify clean") {
+    // UNORM swapchains are drawn into directly; SRGB-only ones get the frame
+    // composed in a UNORM image and copied in.
+    for (const bool composeFirst : {false, true}) {
+        for (const bool countRays : {false, true}) {
+            INFO("compose first " << composeFirst << ", count rays " << countRays);
+            rg::Graph graph(rg::synthetic::twoQueueCaps());
+            const VkExtent2D extent{96, 64};
+            struct Frame {
+                rg::Texture color;
+                rg::Buffer counts;
+            };
+            // Stands in for the reflection frame: a compute pass writing the
+            // RGBA8 output (and the counts).
+            const Frame& frame = graph.addPass<Frame>(
+                "composite", rg::Queue::Graphics,
+                [&](rg::Builder& b, Frame& d) {
+                    d.color = b.write(b.createTexture("composite.color", {.width = extent.width,
+                                                                         .height = extent.height,
+                                                                         .format = VK_FORMAT_R8G8B8A8_UNORM}),
+                                      rg::Access::StorageWrite);
+                    d.counts = b.write(b.createBuffer("stats.counts", {28}), rg::Access::StorageWrite);
+                },
+                [](const Frame&, rg::PassContext&) {});
+            graph.markOutput(frame.color);
+            viewer::ViewerPassesInputs in;
+            in.output = frame.color;
+            in.extent = extent;
+            in.composeFormat = VK_FORMAT_B8G8R8A8_UNORM;
+            in.swapchainFormat = composeFirst ? VK_FORMAT_B8G8R8A8_SRGB : VK_FORMAT_B8G8R8A8_UNORM;
+            const viewer::ViewerPasses passes = viewer::addViewerPasses(graph, in);
+            CHECK(passes.swapchain.valid());
+            CHECK(passes.compose.valid() == composeFirst);
+            if (countRays) viewer::addCountsReadback(graph, frame.counts, 28);
+
+            const rg::Plan plan = graph.compile();
+            const rg::VerifyReport report = rg::verify(plan);
+            INFO(plan.toText());
+            INFO(report.text());
+            CHECK(report.ok());
+            CHECK(plan.findPass("viewer.blit") != nullptr);
+            CHECK(plan.findPass("viewer.imgui") != nullptr);
+            CHECK((plan.findPass("viewer.present_copy") != nullptr) == composeFirst);
+            CHECK((plan.findPass("viewer.read_counts") != nullptr) == countRays);
+
+            // The UI pass sees the layout the UI render pass was made for.
+            CHECK(rg::accessScope(rg::Access::ColorAttachment, rg::ResourceKind::Texture, rg::Pipeline::Raster)
+                      .layout == viewer::kUiTargetLayout);
+
+            // The swapchain image's first barrier starts at the acquire
+            // wait's stages (so its transition follows the wait)...
+            const uint32_t swapchain = plan.findResource("viewer.swapchain");
+            REQUIRE(swapchain != rg::kNoIndex);
+            const rg::PlannedPass* first = plan.findPass(composeFirst ? "viewer.present_copy" : "viewer.blit");
+            REQUIRE(first != nullptr);
+            bool afterAcquire = false;
+            for (const rg::Barrier& b : plan.barriersBefore(*first)) {
+                if (b.resource == swapchain) {
+                    afterAcquire = b.srcStages == viewer::kAcquireWaitStages &&
+                                   b.oldLayout == VK_IMAGE_LAYOUT_UNDEFINED;
+                }
+            }
+            CHECK(afterAcquire);
+            // ... and its last one leaves it in PRESENT_SRC inside the
+            // render-finished signal's scope.
+            const auto last = endBarriersOn(plan, swapchain);
+            REQUIRE(last.size() == 1);
+            CHECK(last[0].newLayout == VK_IMAGE_LAYOUT_PRESENT_SRC_KHR);
+            CHECK((last[0].dstStages & rg::kSemaphoreSignalStages) == rg::kSemaphoreSignalStages);
+
+            if (composeFirst) {
+                // The compose image ends read by the copy, and the next
+                // frame's blit waits for that read.
+                const uint32_t compose = plan.findResource("viewer.compose");
+                REQUIRE(compose != rg::kNoIndex);
+                bool afterCopy = false;
+                for (const rg::Barrier& b : plan.barriersBefore(*plan.findPass("viewer.blit"))) {
+                    if (b.resource == compose) afterCopy = (b.srcStages & VK_PIPELINE_STAGE_2_ALL_TRANSFER_BIT) != 0;
+                }
+                CHECK(afterCopy);
             }
         }
-        CHECK(leftForCopy);
-        // The blit waits for last frame's copy (a transfer read) before writing.
-        bool afterCopy = false;
-        for (const rg::Barrier& b : plan.barriersBefore(*plan.findPass("viewer.blit"))) {
-            if (b.resource == target) afterCopy = (b.srcStages & VK_PIPELINE_STAGE_2_ALL_TRANSFER_BIT) != 0;
-        }
-        CHECK(afterCopy);
     }
 }
 

@@ -328,3 +328,211 @@ TEST_CASE("running a plan whose import has nothing bound names the resource") {
     CHECK_THROWS_WITH_AS(executor.run(plan, {}), doctest::Contains("'unbound-results' has no resource bound"),
                          gpu::GpuError);
 }
+
+namespace {
+
+gpu::Unique<VkSemaphore> binarySemaphore(gpu::Context& ctx, const std::string& name) {
+    VkSemaphoreCreateInfo info{VK_STRUCTURE_TYPE_SEMAPHORE_CREATE_INFO};
+    VkSemaphore semaphore = VK_NULL_HANDLE;
+    gpu::check(vkCreateSemaphore(ctx.device(), &info, nullptr, &semaphore), "vkCreateSemaphore");
+    ctx.setName(semaphore, VK_OBJECT_TYPE_SEMAPHORE, name);
+    return gpu::Unique<VkSemaphore>(ctx.device(), semaphore, vkDestroySemaphore);
+}
+
+gpu::Unique<VkFence> fence(gpu::Context& ctx) {
+    VkFenceCreateInfo info{VK_STRUCTURE_TYPE_FENCE_CREATE_INFO};
+    VkFence f = VK_NULL_HANDLE;
+    gpu::check(vkCreateFence(ctx.device(), &info, nullptr, &f), "vkCreateFence");
+    return gpu::Unique<VkFence>(ctx.device(), f, vkDestroyFence);
+}
+
+// One submission outside the graph: optional command buffer, one binary
+// semaphore waited and one signalled, an optional fence.
+void submitOutside(gpu::Context& ctx, gpu::CommandPool& pool, VkSemaphore wait, VkPipelineStageFlags2 waitStages,
+                   VkSemaphore signal, VkPipelineStageFlags2 signalStages, VkFence done,
+                   const std::function<void(VkCommandBuffer)>& record) {
+    VkCommandBufferSubmitInfo cmdInfo{VK_STRUCTURE_TYPE_COMMAND_BUFFER_SUBMIT_INFO};
+    if (record) {
+        VkCommandBuffer cmd = pool.allocate();
+        VkCommandBufferBeginInfo begin{VK_STRUCTURE_TYPE_COMMAND_BUFFER_BEGIN_INFO};
+        begin.flags = VK_COMMAND_BUFFER_USAGE_ONE_TIME_SUBMIT_BIT;
+        gpu::check(vkBeginCommandBuffer(cmd, &begin), "vkBeginCommandBuffer");
+        record(cmd);
+        gpu::check(vkEndCommandBuffer(cmd), "vkEndCommandBuffer");
+        cmdInfo.commandBuffer = cmd;
+    }
+    VkSemaphoreSubmitInfo waitInfo{VK_STRUCTURE_TYPE_SEMAPHORE_SUBMIT_INFO};
+    waitInfo.semaphore = wait;
+    waitInfo.stageMask = waitStages;
+    VkSemaphoreSubmitInfo signalInfo{VK_STRUCTURE_TYPE_SEMAPHORE_SUBMIT_INFO};
+    signalInfo.semaphore = signal;
+    signalInfo.stageMask = signalStages;
+    VkSubmitInfo2 submit{VK_STRUCTURE_TYPE_SUBMIT_INFO_2};
+    submit.waitSemaphoreInfoCount = wait ? 1 : 0;
+    submit.pWaitSemaphoreInfos = &waitInfo;
+    submit.commandBufferInfoCount = record ? 1 : 0;
+    submit.pCommandBufferInfos = &cmdInfo;
+    submit.signalSemaphoreInfoCount = signal ? 1 : 0;
+    submit.pSignalSemaphoreInfos = &signalInfo;
+    gpu::check(vkQueueSubmit2(ctx.graphicsQueue().queue, 1, &submit, done), "vkQueueSubmit2 (outside the graph)");
+}
+
+} // namespace
+
+TEST_CASE("an external image is waited for on a binary semaphore, ends in PRESENT_SRC and signals another") {
+    // The swapchain's part is played by the test: it owns the image, a
+    // "producer" submission signals `ready` (as vkAcquireNextImageKHR
+    // would), the graph draws into the image through a non-owning wrapper,
+    // and a "consumer" submission waits on `finished` (as
+    // vkQueuePresentKHR would) and reads the image back. Frame 0 imports
+    // the producer's contents (it clears the image to 7 first); later frames
+    // import it as acquired (contents undefined). The validation layer,
+    // synchronisation validation on, judges the semaphore placement, the
+    // stages and the PRESENT_SRC layout; the values prove the order.
+    gpu::ContextOptions options;
+    // VK_IMAGE_LAYOUT_PRESENT_SRC_KHR needs VK_KHR_swapchain (and it VK_KHR_surface); no surface is made.
+    options.swapchain = true;
+    options.instanceExtensions = {VK_KHR_SURFACE_EXTENSION_NAME};
+    test::GpuTest gpu(options);
+    auto& ctx = gpu.ctx();
+    rg::Executor executor(ctx);
+    constexpr uint32_t kFrames = 4;
+    const gpu::ImageDesc desc{kWidth, kWidth, 1, 1, 1, VK_FORMAT_R32_UINT,
+                              VK_IMAGE_USAGE_TRANSFER_SRC_BIT | VK_IMAGE_USAGE_TRANSFER_DST_BIT |
+                                  VK_IMAGE_USAGE_COLOR_ATTACHMENT_BIT,
+                              "external.owner"};
+    const gpu::Image owner(ctx, desc);
+    gpu::CommandPool pool(ctx, ctx.graphicsQueue().family, "external.pool");
+    std::vector<gpu::Image> wrappers;  // kept until the GPU is done with their views
+    // One of each, reused every frame: a binary semaphore signalled twice
+    // without a wait between, or waited with no signal pending, is a
+    // validation error, so a wait or signal the executor dropped fails.
+    const gpu::Unique<VkSemaphore> ready = binarySemaphore(ctx, "external.ready");
+    const gpu::Unique<VkSemaphore> finished = binarySemaphore(ctx, "external.finished");
+    std::vector<gpu::Unique<VkFence>> consumed;
+    std::vector<gpu::Buffer> readbacks;
+    const gpu::Buffer seenByGraph(ctx, {kWidth * kWidth * 4, VK_BUFFER_USAGE_TRANSFER_DST_BIT,
+                                        gpu::MemoryUsage::Readback, "external.seen"});
+
+    for (uint32_t frame = 0; frame < kFrames; ++frame) {
+        consumed.push_back(fence(ctx));
+        readbacks.emplace_back(ctx, gpu::BufferDesc{kWidth * kWidth * 4, VK_BUFFER_USAGE_TRANSFER_DST_BIT,
+                                                    gpu::MemoryUsage::Readback, "external.readback"});
+        const bool keepContents = frame == 0;
+
+        // ---- producer: frame 0 clears to 7 (left in TRANSFER_DST); later
+        // frames only signal, after everything earlier on the queue, as an
+        // acquire does.
+        submitOutside(ctx, pool, VK_NULL_HANDLE, 0, ready.get(),
+                      keepContents ? VK_PIPELINE_STAGE_2_ALL_TRANSFER_BIT : VK_PIPELINE_STAGE_2_ALL_COMMANDS_BIT,
+                      VK_NULL_HANDLE, !keepContents ? std::function<void(VkCommandBuffer)>{} : [&](VkCommandBuffer cmd) {
+                          gpu::imageBarrier(cmd, owner, VK_IMAGE_LAYOUT_UNDEFINED, VK_IMAGE_LAYOUT_TRANSFER_DST_OPTIMAL,
+                                            VK_PIPELINE_STAGE_2_NONE, 0, VK_PIPELINE_STAGE_2_CLEAR_BIT,
+                                            VK_ACCESS_2_TRANSFER_WRITE_BIT);
+                          VkClearColorValue seven{};
+                          seven.uint32[0] = 7;
+                          const VkImageSubresourceRange range{VK_IMAGE_ASPECT_COLOR_BIT, 0, 1, 0, 1};
+                          vkCmdClearColorImage(cmd, owner.handle(), VK_IMAGE_LAYOUT_TRANSFER_DST_OPTIMAL, &seven, 1,
+                                               &range);
+                      });
+
+        // ---- the graph
+        rg::Graph g(executor.queueCaps());
+        rg::FrameResources imports;
+        const rg::BoundaryState initial =
+            keepContents ? rg::BoundaryState::raw(VK_PIPELINE_STAGE_2_ALL_TRANSFER_BIT, VK_ACCESS_2_TRANSFER_WRITE_BIT,
+                                                  VK_IMAGE_LAYOUT_TRANSFER_DST_OPTIMAL)
+                         : rg::BoundaryState::acquired(VK_PIPELINE_STAGE_2_ALL_TRANSFER_BIT);
+        rg::Texture image = g.importTexture(
+            "external", {{kWidth, kWidth, 1, 1, 1, VK_FORMAT_R32_UINT}, initial, rg::BoundaryState::of(rg::Access::Present)});
+        if (keepContents) {
+            // Reads what the producer left (so the wait must come before its
+            // first use, a transfer read), then overwrites it.
+            struct SeenData {
+                rg::Texture image;
+                rg::Buffer seen;
+            };
+            const rg::Buffer seen =
+                g.importBuffer("seen", {{kWidth * kWidth * 4}, rg::BoundaryState::of(rg::Access::None), kHostRead});
+            const SeenData& read = g.addPass<SeenData>(
+                "read-producer", rg::Queue::Graphics,
+                [&](rg::Builder& b, SeenData& d) {
+                    d.image = b.read(image, rg::Access::TransferSrc);
+                    d.seen = b.write(seen, rg::Access::TransferDst);
+                },
+                [](const SeenData& d, rg::PassContext& pc) {
+                    VkBufferImageCopy region{};
+                    region.imageSubresource = {VK_IMAGE_ASPECT_COLOR_BIT, 0, 0, 1};
+                    region.imageExtent = {kWidth, kWidth, 1};
+                    vkCmdCopyImageToBuffer(pc.cmd(), pc.image(d.image).handle(), pc.layout(d.image),
+                                           pc.buffer(d.seen).handle(), 1, &region);
+                });
+            imports.bind(seen, seenByGraph);
+            image = read.image;
+        }
+        {
+            struct ClearData {
+                rg::Texture image;
+            };
+            const uint32_t value = 100 + frame;
+            g.addPass<ClearData>(
+                "clear", rg::Queue::Graphics,
+                [&](rg::Builder& b, ClearData& d) { d.image = b.write(image, rg::Access::TransferDst); },
+                [value](const ClearData& d, rg::PassContext& pc) {
+                    VkClearColorValue clear{};
+                    clear.uint32[0] = value;
+                    const VkImageSubresourceRange range{VK_IMAGE_ASPECT_COLOR_BIT, 0, 1, 0, 1};
+                    vkCmdClearColorImage(pc.cmd(), pc.image(d.image).handle(), pc.layout(d.image), &clear, 1, &range);
+                });
+        }
+        const rg::Plan plan = g.compile(executor.compileOptions());
+        const auto report = rg::verify(plan);
+        REQUIRE_MESSAGE(report.ok(), report.text());
+        // The wait goes to the first use's batch, at its (transfer) stage.
+        const uint32_t external = plan.findResource("external");
+        CHECK(plan.firstUseOf(external).batch == 0);
+        CHECK(plan.firstUseOf(external).stages == VK_PIPELINE_STAGE_2_ALL_TRANSFER_BIT);
+        CHECK(plan.batchEnding(external) == plan.batches.size() - 1);
+
+        wrappers.push_back(gpu::Image::external(ctx, owner.handle(), desc));
+        CHECK(wrappers.back().isExternal());
+        CHECK(wrappers.back().view() != VK_NULL_HANDLE);  // its own view of the image it does not own
+        imports.bind(image, wrappers.back());
+        imports.waitSemaphore(image, ready.get());  // stages: the first use's (a transfer)
+        imports.signalSemaphore(image, finished.get());
+        const rg::SubmittedFrame submitted = executor.run(plan, imports);
+        CHECK(submitted.frame == frame);
+
+        // ---- consumer: waits on `finished`, finds PRESENT_SRC, reads back.
+        const gpu::Buffer& readback = readbacks.back();
+        submitOutside(ctx, pool, finished.get(), VK_PIPELINE_STAGE_2_ALL_TRANSFER_BIT, VK_NULL_HANDLE, 0,
+                      consumed.back().get(), [&](VkCommandBuffer cmd) {
+                          gpu::imageBarrier(cmd, owner, VK_IMAGE_LAYOUT_PRESENT_SRC_KHR,
+                                            VK_IMAGE_LAYOUT_TRANSFER_SRC_OPTIMAL, VK_PIPELINE_STAGE_2_ALL_TRANSFER_BIT,
+                                            0, VK_PIPELINE_STAGE_2_COPY_BIT, VK_ACCESS_2_TRANSFER_READ_BIT);
+                          VkBufferImageCopy region{};
+                          region.imageSubresource = {VK_IMAGE_ASPECT_COLOR_BIT, 0, 0, 1};
+                          region.imageExtent = {kWidth, kWidth, 1};
+                          vkCmdCopyImageToBuffer(cmd, owner.handle(), VK_IMAGE_LAYOUT_TRANSFER_SRC_OPTIMAL,
+                                                 readback.handle(), 1, &region);
+                          gpu::bufferBarrier(cmd, readback, VK_PIPELINE_STAGE_2_COPY_BIT, VK_ACCESS_2_TRANSFER_WRITE_BIT,
+                                             VK_PIPELINE_STAGE_2_HOST_BIT, VK_ACCESS_2_HOST_READ_BIT);
+                      });
+        // The frame's own completion: its semaphores may be reused after it.
+        executor.wait(submitted);
+        CHECK(executor.finished(submitted));
+        const VkFence done = consumed.back().get();
+        gpu::check(vkWaitForFences(ctx.device(), 1, &done, VK_TRUE, 10'000'000'000ull), "vkWaitForFences");
+        const auto words = readback.mappedSpan<uint32_t>();
+        INFO("frame " << frame);
+        if (keepContents) {
+            // The graph's first pass saw the producer's clear.
+            const auto seenWords = seenByGraph.mappedSpan<uint32_t>();
+            CHECK(seenWords[0] == 7u);
+            CHECK(seenWords[kWidth * kWidth - 1] == 7u);
+        }
+        CHECK(words[0] == 100u + frame);
+        CHECK(words[kWidth * kWidth - 1] == 100u + frame);
+    }
+    executor.waitIdle();
+}

@@ -81,7 +81,15 @@ TEST_CASE("the async compute queue has no attachments and no raster pipeline") {
 TEST_CASE("boundary states go through the table, raw ones pass their masks") {
     const SyncScope present = boundaryScope(BoundaryState::of(Access::Present), ResourceKind::Texture);
     CHECK(present.layout == VK_IMAGE_LAYOUT_PRESENT_SRC_KHR);
-    CHECK(present.stages == VK_PIPELINE_STAGE_2_NONE);
+    // No access (presentation reads through the semaphore), but the stages
+    // of the semaphore signal, so the transition is inside its scope.
+    CHECK(present.stages == kSemaphoreSignalStages);
+    CHECK(present.access == VK_ACCESS_2_NONE);
+    const SyncScope acquired =
+        boundaryScope(BoundaryState::acquired(VK_PIPELINE_STAGE_2_COLOR_ATTACHMENT_OUTPUT_BIT), ResourceKind::Texture);
+    CHECK(acquired.stages == VK_PIPELINE_STAGE_2_COLOR_ATTACHMENT_OUTPUT_BIT);
+    CHECK(acquired.access == VK_ACCESS_2_NONE);
+    CHECK(acquired.layout == VK_IMAGE_LAYOUT_UNDEFINED);
     const SyncScope raw =
         boundaryScope(BoundaryState::raw(VK_PIPELINE_STAGE_2_COLOR_ATTACHMENT_OUTPUT_BIT, 0, VK_IMAGE_LAYOUT_UNDEFINED),
                       ResourceKind::Texture);

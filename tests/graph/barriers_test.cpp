@@ -259,7 +259,67 @@ TEST_CASE("an import goes from its initial state and ends in its final one") {
     CHECK(last[0].oldLayout == VK_IMAGE_LAYOUT_ATTACHMENT_OPTIMAL);
     CHECK(last[0].newLayout == VK_IMAGE_LAYOUT_PRESENT_SRC_KHR);
     CHECK(last[0].srcAccess == VK_ACCESS_2_COLOR_ATTACHMENT_WRITE_BIT);
-    CHECK(last[0].dstStages == VK_PIPELINE_STAGE_2_NONE);
+    // Ends at the stages the executor signals semaphores with, no access:
+    // the transition is inside the render-finished signal's scope.
+    CHECK(last[0].dstStages == kSemaphoreSignalStages);
+    CHECK(last[0].dstAccess == VK_ACCESS_2_NONE);
+}
+
+TEST_CASE("an acquired swapchain image written by a transfer then drawn over ends in PRESENT_SRC before the signal") {
+    // The viewer's frame: a blit into the acquired image, the UI drawn over
+    // it, presented. The acquire wait is at the blit's stage.
+    Graph g(oneQueue());
+    Texture swapchain = g.importTexture("swapchain", {tex(64, VK_FORMAT_B8G8R8A8_UNORM),
+                                                      BoundaryState::acquired(VK_PIPELINE_STAGE_2_ALL_TRANSFER_BIT),
+                                                      BoundaryState::of(Access::Present)});
+    Texture source = g.createTexture("source", tex(64, VK_FORMAT_R8G8B8A8_UNORM));
+    g.addPass("render", Queue::Graphics, [&](Builder& b) { source = b.write(source, Access::StorageWrite); }, noop);
+    g.addPass(
+        "blit", Queue::Graphics,
+        [&](Builder& b) {
+            b.read(source, Access::TransferSrc);
+            swapchain = b.write(swapchain, Access::TransferDst);
+        },
+        noop);
+    g.addPass(
+        "ui", Queue::Graphics,
+        [&](Builder& b) {
+            b.setPipeline(Pipeline::Raster);
+            swapchain = b.write(swapchain, Access::ColorAttachment);
+        },
+        noop);
+    Plan plan = compileChecked(g); // verify()s it
+    const auto first = barriersOn(plan, "blit", "swapchain");
+    REQUIRE(first.size() == 1);
+    CHECK(first[0].oldLayout == VK_IMAGE_LAYOUT_UNDEFINED);
+    CHECK(first[0].newLayout == VK_IMAGE_LAYOUT_TRANSFER_DST_OPTIMAL);
+    CHECK(first[0].srcStages == VK_PIPELINE_STAGE_2_ALL_TRANSFER_BIT); // chained to the acquire wait
+    const uint32_t image = resourceNamed(plan, "swapchain");
+    uint32_t toPresent = 0;
+    for (const Batch& batch : plan.batches)
+        for (const Barrier& b : plan.barriersAfter(batch))
+            if (b.resource == image) {
+                ++toPresent;
+                CHECK(b.oldLayout == VK_IMAGE_LAYOUT_ATTACHMENT_OPTIMAL);
+                CHECK(b.newLayout == VK_IMAGE_LAYOUT_PRESENT_SRC_KHR);
+                CHECK(b.srcStages == VK_PIPELINE_STAGE_2_COLOR_ATTACHMENT_OUTPUT_BIT);
+                CHECK(b.srcAccess == VK_ACCESS_2_COLOR_ATTACHMENT_WRITE_BIT);
+                CHECK((b.dstStages & kSemaphoreSignalStages) != 0);
+            }
+    CHECK(toPresent == 1);
+    // Where the executor puts the caller's semaphores: the acquire wait in
+    // the batch of the blit, at the blit's stage; the render-finished
+    // signal from the batch that records the transition to PRESENT_SRC.
+    const Plan::WaitPoint wait = plan.firstUseOf(image);
+    CHECK(wait.batch == passNamed(plan, "blit").batch);
+    CHECK(wait.stages == VK_PIPELINE_STAGE_2_ALL_TRANSFER_BIT);
+    const uint32_t ending = plan.batchEnding(image);
+    REQUIRE(ending != kNoIndex);
+    CHECK(ending >= passNamed(plan, "ui").batch);
+    bool endsThere = false;
+    for (const Barrier& b : plan.barriersAfter(plan.batches[ending]))
+        endsThere = endsThere || (b.resource == image && b.newLayout == VK_IMAGE_LAYOUT_PRESENT_SRC_KHR);
+    CHECK(endsThere);
 }
 
 TEST_CASE("an import whose final state describes its last use needs no end barrier") {

@@ -139,6 +139,69 @@ TEST_CASE("the verifier catches a wrong layout") {
     CHECK(verify(plan).has(Violation::Kind::Layout));
 }
 
+namespace {
+
+// A swapchain image drawn and presented.
+Plan presentPlan() {
+    Graph g(oneQueue());
+    Texture swapchain = g.importTexture(
+        "swapchain", {tex(64, VK_FORMAT_B8G8R8A8_UNORM),
+                      BoundaryState::acquired(VK_PIPELINE_STAGE_2_COLOR_ATTACHMENT_OUTPUT_BIT),
+                      BoundaryState::of(Access::Present)});
+    g.addPass(
+        "draw", Queue::Graphics,
+        [&](Builder& b) {
+            b.setPipeline(Pipeline::Raster);
+            swapchain = b.write(swapchain, Access::ColorAttachment);
+        },
+        noop);
+    return compile(g, oneQueue());
+}
+
+uint32_t presentBarrier(const Plan& plan) {
+    const uint32_t image = plan.findResource("swapchain");
+    for (const Batch& batch : plan.batches)
+        for (uint32_t i = batch.firstEndBarrier; i < batch.firstEndBarrier + batch.endBarrierCount; ++i)
+            if (plan.barriers[i].resource == image) return i;
+    return kNoIndex;
+}
+
+} // namespace
+
+TEST_CASE("the verifier accepts a plan that moves a swapchain image to PRESENT_SRC before the frame's signal") {
+    const Plan plan = presentPlan();
+    const uint32_t i = presentBarrier(plan);
+    REQUIRE(i != kNoIndex);
+    CHECK(plan.barriers[i].newLayout == VK_IMAGE_LAYOUT_PRESENT_SRC_KHR);
+    const VerifyReport report = verify(plan);
+    CHECK_MESSAGE(report.ok(), report.text());
+}
+
+TEST_CASE("the verifier catches a swapchain image left out of PRESENT_SRC") {
+    const Plan plan = presentPlan();
+    const uint32_t i = presentBarrier(plan);
+    REQUIRE(i != kNoIndex);
+    VerifyOptions options;
+    options.checkRedundancy = false;
+    const VerifyReport report = verify(withoutBarrier(plan, i), options);
+    CHECK(report.has(Violation::Kind::FinalState));
+    CHECK(contains(report.text(), "'swapchain'"));
+    CHECK(contains(report.text(), "final layout"));
+}
+
+TEST_CASE("the verifier catches a transition to PRESENT_SRC outside the semaphore signal's scope") {
+    // A NONE destination stage: the transition may still run when the
+    // render-finished semaphore is signalled (a present-after-write hazard).
+    Plan plan = presentPlan();
+    const uint32_t i = presentBarrier(plan);
+    REQUIRE(i != kNoIndex);
+    plan.barriers[i].dstStages = VK_PIPELINE_STAGE_2_NONE;
+    const VerifyReport report = verify(plan);
+    CHECK(report.has(Violation::Kind::FinalState));
+    CHECK(contains(report.text(), "layout transition"));
+    CHECK(contains(report.text(), "not ordered before its final state"));
+}
+
 TEST_CASE("the verifier catches a missing semaphore wait") {
     Graph g(twoQueues());
     synthetic::declare(g, synthetic::reflectionFrame({}));
