@@ -36,10 +36,30 @@ std::vector<gpu::Binding> geometryBindings() {
 // The G-buffer's pipelines add the shadow map (shaders/gbuffer/shadow.glsl);
 // the shadow map's own pipeline cannot bind what it renders.
 constexpr uint32_t kShadowMapBinding = 5;
+constexpr uint32_t kNormalMapBinding = 6;
 std::vector<gpu::Binding> gbufferBindings() {
     std::vector<gpu::Binding> bindings = geometryBindings();
     bindings.push_back({kShadowMapBinding, VK_DESCRIPTOR_TYPE_COMBINED_IMAGE_SAMPLER, VK_SHADER_STAGE_FRAGMENT_BIT});
+    bindings.push_back({kNormalMapBinding, VK_DESCRIPTOR_TYPE_COMBINED_IMAGE_SAMPLER, VK_SHADER_STAGE_FRAGMENT_BIT});
     return bindings;
+}
+
+VkSamplerAddressMode addressMode(scene::Wrap wrap) {
+    switch (wrap) {
+    case scene::Wrap::ClampToEdge: return VK_SAMPLER_ADDRESS_MODE_CLAMP_TO_EDGE;
+    case scene::Wrap::MirroredRepeat: return VK_SAMPLER_ADDRESS_MODE_MIRRORED_REPEAT;
+    case scene::Wrap::Repeat: break;
+    }
+    return VK_SAMPLER_ADDRESS_MODE_REPEAT;
+}
+
+// A scene texture no material uses as its normal texture.
+constexpr size_t kNoImage = std::numeric_limits<size_t>::max();
+
+// glTF's three wrap modes for S and T: nine samplers.
+constexpr size_t kWrapModes = 3;
+size_t samplerIndex(const scene::TextureRef& ref) {
+    return size_t(ref.wrapS) * kWrapModes + size_t(ref.wrapT);
 }
 
 // Shadows fade out over the last tenth of SunShadowSettings::maxDistance.
@@ -192,6 +212,11 @@ struct GBufferRenderer::DrawRange {
     uint32_t indexCount = 0;
     int32_t vertexOffset = 0;
     bool doubleSided = false;
+    // The draw's push constants less the instance; normalMap = 1 with
+    // normalImage and normalSampler set.
+    shader::GBufferDraw material{};
+    size_t normalImage = 0;
+    size_t normalSampler = 0;
 };
 
 // Host-visible buffers of one frame in flight, written when the frame
@@ -254,6 +279,37 @@ GBufferRenderer::GBufferRenderer(gpu::Context& ctx, const scene::Scene& scene, u
     nearest_ = gpu::Sampler(ctx, {VK_FILTER_NEAREST, VK_SAMPLER_MIPMAP_MODE_NEAREST,
                                   VK_SAMPLER_ADDRESS_MODE_CLAMP_TO_EDGE, 0.0f, "gbuffer.nearest"});
 
+    for (size_t wrapS = 0; wrapS < kWrapModes; ++wrapS) {
+        for (size_t wrapT = 0; wrapT < kWrapModes; ++wrapT) {
+            gpu::SamplerDesc desc{VK_FILTER_LINEAR, VK_SAMPLER_MIPMAP_MODE_LINEAR,
+                                  addressMode(scene::Wrap(wrapS)), VK_LOD_CLAMP_NONE, "gbuffer.normal_map"};
+            desc.addressV = addressMode(scene::Wrap(wrapT));
+            normalSamplers_.emplace_back(ctx, desc);
+        }
+    }
+    // (0.5, 0.5, 1): the unperturbed normal; bound where a draw has no
+    // normal map so the binding is always valid.
+    const std::array<uint8_t, 4> flat = {128, 128, 255, 255};
+    flatNormal_ = gpu::createSampledImageWithMips(
+        ctx, {.width = 1, .height = 1, .format = VK_FORMAT_R8G8B8A8_UNORM, .name = "gbuffer.flat_normal"}, flat.data());
+    // Normal textures, each once however many materials share it. Linear
+    // (UNORM): glTF normal textures hold vectors, not colours.
+    std::vector<size_t> normalImageOf(scene.textures.size(), kNoImage);
+    for (const scene::Material& material : scene.materials) {
+        const scene::TextureRef& ref = material.normalTexture;
+        if (!ref.valid() || normalImageOf.at(size_t(ref.texture)) != kNoImage) continue;
+        const scene::Texture& texture = scene.textures[size_t(ref.texture)];
+        if (texture.format != scene::TextureFormat::Rgba8) continue;
+        normalImageOf[size_t(ref.texture)] = normalImages_.size();
+        normalImages_.push_back(gpu::createSampledImageWithMips(ctx,
+                                                                {.width = texture.width,
+                                                                 .height = texture.height,
+                                                                 .format = VK_FORMAT_R8G8B8A8_UNORM,
+                                                                 .name = "gbuffer.normal_map." + texture.name},
+                                                                texture.rgba8.data()));
+    }
+    stats_.normalMaps = uint32_t(normalImages_.size());
+
     // Every mesh's LOD 0 into one vertex and one index buffer: one binding
     // for the whole frame, draws differ only in their ranges.
     std::vector<shader::GBufferVertex> vertices;
@@ -267,7 +323,18 @@ GBufferRenderer::GBufferRenderer(gpu::Context& ctx, const scene::Scene& scene, u
             range.firstIndex = uint32_t(indices.size());
             range.indexCount = uint32_t(g.indices.size());
             range.vertexOffset = int32_t(vertices.size());
-            range.doubleSided = scene.materials.at(g.material).doubleSided;
+            const scene::Material& material = scene.materials.at(g.material);
+            range.doubleSided = material.doubleSided;
+            const scene::TextureRef& normalRef = material.normalTexture;
+            if (normalRef.valid() && normalImageOf.at(size_t(normalRef.texture)) != kNoImage &&
+                g.tangents.size() == g.vertexCount()) {
+                range.material.normalMap = 1;
+                range.material.normalTexCoord = normalRef.texCoord;
+                range.material.normalUvTransform = normalRef.uvTransform();
+                range.material.normalScale = material.normalScale;
+                range.normalImage = normalImageOf[size_t(normalRef.texture)];
+                range.normalSampler = samplerIndex(normalRef);
+            }
             for (uint32_t v = 0; v < g.vertexCount(); ++v) {
                 const shader::SurfaceVertex s = scene::surfaceAtVertex(scene, g, v);
                 shader::GBufferVertex out{};
@@ -282,6 +349,9 @@ GBufferRenderer::GBufferRenderer(gpu::Context& ctx, const scene::Scene& scene, u
                     out.joints = {uint32_t(j.x) | uint32_t(j.y) << 16, uint32_t(j.z) | uint32_t(j.w) << 16};
                     out.weights = g.weights[v];
                 }
+                out.tangent = v < g.tangents.size() ? g.tangents[v] : glm::vec4(1.0f, 0.0f, 0.0f, 1.0f);
+                out.uv0 = v < g.texcoords0.size() ? g.texcoords0[v] : glm::vec2(0.0f);
+                out.uv1 = v < g.texcoords1.size() ? g.texcoords1[v] : glm::vec2(0.0f);
                 vertices.push_back(out);
             }
             indices.insert(indices.end(), g.indices.begin(), g.indices.end());
@@ -417,7 +487,9 @@ void GBufferRenderer::recordShadowMap(const FrameWork& work, rg::PassContext& pc
         for (size_t i = 0; i < work.instances.size(); ++i) {
             for (const DrawRange& range : meshDraws_.at(work.meshes[i])) {
                 if (range.indexCount == 0) continue;
-                shadowPipeline_.pushConstants(cmd, shader::GBufferDraw{uint32_t(i), 0u});
+                shader::GBufferDraw draw{};
+                draw.instance = uint32_t(i);
+                shadowPipeline_.pushConstants(cmd, draw);
                 vkCmdDrawIndexed(cmd, range.indexCount, 1, range.firstIndex, range.vertexOffset, 0);
                 ++stats_.shadowDraws;
             }
@@ -465,7 +537,9 @@ void GBufferRenderer::record(const FrameWork& work, rg::PassContext& pc, const G
     vkCmdSetViewport(cmd, 0, 1, &viewport);
     vkCmdSetScissor(cmd, 0, 1, &scissor);
 
-    const auto pushBindings = [&](const gpu::Pipeline& pipeline) {
+    // Pushed again only when a draw's normal map differs from the last one.
+    const auto pushBindings = [&](const gpu::Pipeline& pipeline, const gpu::Image& normalImage,
+                                  const gpu::Sampler& normalSampler) {
         gpu::PushDescriptors(pipeline)
             .storageBuffer(0, slot.frame)
             .storageBuffer(1, slot.instances)
@@ -474,18 +548,35 @@ void GBufferRenderer::record(const FrameWork& work, rg::PassContext& pc, const G
             .storageBuffer(4, slot.previousJoints)
             .sampledImage(kShadowMapBinding, pc.view(targets.shadowMap), nearest_.handle(),
                           pc.layout(targets.shadowMap))
+            .sampledImage(kNormalMapBinding, normalImage.view(), normalSampler.handle())
             .push(ctx_, cmd);
     };
 
     stats_.draws = 0;
     stats_.triangles = 0;
+    stats_.normalMappedDraws = 0;
     surfacePipeline_.bind(cmd);
-    pushBindings(surfacePipeline_);
+    const gpu::Image* boundImage = &flatNormal_;
+    const gpu::Sampler* boundSampler = &normalSamplers_[0];
+    pushBindings(surfacePipeline_, *boundImage, *boundSampler);
     vkCmdBindIndexBuffer(cmd, indices_.handle(), 0, VK_INDEX_TYPE_UINT32);
     for (size_t i = 0; i < work.instances.size(); ++i) {
         for (const DrawRange& range : meshDraws_.at(work.meshes[i])) {
             if (range.indexCount == 0) continue;
-            surfacePipeline_.pushConstants(cmd, shader::GBufferDraw{uint32_t(i), range.doubleSided ? 1u : 0u});
+            if (range.material.normalMap != 0) {
+                const gpu::Image* image = &normalImages_[range.normalImage];
+                const gpu::Sampler* sampler = &normalSamplers_[range.normalSampler];
+                if (image != boundImage || sampler != boundSampler) {
+                    boundImage = image;
+                    boundSampler = sampler;
+                    pushBindings(surfacePipeline_, *boundImage, *boundSampler);
+                }
+                ++stats_.normalMappedDraws;
+            }
+            shader::GBufferDraw draw = range.material;
+            draw.instance = uint32_t(i);
+            draw.doubleSided = range.doubleSided ? 1u : 0u;
+            surfacePipeline_.pushConstants(cmd, draw);
             vkCmdDrawIndexed(cmd, range.indexCount, 1, range.firstIndex, range.vertexOffset, 0);
             ++stats_.draws;
             stats_.triangles += range.indexCount / 3;
@@ -493,8 +584,8 @@ void GBufferRenderer::record(const FrameWork& work, rg::PassContext& pc, const G
     }
     if (work.drawSky) {
         skyPipeline_.bind(cmd);
-        pushBindings(skyPipeline_);
-        skyPipeline_.pushConstants(cmd, shader::GBufferDraw{0, 0});
+        pushBindings(skyPipeline_, flatNormal_, normalSamplers_[0]);
+        skyPipeline_.pushConstants(cmd, shader::GBufferDraw{});
         vkCmdDraw(cmd, 3, 1, 0, 0);
     }
     vkCmdEndRendering(cmd);

@@ -24,8 +24,12 @@
 // smaller, on a world-fixed texel grid so it does not shimmer as the camera
 // moves. It needs no BVH, so every mode and device gets the same shadows.
 // Materials are sampled at the vertices on the CPU (scene::surfaceAtVertex,
-// as the BVH's packed primitives are), so textures contribute at vertex
-// rate and normal maps not at all.
+// as the BVH's packed primitives are), so base colour and metallic-
+// roughness textures contribute at vertex rate. Normal maps are the
+// exception: uploaded with their mips and sampled per pixel (tangent space,
+// glTF's TANGENT or generated tangents, normalTexture.scale, the texture
+// coordinate set and KHR_texture_transform the material names). The packed
+// primitives of the RT hits keep the vertex normal.
 
 #include "gpu/context.h"
 #include "gpu/pipeline.h"
@@ -123,6 +127,8 @@ struct GBufferStats {
     // This frame's shadow map fit (enabled = 0 with shadows off).
     shader::GBufferShadow shadow{};
     uint64_t geometryBytes = 0;   // the uploaded vertex and index buffers
+    uint32_t normalMaps = 0;      // normal textures uploaded
+    uint32_t normalMappedDraws = 0;  // this frame
 };
 
 // Owns the scene's GPU geometry (every mesh's LOD 0, uploaded once into one
@@ -163,6 +169,12 @@ private:
     gpu::Pipeline skyPipeline_;
     gpu::Pipeline shadowPipeline_;
     gpu::Sampler nearest_;  // completes the shadow map's descriptor; reads are texelFetch
+    // Normal maps: one image per scene texture some material uses as its
+    // normal texture (by scene texture index), a 1x1 flat one bound to
+    // draws without, and one sampler per glTF wrap-mode pair.
+    std::vector<gpu::Image> normalImages_;
+    gpu::Image flatNormal_;
+    std::vector<gpu::Sampler> normalSamplers_;
     gpu::Buffer vertices_;  // GBufferVertex, every geometry of every mesh's LOD 0
     gpu::Buffer indices_;
     std::vector<std::vector<DrawRange>> meshDraws_;  // per mesh: its LOD-0 geometries

@@ -240,7 +240,8 @@ Sampler::Sampler(Context& ctx, const SamplerDesc& desc) {
     info.magFilter = desc.filter;
     info.minFilter = desc.filter;
     info.mipmapMode = desc.mipmap;
-    info.addressModeU = info.addressModeV = info.addressModeW = desc.address;
+    info.addressModeU = desc.address;
+    info.addressModeV = info.addressModeW = desc.addressV.value_or(desc.address);
     info.maxLod = desc.maxLod;
     VkSampler sampler = VK_NULL_HANDLE;
     check(vkCreateSampler(ctx.device(), &info, nullptr, &sampler), "vkCreateSampler '" + desc.name + "'");

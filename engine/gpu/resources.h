@@ -8,6 +8,7 @@
 
 #include <vulkan/vulkan.h>
 
+#include <optional>
 #include <span>
 #include <string>
 #include <vector>
@@ -115,6 +116,9 @@ struct SamplerDesc {
     VkSamplerAddressMode address = VK_SAMPLER_ADDRESS_MODE_CLAMP_TO_EDGE;
     float maxLod = VK_LOD_CLAMP_NONE;
     std::string name;
+    // V's (and W's) address mode when it differs from `address` (U's):
+    // glTF samplers wrap S and T independently.
+    std::optional<VkSamplerAddressMode> addressV;
 };
 
 class Sampler {

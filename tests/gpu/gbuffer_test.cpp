@@ -16,6 +16,7 @@
 #include "passes/gbuffer.h"
 #include "scene/animation.h"
 #include "scene/builtin_scenes.h"
+#include "scene/mesh_tools.h"
 
 #include "glint/packing.h"
 
@@ -217,6 +218,60 @@ TEST_CASE("a plane facing the camera gives the reversed-Z depth, its normal and 
             REQUIRE(img.motion[i] == glm::vec2(0.0f));  // nothing moved
             REQUIRE(finite(img.lit[i]));
             REQUIRE(img.lit[i].r > 0.0f);
+        }
+    }
+}
+
+TEST_CASE("a constant tilted normal map tilts the G-buffer normal of a plane by its tangent frame and scale") {
+    // The tangent-space normal (0.5, -0.3, 0.81) stored as 8-bit texels; the
+    // plane faces +Z with glTF UVs (u along +x, v down the image, so along
+    // -y): generated tangent +x, bitangent +y.
+    const glm::vec3 tilted = glm::normalize(glm::vec3(0.5f, -0.3f, 0.81f));
+    const glm::u8vec4 texel(glm::round((tilted * 0.5f + 0.5f) * 255.0f), 255);
+    const glm::vec3 stored = glm::vec3(texel) / 255.0f * 2.0f - 1.0f;  // what the sampler returns, decoded
+
+    for (const float scale : {1.0f, 0.5f}) {
+        INFO("normalTexture.scale " << scale);
+        test::GpuTest gpu;
+        scene::Geometry plane = square({0, 0, -5}, {1, 0, 0}, {0, 1, 0}, 20.0f);
+        for (const glm::vec3& p : plane.positions) {
+            plane.texcoords0.push_back({p.x / 40.0f + 0.5f, 0.5f - p.y / 40.0f});
+        }
+        scene::generateTangents(plane);
+        scene::Material material;
+        material.normalTexture.texture = 0;
+        material.normalScale = scale;
+        scene::Scene scene = [&] {
+            scene::Scene s;
+            s.name = "gbuffer-normal-map-test";
+            scene::Texture texture;
+            texture.name = "tilted";
+            texture.width = texture.height = 4;
+            for (int i = 0; i < 16; ++i) texture.rgba8.insert(texture.rgba8.end(), {texel.r, texel.g, texel.b, 255});
+            s.textures.push_back(texture);
+            s.materials.push_back(material);
+            scene::Mesh mesh;
+            mesh.lods.push_back({{plane}});
+            s.meshes.push_back(std::move(mesh));
+            s.instances.push_back({});
+            scene::prepareScene(s);
+            return s;
+        }();
+        passes::GBufferStats stats;
+        const GBufferImage img = render(gpu, scene, {testCamera()}, &stats);
+        CHECK(stats.normalMaps == 1);
+        CHECK(stats.normalMappedDraws == 1);
+
+        const glm::vec3 expected = glm::normalize(glm::vec3(stored.x * scale, stored.y * scale, stored.z));
+        // Against the unquantised normal too: within 8-bit quantisation.
+        const glm::vec3 ideal = glm::normalize(glm::vec3(tilted.x * scale, tilted.y * scale, tilted.z));
+        for (uint32_t y = 0; y < kSize; ++y) {
+            for (uint32_t x = 0; x < kSize; ++x) {
+                INFO("pixel " << x << ", " << y);
+                const glm::vec3 n(img.normal[img.at(x, y)]);
+                REQUIRE(glm::length(n - expected) < 2e-3f);  // half-float output
+                REQUIRE(glm::length(n - ideal) < 2.0f / 255.0f * 2.0f);
+            }
         }
     }
 }
