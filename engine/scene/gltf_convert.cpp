@@ -850,12 +850,13 @@ private:
             context_.chargeDecoded(g.positions.size() * sizeof(glm::vec4), context);
             generateTangents(g, material.normalTexture.valid() ? material.normalTexture.texCoord : 0);
         } else {
-            // glTF: unit xyz, w = +-1 (the bitangent's sign).
-            for (glm::vec4& t : g.tangents) {
+            // glTF: unit xyz, w = +-1 (the bitangent's sign). A zero tangent
+            // becomes any vector perpendicular to the normal.
+            for (size_t v = 0; v < g.tangents.size(); ++v) {
+                glm::vec4& t = g.tangents[v];
                 const glm::vec3 xyz(t);
                 const float len = glm::length(xyz);
-                const glm::vec3 nrm = glm::vec3(0.0f, 1.0f, 0.0f);
-                t = glm::vec4(len > 0.0f ? xyz / len : anyPerpendicular(nrm), t.w < 0.0f ? -1.0f : 1.0f);
+                t = glm::vec4(len > 0.0f ? xyz / len : anyPerpendicular(g.normals[v]), t.w < 0.0f ? -1.0f : 1.0f);
             }
         }
         return g;

@@ -276,6 +276,53 @@ TEST_CASE("a constant tilted normal map tilts the G-buffer normal of a plane by 
     }
 }
 
+TEST_CASE("the normal map is sampled through its texture reference's coordinate set and KHR_texture_transform") {
+    // Two texels: left tilted, right flat. Constant UVs sit on texel centres
+    // (u = 0.25 left, 0.75 right), so bilinear filtering returns one texel.
+    const glm::vec3 tilted = glm::normalize(glm::vec3(0.6f, 0.0f, 0.8f));
+    const glm::u8vec4 left(glm::round((tilted * 0.5f + 0.5f) * 255.0f), 255);
+    const glm::u8vec4 right(128, 128, 255, 255);
+    struct Case {
+        const char* what;
+        uint32_t texCoord;
+        glm::vec2 offset;
+        bool expectTilted;
+    };
+    for (const Case& c : {Case{"set 0, identity", 0, {0.0f, 0.0f}, true},
+                          Case{"set 0, offset half a texture", 0, {0.5f, 0.0f}, false},
+                          Case{"set 1, identity", 1, {0.0f, 0.0f}, false},
+                          Case{"set 1, offset back", 1, {-0.5f, 0.0f}, true}}) {
+        INFO(c.what);
+        test::GpuTest gpu;
+        scene::Geometry plane = square({0, 0, -5}, {1, 0, 0}, {0, 1, 0}, 20.0f);
+        plane.texcoords0.assign(4, {0.25f, 0.5f});
+        plane.texcoords1.assign(4, {0.75f, 0.5f});
+        plane.tangents.assign(4, {1.0f, 0.0f, 0.0f, 1.0f});
+        scene::Scene s;
+        s.name = "gbuffer-normal-map-uv-test";
+        scene::Texture texture;
+        texture.name = "left tilted, right flat";
+        texture.width = 2;
+        texture.height = 1;
+        texture.rgba8 = {left.r, left.g, left.b, 255, right.r, right.g, right.b, 255};
+        s.textures.push_back(texture);
+        scene::Material material;
+        material.normalTexture.texture = 0;
+        material.normalTexture.texCoord = c.texCoord;
+        material.normalTexture.offset = c.offset;
+        s.materials.push_back(material);
+        scene::Mesh mesh;
+        mesh.lods.push_back({{plane}});
+        s.meshes.push_back(std::move(mesh));
+        s.instances.push_back({});
+        scene::prepareScene(s);
+        const GBufferImage img = render(gpu, s, {testCamera()});
+        const glm::vec3 expected = c.expectTilted ? glm::vec3(glm::vec3(left) / 255.0f * 2.0f - 1.0f) : glm::vec3(0, 0, 1);
+        const glm::vec3 n(img.normal[img.at(kSize / 2, kSize / 2)]);
+        CHECK(glm::length(n - glm::normalize(expected)) < 0.01f);
+    }
+}
+
 TEST_CASE("a plane the sun grazes is lit by the sky alone: albedo / pi times the hemisphere irradiance") {
     test::GpuTest gpu;
     scene::Material material;

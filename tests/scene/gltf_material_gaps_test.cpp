@@ -16,6 +16,7 @@
 #include <stb_image_write.h>
 
 #include <functional>
+#include <random>
 
 using namespace glint::scene;
 using namespace glint::test;
@@ -396,4 +397,65 @@ TEST_CASE("tangents generated for WaterBottle agree with the MikkTSpace TANGENTs
     MESSAGE(vertices << " vertices: " << sameSign << " same handedness, " << aligned << " within 26 degrees");
     CHECK(double(sameSign) / double(vertices) > 0.99);
     CHECK(double(aligned) / double(vertices) > 0.95);
+}
+
+TEST_CASE("randomly corrupted morph-target and texture-transform documents load or fail with a SceneError") {
+    // Digit changes in the JSON (indices, counts, offsets, weights, texCoord
+    // and transform numbers, and the base64 buffer) of a document using
+    // every feature of this file; mutants that load are animated and
+    // morphed too, so the sanitiser build checks the evaluation as well.
+    MorphFile m;
+    const int uvs = m.f.floats({0.25f, 0.5f, 0.75f, 0.5f, 0.25f, 0.5f}, "VEC2", 2);
+    m.f.doc["meshes"][0]["primitives"][0]["attributes"]["TEXCOORD_0"] = uvs;
+    m.f.doc["meshes"][0]["primitives"][0]["attributes"]["TEXCOORD_1"] = uvs;
+    m.f.doc["meshes"][0]["primitives"][0]["material"] = 0;
+    m.f.doc["images"] = {{{"uri", "data:image/png;base64," + base64(redGreenPng())}}};
+    m.f.doc["textures"] = {{{"source", 0}}};
+    m.f.doc["materials"] = {
+        {{"pbrMetallicRoughness",
+          {{"baseColorTexture",
+            {{"index", 0},
+             {"texCoord", 1},
+             {"extensions", {{"KHR_texture_transform", {{"offset", {0.5, 0.25}}, {"rotation", 0.3}, {"scale", {2, 3}}}}}}}}}},
+         {"normalTexture", {{"index", 0}, {"scale", 0.7}}}}};
+    m.f.doc["extensionsUsed"] = {"KHR_texture_transform"};
+    m.f.doc["animations"][0]["samplers"][0]["interpolation"] = "STEP";
+    const std::string text = Json::parse(m.f.text()).dump();
+    std::vector<size_t> digits;
+    for (size_t i = 0; i < text.size(); ++i) {
+        if (text[i] >= '0' && text[i] <= '9') digits.push_back(i);
+    }
+    const std::filesystem::path dir = outputDir("morph-random");
+    std::mt19937 rng(4321);
+    LogCapture quiet;
+    size_t loaded = 0, refused = 0;
+    for (int i = 0; i < 300; ++i) {
+        std::string mutated = text;
+        for (int k = 0; k < 1 + int(rng() % 3); ++k) {
+            mutated[digits[rng() % digits.size()]] = char('0' + rng() % 10);
+        }
+        const std::filesystem::path path = dir / ("morph-" + std::to_string(i) + ".gltf");
+        writeText(path, mutated);
+        try {
+            Scene scene = loadGltf(path, {.maxDecodedBytes = 64ull << 20});
+            for (const double t : {0.25, 0.75, 3.0}) {
+                advanceScene(scene, t);
+                for (const Instance& inst : scene.instances) {
+                    for (const Geometry& g : scene.meshes[inst.mesh].lods[0].geometries) {
+                        const Geometry morphed = morphedGeometry(g, inst.morphWeights);
+                        for (uint32_t v = 0; v < morphed.vertexCount(); ++v) {
+                            (void)surfaceAtVertex(scene, morphed, v);
+                        }
+                    }
+                }
+            }
+            ++loaded;
+        } catch (const SceneError& e) {
+            CHECK_MESSAGE(std::string(e.what()).find(path.filename().string()) != std::string::npos, e.what());
+            ++refused;
+        }
+    }
+    MESSAGE(loaded << " mutants loaded, " << refused << " refused with a SceneError");
+    CHECK(loaded > 30);
+    CHECK(refused > 30);
 }
