@@ -3,7 +3,8 @@
 //
 // BvhManager owns what lives across frames: the reflection-LOD geometry of
 // every mesh a BLAS was built from (uploaded once, material sampled at the
-// vertices on the CPU), one AccelerationStructure per resident BLAS, the
+// vertices on the CPU; a morphing instance's own BLAS instead gets its
+// morphed vertices, morph targets applied on the CPU, per build), one AccelerationStructure per resident BLAS, the
 // unwrapped build positions of the deformable ones, the one primitive pool
 // (PackedPrimitive per triangle, glint/packing.h), the primitive offset
 // buffer, the TLAS and its per-frame instance buffers.
@@ -165,6 +166,9 @@ private:
     void record(FrameWork& work, rg::PassContext& pc, const BvhUpdateOutputs& handles);
     const SourceGeometry& sourceGeometry(uint32_t mesh, uint32_t lod, uint32_t geometry);
     ResidentBlas& createBlas(const scene::BlasDesc& desc);
+    // A morphing instance's BLAS geometry: its host-visible source vertex
+    // buffer of frame slot `slot`, at least `bytes` large.
+    const gpu::Buffer& morphedVertexBuffer(ResidentBlas& blas, size_t geometryIndex, uint32_t slot, VkDeviceSize bytes);
     void ensurePool(uint32_t triangles, FrameWork& work);
     void ensureTlas(uint32_t instances);
     void ensureOffsets(size_t entries);

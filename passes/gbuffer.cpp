@@ -4,6 +4,7 @@
 #include "gpu/descriptors.h"
 #include "gpu/error.h"
 #include "graph/executor.h"
+#include "scene/animation.h"
 #include "scene/packed_primitives.h"
 
 #include "glint/gbuffer_shared.h"
@@ -223,6 +224,7 @@ struct GBufferRenderer::DrawRange {
 // records (the executor has waited for the slot's previous frame by then).
 struct GBufferRenderer::FrameSlot {
     gpu::Buffer frame;
+    gpu::Buffer morphedVertices;  // this frame's morphing instances (FrameWork::morphedVertices)
     gpu::Buffer instances;
     gpu::Buffer joints;
     gpu::Buffer previousJoints;
@@ -237,6 +239,11 @@ struct GBufferRenderer::FrameWork {
     std::vector<uint32_t> meshes;  // per instance
     std::vector<glm::mat4> joints;
     std::vector<glm::mat4> previousJoints;
+    // Morphing instances: the mesh's vertices with the instance's weights
+    // applied, end to end; per instance the first of them, or -1 (the
+    // shared vertex buffer).
+    std::vector<shader::GBufferVertex> morphedVertices;
+    std::vector<int64_t> morphedFirstVertex;
 };
 
 GBufferRenderer::GBufferRenderer(gpu::Context& ctx, const scene::Scene& scene, uint32_t framesInFlight)
@@ -315,8 +322,11 @@ GBufferRenderer::GBufferRenderer(gpu::Context& ctx, const scene::Scene& scene, u
     std::vector<shader::GBufferVertex> vertices;
     std::vector<uint32_t> indices;
     meshDraws_.resize(scene.meshes.size());
+    meshFirstVertex_.assign(scene.meshes.size(), 0);
+    morphBaseVertices_.resize(scene.meshes.size());
     for (size_t m = 0; m < scene.meshes.size(); ++m) {
         const scene::Mesh& mesh = scene.meshes[m];
+        meshFirstVertex_[m] = int32_t(vertices.size());
         if (mesh.lods.empty()) continue;
         for (const scene::Geometry& g : mesh.lods[0].geometries) {
             DrawRange range;
@@ -356,6 +366,11 @@ GBufferRenderer::GBufferRenderer(gpu::Context& ctx, const scene::Scene& scene, u
             }
             indices.insert(indices.end(), g.indices.begin(), g.indices.end());
             meshDraws_[m].push_back(range);
+        }
+        if (!mesh.morphWeights.empty()) {
+            // Kept for the per-frame morphed copies: materials and skins stay,
+            // positions, normals and tangents are replaced.
+            morphBaseVertices_[m].assign(vertices.begin() + meshFirstVertex_[m], vertices.end());
         }
     }
     // Vulkan buffers cannot be empty; an empty scene still binds something.
@@ -416,6 +431,7 @@ std::shared_ptr<GBufferRenderer::FrameWork> GBufferRenderer::prepare(const GBuff
         }
         work->instances.push_back(gi);
         work->meshes.push_back(inst.mesh);
+        work->morphedFirstVertex.push_back(appendMorphed(inst, work->morphedVertices));
     }
     work->joints = scene_.jointMatrices;
     work->previousJoints = scene_.previousJointMatrices;
@@ -425,8 +441,35 @@ std::shared_ptr<GBufferRenderer::FrameWork> GBufferRenderer::prepare(const GBuff
     return work;
 }
 
+int64_t GBufferRenderer::appendMorphed(const scene::Instance& inst, std::vector<shader::GBufferVertex>& out) const {
+    if (inst.mesh >= scene_.meshes.size() || inst.morphWeights.empty() || morphBaseVertices_[inst.mesh].empty()) {
+        return -1;
+    }
+    const int64_t first = int64_t(out.size());
+    const std::vector<shader::GBufferVertex>& base = morphBaseVertices_[inst.mesh];
+    size_t v = 0;
+    for (const scene::Geometry& g : scene_.meshes[inst.mesh].lods[0].geometries) {
+        const scene::Geometry morphed = scene::morphedGeometry(g, inst.morphWeights);
+        for (uint32_t k = 0; k < morphed.vertexCount(); ++k, ++v) {
+            shader::GBufferVertex vertex = base.at(v);
+            vertex.position = morphed.positions[k];
+            if (k < morphed.normals.size()) vertex.normal = morphed.normals[k];
+            if (k < morphed.tangents.size()) vertex.tangent = morphed.tangents[k];
+            out.push_back(vertex);
+        }
+    }
+    return first;
+}
+
 void GBufferRenderer::upload(const FrameWork& work) {
     FrameSlot& slot = *slots_[work.slot];
+    ensureCapacity(slot.morphedVertices,
+                   std::max<size_t>(work.morphedVertices.size(), 1) * sizeof(shader::GBufferVertex),
+                   "gbuffer.morphed_vertices");
+    if (!work.morphedVertices.empty()) {
+        std::memcpy(slot.morphedVertices.mapped(), work.morphedVertices.data(),
+                    work.morphedVertices.size() * sizeof(shader::GBufferVertex));
+    }
 
     // Host writes before the submit are visible to the device without a
     // barrier; this slot's previous frame has finished.
@@ -446,6 +489,14 @@ void GBufferRenderer::upload(const FrameWork& work) {
         std::memcpy(slot.previousJoints.mapped(), work.previousJoints.data(),
                     work.previousJoints.size() * sizeof(glm::mat4));
     }
+}
+
+std::pair<const gpu::Buffer*, int32_t> GBufferRenderer::vertexSource(const FrameWork& work, size_t instance,
+                                                                     const FrameSlot& slot) const {
+    const int64_t first = work.morphedFirstVertex[instance];
+    if (first < 0) return {&vertices_, 0};
+    // The morphed copy lies at `first`; the draw ranges index the shared buffer.
+    return {&slot.morphedVertices, int32_t(first) - meshFirstVertex_[work.meshes[instance]]};
 }
 
 void GBufferRenderer::recordShadowMap(const FrameWork& work, rg::PassContext& pc, rg::Texture shadowMap) {
@@ -476,21 +527,30 @@ void GBufferRenderer::recordShadowMap(const FrameWork& work, rg::PassContext& pc
         vkCmdSetViewport(cmd, 0, 1, &viewport);
         vkCmdSetScissor(cmd, 0, 1, &scissor);
         shadowPipeline_.bind(cmd);
-        gpu::PushDescriptors(shadowPipeline_)
-            .storageBuffer(0, slot.frame)
-            .storageBuffer(1, slot.instances)
-            .storageBuffer(2, vertices_)
-            .storageBuffer(3, slot.joints)
-            .storageBuffer(4, slot.previousJoints)
-            .push(ctx_, cmd);
+        const auto pushBindings = [&](const gpu::Buffer& vertices) {
+            gpu::PushDescriptors(shadowPipeline_)
+                .storageBuffer(0, slot.frame)
+                .storageBuffer(1, slot.instances)
+                .storageBuffer(2, vertices)
+                .storageBuffer(3, slot.joints)
+                .storageBuffer(4, slot.previousJoints)
+                .push(ctx_, cmd);
+        };
+        const gpu::Buffer* boundVertices = &vertices_;
+        pushBindings(*boundVertices);
         vkCmdBindIndexBuffer(cmd, indices_.handle(), 0, VK_INDEX_TYPE_UINT32);
         for (size_t i = 0; i < work.instances.size(); ++i) {
+            const auto [vertices, vertexShift] = vertexSource(work, i, slot);
+            if (vertices != boundVertices) {
+                boundVertices = vertices;
+                pushBindings(*boundVertices);
+            }
             for (const DrawRange& range : meshDraws_.at(work.meshes[i])) {
                 if (range.indexCount == 0) continue;
                 shader::GBufferDraw draw{};
                 draw.instance = uint32_t(i);
                 shadowPipeline_.pushConstants(cmd, draw);
-                vkCmdDrawIndexed(cmd, range.indexCount, 1, range.firstIndex, range.vertexOffset, 0);
+                vkCmdDrawIndexed(cmd, range.indexCount, 1, range.firstIndex, range.vertexOffset + vertexShift, 0);
                 ++stats_.shadowDraws;
             }
         }
@@ -538,12 +598,12 @@ void GBufferRenderer::record(const FrameWork& work, rg::PassContext& pc, const G
     vkCmdSetScissor(cmd, 0, 1, &scissor);
 
     // Pushed again only when a draw's normal map differs from the last one.
-    const auto pushBindings = [&](const gpu::Pipeline& pipeline, const gpu::Image& normalImage,
-                                  const gpu::Sampler& normalSampler) {
+    const auto pushBindings = [&](const gpu::Pipeline& pipeline, const gpu::Buffer& vertices,
+                                  const gpu::Image& normalImage, const gpu::Sampler& normalSampler) {
         gpu::PushDescriptors(pipeline)
             .storageBuffer(0, slot.frame)
             .storageBuffer(1, slot.instances)
-            .storageBuffer(2, vertices_)
+            .storageBuffer(2, vertices)
             .storageBuffer(3, slot.joints)
             .storageBuffer(4, slot.previousJoints)
             .sampledImage(kShadowMapBinding, pc.view(targets.shadowMap), nearest_.handle(),
@@ -556,35 +616,40 @@ void GBufferRenderer::record(const FrameWork& work, rg::PassContext& pc, const G
     stats_.triangles = 0;
     stats_.normalMappedDraws = 0;
     surfacePipeline_.bind(cmd);
+    const gpu::Buffer* boundVertices = &vertices_;
     const gpu::Image* boundImage = &flatNormal_;
     const gpu::Sampler* boundSampler = &normalSamplers_[0];
-    pushBindings(surfacePipeline_, *boundImage, *boundSampler);
+    pushBindings(surfacePipeline_, *boundVertices, *boundImage, *boundSampler);
     vkCmdBindIndexBuffer(cmd, indices_.handle(), 0, VK_INDEX_TYPE_UINT32);
     for (size_t i = 0; i < work.instances.size(); ++i) {
+        const auto [vertices, vertexShift] = vertexSource(work, i, slot);
         for (const DrawRange& range : meshDraws_.at(work.meshes[i])) {
             if (range.indexCount == 0) continue;
+            const gpu::Image* image = boundImage;
+            const gpu::Sampler* sampler = boundSampler;
             if (range.material.normalMap != 0) {
-                const gpu::Image* image = &normalImages_[range.normalImage];
-                const gpu::Sampler* sampler = &normalSamplers_[range.normalSampler];
-                if (image != boundImage || sampler != boundSampler) {
-                    boundImage = image;
-                    boundSampler = sampler;
-                    pushBindings(surfacePipeline_, *boundImage, *boundSampler);
-                }
+                image = &normalImages_[range.normalImage];
+                sampler = &normalSamplers_[range.normalSampler];
                 ++stats_.normalMappedDraws;
+            }
+            if (vertices != boundVertices || image != boundImage || sampler != boundSampler) {
+                boundVertices = vertices;
+                boundImage = image;
+                boundSampler = sampler;
+                pushBindings(surfacePipeline_, *boundVertices, *boundImage, *boundSampler);
             }
             shader::GBufferDraw draw = range.material;
             draw.instance = uint32_t(i);
             draw.doubleSided = range.doubleSided ? 1u : 0u;
             surfacePipeline_.pushConstants(cmd, draw);
-            vkCmdDrawIndexed(cmd, range.indexCount, 1, range.firstIndex, range.vertexOffset, 0);
+            vkCmdDrawIndexed(cmd, range.indexCount, 1, range.firstIndex, range.vertexOffset + vertexShift, 0);
             ++stats_.draws;
             stats_.triangles += range.indexCount / 3;
         }
     }
     if (work.drawSky) {
         skyPipeline_.bind(cmd);
-        pushBindings(skyPipeline_, flatNormal_, normalSamplers_[0]);
+        pushBindings(skyPipeline_, vertices_, flatNormal_, normalSamplers_[0]);
         skyPipeline_.pushConstants(cmd, shader::GBufferDraw{});
         vkCmdDraw(cmd, 3, 1, 0, 0);
     }

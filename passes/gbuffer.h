@@ -29,7 +29,10 @@
 // exception: uploaded with their mips and sampled per pixel (tangent space,
 // glTF's TANGENT or generated tangents, normalTexture.scale, the texture
 // coordinate set and KHR_texture_transform the material names). The packed
-// primitives of the RT hits keep the vertex normal.
+// primitives of the RT hits keep the vertex normal. Instances of meshes with
+// morph targets draw from a per-frame copy of their vertices with their
+// morph weights applied on the CPU (scene::morphedGeometry); their motion
+// vectors cover transforms and skins, not last frame's morph.
 
 #include "gpu/context.h"
 #include "gpu/pipeline.h"
@@ -39,8 +42,11 @@
 #include "scene/camera.h"
 #include "scene/scene.h"
 
+#include "glint/gbuffer_shared.h"
+
 #include <cstdint>
 #include <memory>
+#include <utility>
 #include <vector>
 
 namespace glint::passes {
@@ -160,6 +166,14 @@ private:
     void recordShadowMap(const FrameWork& work, rg::PassContext& pc, rg::Texture shadowMap);
     void record(const FrameWork& work, rg::PassContext& pc, const GBufferOutputs& targets);
     void ensureCapacity(gpu::Buffer& buffer, VkDeviceSize bytes, const char* name);
+    // Appends the morphed vertices of `inst` (its mesh's LOD 0 with its
+    // morph weights applied on the CPU) to `out`; their first index, or -1
+    // when the instance does not morph.
+    int64_t appendMorphed(const scene::Instance& inst, std::vector<shader::GBufferVertex>& out) const;
+    // The vertex buffer an instance's draws read and the shift of their
+    // vertex offsets into it.
+    std::pair<const gpu::Buffer*, int32_t> vertexSource(const FrameWork& work, size_t instance,
+                                                        const FrameSlot& slot) const;
 
     gpu::Context& ctx_;
     const scene::Scene& scene_;
@@ -178,6 +192,9 @@ private:
     gpu::Buffer vertices_;  // GBufferVertex, every geometry of every mesh's LOD 0
     gpu::Buffer indices_;
     std::vector<std::vector<DrawRange>> meshDraws_;  // per mesh: its LOD-0 geometries
+    std::vector<int32_t> meshFirstVertex_;           // per mesh: its first vertex in vertices_
+    // Per mesh with morph targets: its vertices as uploaded (else empty).
+    std::vector<std::vector<shader::GBufferVertex>> morphBaseVertices_;
     std::vector<std::unique_ptr<FrameSlot>> slots_;
     GBufferStats stats_;
 };

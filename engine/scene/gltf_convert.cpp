@@ -1233,10 +1233,14 @@ private:
         inst.mesh = uint32_t(src.mesh);
         inst.node = int32_t(n);
         inst.transform = inst.previousTransform = world;
-        // Animated morph weights deform the mesh: an own BLAS, rebuilt when
-        // they change (deformVersion).
-        inst.motion = animatedOrBelowAnimated(n) || morphedNodes_.count(n) ? Motion::Dynamic : Motion::Static;
+        // Morph weights deform the mesh: animated or not zero, the instance
+        // gets a BLAS of its own with its shape (a shared static BLAS holds
+        // the base shape), rebuilt when they change (deformVersion).
         inst.morphWeights = scene_.nodes[n].morphWeights;
+        const bool morphed = morphedNodes_.count(n) != 0 ||
+                             std::any_of(inst.morphWeights.begin(), inst.morphWeights.end(),
+                                         [](float w) { return w != 0.0f; });
+        inst.motion = animatedOrBelowAnimated(n) || morphed ? Motion::Dynamic : Motion::Static;
         if (src.skin >= 0) {
             const std::string where = element("node", n, src.name);
             const size_t joints = scene_.skins[size_t(src.skin)].joints.size();

@@ -20,7 +20,10 @@
 // reference to a higher set is dropped with a warning naming the material.
 // Missing TANGENTs are generated (mesh_tools.h, generateTangents). Morph
 // targets (POSITION, NORMAL, TANGENT) are loaded with the mesh's default
-// weights, node weights and animated `weights` channels; see animation.h.
+// weights, node weights and animated `weights` channels; instances with
+// animated or non-zero weights are Motion::Dynamic, and the CPU applies the
+// weights (animation.h, morphedGeometry) for the G-buffer's and the BVH's
+// vertex data.
 
 #include "scene/scene.h"
 

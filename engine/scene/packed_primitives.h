@@ -36,8 +36,8 @@ UnwrappedGeometry unwrapGeometry(const Scene& scene, const Geometry& geometry,
 
 // The whole pool of `plan` (poolTriangles entries), every BLAS at its
 // range; deformable BLASes use their instance's current joint matrices and
-// morph weights (morph targets apply only here, on the CPU: the GPU pack
-// pass reads the base shape).
+// morph weights (morph targets applied first, as passes::BvhManager feeds
+// the pack pass).
 // Ranges no BLAS owns stay zero.
 std::vector<shader::PackedPrimitive> buildPrimitivePool(const Scene& scene, const BvhPlan& plan);
 

@@ -323,6 +323,38 @@ TEST_CASE("the normal map is sampled through its texture reference's coordinate 
     }
 }
 
+TEST_CASE("a morphing plane is drawn, and casts its shadow, where its morph weights put it") {
+    // A plane at distance 5 whose one morph target moves it 2 towards the
+    // camera: weight 0.5 puts it at distance 4, weight 0 leaves it at 5.
+    for (const float weight : {0.0f, 0.5f}) {
+        INFO("weight " << weight);
+        test::GpuTest gpu;
+        scene::Geometry plane = square({0, 0, -5}, {1, 0, 0}, {0, 1, 0}, 20.0f);
+        scene::MorphTarget target;
+        target.positions.assign(4, {0, 0, 2});
+        plane.morphTargets.push_back(target);
+        scene::Scene s;
+        s.name = "gbuffer-morph-test";
+        s.materials.emplace_back();
+        scene::Mesh mesh;
+        mesh.lods.push_back({{plane}});
+        mesh.morphWeights = {weight};
+        s.meshes.push_back(std::move(mesh));
+        s.instances.push_back({});
+        scene::prepareScene(s);
+        passes::GBufferStats stats;
+        const GBufferImage img = render(gpu, s, {testCamera()}, &stats);
+        CHECK(stats.shadowDraws == 1);
+        const float expectedDepth = kNear / (5.0f - 2.0f * weight);
+        for (uint32_t y = 0; y < kSize; y += 7) {
+            for (uint32_t x = 0; x < kSize; x += 7) {
+                INFO("pixel " << x << ", " << y);
+                REQUIRE(std::abs(img.depth[img.at(x, y)] - expectedDepth) < 1e-5f);
+            }
+        }
+    }
+}
+
 TEST_CASE("a plane the sun grazes is lit by the sky alone: albedo / pi times the hemisphere irradiance") {
     test::GpuTest gpu;
     scene::Material material;

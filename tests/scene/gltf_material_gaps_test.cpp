@@ -294,7 +294,7 @@ TEST_CASE("morph weight 0.5 puts positions and normals halfway between the base 
     REQUIRE(scene.meshes[0].morphWeights == std::vector<float>{0.25f});  // the mesh's default
     const Instance& inst = scene.instances[0];
     REQUIRE(inst.morphWeights == std::vector<float>{0.5f});              // the node's own
-    CHECK(inst.motion == Motion::Static);                                 // nothing animates it
+    CHECK(inst.motion == Motion::Dynamic);  // not the shared BLAS of the base shape
     const Geometry& base = scene.meshes[0].lods[0].geometries[0];
     REQUIRE(base.morphTargets.size() == 1);
     const Geometry morphed = morphedGeometry(base, inst.morphWeights);
