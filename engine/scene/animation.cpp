@@ -267,6 +267,21 @@ void prepareScene(Scene& scene, double seconds) {
         mesh.bounds = Aabb{};
         for (const Geometry& g : mesh.lods[0].geometries) {
             mesh.bounds.extend(g.bounds);
+            // Every shape the morph targets reach with weights in [0, 1]
+            // (the usual range; glTF allows others): per vertex, the base
+            // plus each target's negative or positive displacement.
+            if (g.morphTargets.empty()) continue;
+            for (size_t v = 0; v < g.positions.size(); ++v) {
+                glm::vec3 low = g.positions[v], high = g.positions[v];
+                for (const MorphTarget& target : g.morphTargets) {
+                    if (v < target.positions.size()) {
+                        low += glm::min(target.positions[v], glm::vec3(0.0f));
+                        high += glm::max(target.positions[v], glm::vec3(0.0f));
+                    }
+                }
+                mesh.bounds.extend(low);
+                mesh.bounds.extend(high);
+            }
         }
     }
     uint32_t palette = 0;

@@ -165,7 +165,7 @@ struct Mesh {
     // LOD the reflection BLAS uses. Unset: lods[1] when the mesh has one
     // (Far Cry 6 traces reflections against a lower LOD).
     std::optional<uint32_t> reflectionLod;
-    Aabb bounds;  // of lods[0]
+    Aabb bounds;  // of lods[0], with every shape its morph targets reach at weights in [0, 1]
     // Default morph target weights (glTF mesh.weights, zeros when absent),
     // one per target of each LOD-0 geometry; empty: the mesh does not morph.
     std::vector<float> morphWeights;

@@ -306,6 +306,9 @@ TEST_CASE("morph weight 0.5 puts positions and normals halfway between the base 
         CHECK(morphed.normals[v].z == doctest::Approx(std::sqrt(0.5f)));
     }
     CHECK(morphed.bounds.max.z == doctest::Approx(1.0f));
+    // The mesh's bounds cover the target at full weight.
+    CHECK(scene.meshes[0].bounds.max.z == doctest::Approx(2.0f));
+    CHECK(scene.meshes[0].bounds.min.z == doctest::Approx(0.0f));
 }
 
 TEST_CASE("an animated weights channel drives the instance's morph weights, bumps deformVersion and the BLAS follows") {
