@@ -432,10 +432,16 @@ void BvhManager::recordParticleQuads(const FrameWork& work, VkCommandBuffer cmd,
 
 const gpu::Buffer& BvhManager::morphedVertexBuffer(ResidentBlas& blas, size_t geometryIndex, uint32_t slot,
                                                   VkDeviceSize bytes) {
-    blas.morphedVertices.resize(framesInFlight_);
-    std::vector<gpu::Buffer>& buffers = blas.morphedVertices[slot];
-    buffers.resize(std::max(buffers.size(), geometryIndex + 1));
-    gpu::Buffer& buffer = buffers[geometryIndex];
+    // Sized once for every slot and geometry: the frame's packs keep
+    // pointers to these buffers, which must not move.
+    if (blas.morphedVertices.empty()) {
+        blas.morphedVertices.resize(framesInFlight_);
+        for (std::vector<gpu::Buffer>& buffers : blas.morphedVertices) {
+            buffers.resize(blas.desc.geometries.size());
+        }
+    }
+    std::vector<gpu::Buffer>& buffers = blas.morphedVertices.at(slot);
+    gpu::Buffer& buffer = buffers.at(geometryIndex);
     if (!buffer || buffer.size() < bytes) {
         if (buffer) retire(std::move(buffer));
         buffer = gpu::Buffer(ctx_, {std::max<VkDeviceSize>(bytes, 4), VK_BUFFER_USAGE_STORAGE_BUFFER_BIT,

@@ -597,7 +597,8 @@ void GBufferRenderer::record(const FrameWork& work, rg::PassContext& pc, const G
     vkCmdSetViewport(cmd, 0, 1, &viewport);
     vkCmdSetScissor(cmd, 0, 1, &scissor);
 
-    // Pushed again only when a draw's normal map differs from the last one.
+    // Pushed again only when a draw's vertex buffer (a morphing instance's
+    // own) or normal map differs from the last one.
     const auto pushBindings = [&](const gpu::Pipeline& pipeline, const gpu::Buffer& vertices,
                                   const gpu::Image& normalImage, const gpu::Sampler& normalSampler) {
         gpu::PushDescriptors(pipeline)

@@ -333,8 +333,8 @@ TEST_CASE("the GPU-packed primitive pool of a textured glTF equals the CPU refer
 }
 
 TEST_CASE("a morphing instance's BLAS packs its morphed shape, equal to the CPU reference, and follows new weights") {
-    // A quad whose one morph target lifts it along +z and tilts its normals
-    // towards +x; half weight, then full.
+    // Quads whose one morph target lifts them along +z and tilts their
+    // normals towards +x; half weight, then full.
     scene::Geometry quad;
     quad.positions = {{-1, -1, 0}, {1, -1, 0}, {1, 1, 0}, {-1, 1, 0}};
     quad.normals.assign(4, {0, 0, 1});
@@ -348,7 +348,10 @@ TEST_CASE("a morphing instance's BLAS packs its morphed shape, equal to the CPU 
     s.materials.emplace_back();
     scene::Mesh mesh;
     mesh.name = "morphing quad";
-    mesh.lods.push_back({{quad}});
+    // Two geometries: each BLAS geometry gets morphed vertices of its own.
+    scene::Geometry second = quad;
+    for (glm::vec3& p : second.positions) p.x += 3.0f;
+    mesh.lods.push_back({{quad, second}});
     mesh.morphWeights = {0.5f};
     s.meshes.push_back(std::move(mesh));
     scene::Instance inst;
@@ -364,7 +367,7 @@ TEST_CASE("a morphing instance's BLAS packs its morphed shape, equal to the CPU 
         rig.scene.instances[0].morphWeights = {weight};
         ++rig.scene.instances[0].deformVersion;
         const scene::BvhPlan plan = rig.run();
-        REQUIRE(plan.poolTriangles == 2);
+        REQUIRE(plan.poolTriangles == 4);
         REQUIRE(plan.builds.size() == 1);
         const auto gpuPool = readPool(rig.gpu.ctx(), *rig.bvh, plan.poolTriangles);
         const auto cpuPool = scene::buildPrimitivePool(rig.scene, plan);
