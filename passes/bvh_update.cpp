@@ -3,6 +3,7 @@
 #include "gpu/commands.h"
 #include "gpu/descriptors.h"
 #include "gpu/error.h"
+#include "scene/animation.h"
 #include "scene/packed_primitives.h"
 #include "scene/smoke_scene.h"
 
@@ -35,6 +36,22 @@ constexpr uint64_t kMinScratchBytes = 64 * 1024;
 constexpr uint32_t kMinTlasInstances = 64;
 constexpr uint32_t kMinOffsetEntries = 256;
 constexpr uint32_t kMinParticles = 64;
+
+// The pack pass's source vertices of `g`. Material attributes are sampled
+// here with the CPU reference: texture sampling at the vertices gives the
+// same answer every frame, so doing it per frame on the GPU would cost
+// texture bindings and fetches for nothing. The pack pass then only skins
+// the normal and packs it.
+std::vector<shader::BvhSourceVertex> sourceVertices(const scene::Scene& scene, const scene::Geometry& g) {
+    std::vector<shader::BvhSourceVertex> vertices(g.vertexCount());
+    for (uint32_t v = 0; v < g.vertexCount(); ++v) {
+        const shader::SurfaceVertex s = scene::surfaceAtVertex(scene, g, v);
+        const shader::PackedVertex packed = shader::packVertex(s);
+        vertices[v] = {g.positions[v], s.normal, packed.albedoSmoothness,
+                       packed.normalMetallicReflectance & 0xFFFF0000u};
+    }
+    return vertices;
+}
 
 VkPipelineStageFlags2 traceStages(const gpu::Capabilities& caps) {
     VkPipelineStageFlags2 stages = VK_PIPELINE_STAGE_2_COMPUTE_SHADER_BIT;
@@ -78,6 +95,11 @@ struct BvhManager::ResidentBlas {
     std::vector<const SourceGeometry*> sources;  // per BLAS geometry
     std::optional<gpu::AccelBuild> build;        // geometry addresses into `positions`, reused by rebuilds
     gpu::AccelerationStructure structure;
+    // A morphing instance's BLAS: per frame slot and BLAS geometry, its
+    // source vertices with the instance's morph weights applied on the CPU
+    // (host-visible, written when a build of that slot records; empty for
+    // geometries without morph targets).
+    std::vector<std::vector<gpu::Buffer>> morphedVertices;
 };
 
 struct BvhManager::Retired {
@@ -90,6 +112,10 @@ struct BvhManager::FrameWork {
         const SourceGeometry* source = nullptr;
         const gpu::Buffer* positions = nullptr;
         shader::BvhPackParams params{};
+        // Set for a morphing geometry: read these source vertices instead of
+        // source->vertices, after writing `morphed` into them.
+        const gpu::Buffer* vertices = nullptr;
+        std::vector<shader::BvhSourceVertex> morphed;
     };
     struct Build {
         ResidentBlas* blas = nullptr;
@@ -196,17 +222,8 @@ const BvhManager::SourceGeometry& BvhManager::sourceGeometry(uint32_t mesh, uint
     const scene::Geometry& g = scene_.meshes.at(mesh).lods.at(lod).geometries.at(geometry);
     const std::string name = "bvh." + scene_.meshes[mesh].name + ".lod" + std::to_string(lod) + ".geometry" +
                              std::to_string(geometry);
-    // Material attributes are sampled here, once, with the CPU reference:
-    // texture sampling at the vertices gives the same answer every frame, so
-    // doing it per frame on the GPU would cost texture bindings and fetches
-    // for nothing. The pack pass then only skins the normal and packs it.
-    std::vector<shader::BvhSourceVertex> vertices(g.vertexCount());
-    for (uint32_t v = 0; v < g.vertexCount(); ++v) {
-        const shader::SurfaceVertex s = scene::surfaceAtVertex(scene_, g, v);
-        const shader::PackedVertex packed = shader::packVertex(s);
-        vertices[v] = {g.positions[v], s.normal, packed.albedoSmoothness,
-                       packed.normalMetallicReflectance & 0xFFFF0000u};
-    }
+    // Sampled once: see sourceVertices.
+    const std::vector<shader::BvhSourceVertex> vertices = sourceVertices(scene_, g);
     auto source = std::make_unique<SourceGeometry>();
     source->triangleCount = g.triangleCount();
     // The buffers are filled by the frame's pass (FrameWork::uploads); the
@@ -438,6 +455,26 @@ void BvhManager::recordParticleQuads(const FrameWork& work, VkCommandBuffer cmd,
                   1, 1);
 }
 
+const gpu::Buffer& BvhManager::morphedVertexBuffer(ResidentBlas& blas, size_t geometryIndex, uint32_t slot,
+                                                  VkDeviceSize bytes) {
+    // Sized once for every slot and geometry: the frame's packs keep
+    // pointers to these buffers, which must not move.
+    if (blas.morphedVertices.empty()) {
+        blas.morphedVertices.resize(framesInFlight_);
+        for (std::vector<gpu::Buffer>& buffers : blas.morphedVertices) {
+            buffers.resize(blas.desc.geometries.size());
+        }
+    }
+    std::vector<gpu::Buffer>& buffers = blas.morphedVertices.at(slot);
+    gpu::Buffer& buffer = buffers.at(geometryIndex);
+    if (!buffer || buffer.size() < bytes) {
+        if (buffer) retire(std::move(buffer));
+        buffer = gpu::Buffer(ctx_, {std::max<VkDeviceSize>(bytes, 4), VK_BUFFER_USAGE_STORAGE_BUFFER_BIT,
+                                    gpu::MemoryUsage::Upload, "bvh.morphed_vertices", true});
+    }
+    return buffer;
+}
+
 std::shared_ptr<BvhManager::FrameWork> BvhManager::prepare(const scene::BvhPlan& plan, const scene::Camera* camera) {
     ++frame_;
     collectRetired();
@@ -513,7 +550,20 @@ std::shared_ptr<BvhManager::FrameWork> BvhManager::prepare(const scene::BvhPlan&
         for (size_t g = 0; g < desc->geometries.size(); ++g) {
             const scene::BlasGeometry& geometry = desc->geometries[g];
             const SourceGeometry* source = blas.sources[g];
-            FrameWork::Pack pack{source, &blas.positions, {}};
+            FrameWork::Pack pack{source, &blas.positions, {}, nullptr, {}};
+            // A morphing instance's own BLAS packs its morphed shape: the
+            // weights as they are when the frame is declared (like the
+            // joints), applied on the CPU, written when the pass records.
+            const scene::Geometry& sourceShape =
+                scene_.meshes.at(desc->mesh).lods.at(desc->lod).geometries.at(geometry.meshGeometry);
+            if (desc->instance != scene::kNone && !sourceShape.morphTargets.empty()) {
+                const std::vector<float>& weights = scene_.instances.at(size_t(desc->instance)).morphWeights;
+                if (!weights.empty()) {
+                    pack.morphed = sourceVertices(scene_, scene::morphedGeometry(sourceShape, weights));
+                    pack.vertices = &morphedVertexBuffer(blas, g, work->slot,
+                                                         pack.morphed.size() * sizeof(shader::BvhSourceVertex));
+                }
+            }
             pack.params.triangleCount = geometry.triangleCount;
             pack.params.poolOffset = geometry.poolOffset;
             pack.params.positionOffset = 3 * first;
@@ -596,6 +646,12 @@ void BvhManager::record(FrameWork& work, rg::PassContext& pc, const BvhUpdateOut
     if (!work.offsets.empty()) {
         std::memcpy(offsetStaging_[slot].mapped(), work.offsets.data(), work.offsets.size() * sizeof(uint32_t));
     }
+    for (const FrameWork::Pack& pack : work.packs) {
+        if (pack.vertices && !pack.morphed.empty()) {
+            std::memcpy(pack.vertices->mapped(), pack.morphed.data(),
+                        pack.morphed.size() * sizeof(shader::BvhSourceVertex));
+        }
+    }
     const bool particles = !work.particles.empty();
     if (particles) {
         std::memcpy(particleStaging_[slot].mapped(), work.particles.data(),
@@ -653,7 +709,7 @@ void BvhManager::record(FrameWork& work, rg::PassContext& pc, const BvhUpdateOut
         for (const FrameWork::Pack& pack : work.packs) {
             const gpu::Buffer& skin = pack.source->skin ? pack.source->skin : pack.source->vertices;
             gpu::PushDescriptors(packPipeline_)
-                .storageBuffer(0, pack.source->vertices)
+                .storageBuffer(0, pack.vertices ? *pack.vertices : pack.source->vertices)
                 .storageBuffer(1, pack.source->indices)
                 .storageBuffer(2, skin)  // unread when jointCount is 0; the binding must still be valid
                 .storageBuffer(3, jointPalettes_[slot])

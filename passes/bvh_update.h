@@ -4,11 +4,12 @@
 // BvhManager owns what lives across frames: the reflection-LOD geometry of
 // every mesh a BLAS was built from (uploaded once, material sampled at the
 // vertices on the CPU, copied from staging inside the update pass of the
-// frame that first builds it: no submission of its own, no host wait), one
-// AccelerationStructure per resident BLAS, the unwrapped build positions of
-// the deformable ones, the one primitive pool (PackedPrimitive per
-// triangle, glint/packing.h), the primitive offset buffer, the TLAS and its
-// per-frame instance buffers.
+// frame that first builds it: no submission of its own, no host wait; a
+// morphing instance's own BLAS instead gets its morphed vertices, morph
+// targets applied on the CPU, per build), one AccelerationStructure per
+// resident BLAS, the unwrapped build positions of the deformable ones, the
+// one primitive pool (PackedPrimitive per triangle, glint/packing.h), the
+// primitive offset buffer, the TLAS and its per-frame instance buffers.
 //
 // addBvhUpdatePass() declares the frame's builds as ONE render-graph pass on
 // the async compute queue (the graphics queue on one-queue devices, or where
@@ -169,6 +170,9 @@ private:
     void record(FrameWork& work, rg::PassContext& pc, const BvhUpdateOutputs& handles);
     const SourceGeometry& sourceGeometry(uint32_t mesh, uint32_t lod, uint32_t geometry, FrameWork& work);
     ResidentBlas& createBlas(const scene::BlasDesc& desc, FrameWork& work);
+    // A morphing instance's BLAS geometry: its host-visible source vertex
+    // buffer of frame slot `slot`, at least `bytes` large.
+    const gpu::Buffer& morphedVertexBuffer(ResidentBlas& blas, size_t geometryIndex, uint32_t slot, VkDeviceSize bytes);
     void ensurePool(uint32_t triangles, FrameWork& work);
     void ensureTlas(uint32_t instances);
     void ensureOffsets(size_t entries);

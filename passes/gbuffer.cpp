@@ -5,6 +5,7 @@
 #include "gpu/error.h"
 #include "graph/executor.h"
 #include "passes/environment.h"
+#include "scene/animation.h"
 #include "scene/packed_primitives.h"
 
 #include "glint/gbuffer_shared.h"
@@ -39,11 +40,31 @@ std::vector<gpu::Binding> geometryBindings() {
 // and the prefiltered environment (glint/environment.glsl).
 constexpr uint32_t kShadowMapBinding = 5;
 constexpr uint32_t kEnvironmentBinding = 6;
+constexpr uint32_t kNormalMapBinding = 7;
 std::vector<gpu::Binding> gbufferBindings() {
     std::vector<gpu::Binding> bindings = geometryBindings();
     bindings.push_back({kShadowMapBinding, VK_DESCRIPTOR_TYPE_COMBINED_IMAGE_SAMPLER, VK_SHADER_STAGE_FRAGMENT_BIT});
     bindings.push_back({kEnvironmentBinding, VK_DESCRIPTOR_TYPE_COMBINED_IMAGE_SAMPLER, VK_SHADER_STAGE_FRAGMENT_BIT});
+    bindings.push_back({kNormalMapBinding, VK_DESCRIPTOR_TYPE_COMBINED_IMAGE_SAMPLER, VK_SHADER_STAGE_FRAGMENT_BIT});
     return bindings;
+}
+
+VkSamplerAddressMode addressMode(scene::Wrap wrap) {
+    switch (wrap) {
+    case scene::Wrap::ClampToEdge: return VK_SAMPLER_ADDRESS_MODE_CLAMP_TO_EDGE;
+    case scene::Wrap::MirroredRepeat: return VK_SAMPLER_ADDRESS_MODE_MIRRORED_REPEAT;
+    case scene::Wrap::Repeat: break;
+    }
+    return VK_SAMPLER_ADDRESS_MODE_REPEAT;
+}
+
+// A scene texture no material uses as its normal texture.
+constexpr size_t kNoImage = std::numeric_limits<size_t>::max();
+
+// glTF's three wrap modes for S and T: nine samplers.
+constexpr size_t kWrapModes = 3;
+size_t samplerIndex(const scene::TextureRef& ref) {
+    return size_t(ref.wrapS) * kWrapModes + size_t(ref.wrapT);
 }
 
 // Shadows fade out over the last tenth of SunShadowSettings::maxDistance.
@@ -196,12 +217,18 @@ struct GBufferRenderer::DrawRange {
     uint32_t indexCount = 0;
     int32_t vertexOffset = 0;
     bool doubleSided = false;
+    // The draw's push constants less the instance; normalMap = 1 with
+    // normalImage and normalSampler set.
+    shader::GBufferDraw material{};
+    size_t normalImage = 0;
+    size_t normalSampler = 0;
 };
 
 // Host-visible buffers of one frame in flight, written when the frame
 // records (the executor has waited for the slot's previous frame by then).
 struct GBufferRenderer::FrameSlot {
     gpu::Buffer frame;
+    gpu::Buffer morphedVertices;  // this frame's morphing instances (FrameWork::morphedVertices)
     gpu::Buffer instances;
     gpu::Buffer joints;
     gpu::Buffer previousJoints;
@@ -216,6 +243,11 @@ struct GBufferRenderer::FrameWork {
     std::vector<uint32_t> meshes;  // per instance
     std::vector<glm::mat4> joints;
     std::vector<glm::mat4> previousJoints;
+    // Morphing instances: the mesh's vertices with the instance's weights
+    // applied, end to end; per instance the first of them, or -1 (the
+    // shared vertex buffer).
+    std::vector<shader::GBufferVertex> morphedVertices;
+    std::vector<int64_t> morphedFirstVertex;
 };
 
 GBufferRenderer::GBufferRenderer(gpu::Context& ctx, const scene::Scene& scene, uint32_t framesInFlight)
@@ -259,20 +291,65 @@ GBufferRenderer::GBufferRenderer(gpu::Context& ctx, const scene::Scene& scene, u
                                   VK_SAMPLER_ADDRESS_MODE_CLAMP_TO_EDGE, 0.0f, "gbuffer.nearest"});
     environmentSampler_ = createEnvironmentSampler(ctx, "gbuffer.environment");
 
+    for (size_t wrapS = 0; wrapS < kWrapModes; ++wrapS) {
+        for (size_t wrapT = 0; wrapT < kWrapModes; ++wrapT) {
+            gpu::SamplerDesc desc{VK_FILTER_LINEAR, VK_SAMPLER_MIPMAP_MODE_LINEAR,
+                                  addressMode(scene::Wrap(wrapS)), VK_LOD_CLAMP_NONE, "gbuffer.normal_map"};
+            desc.addressV = addressMode(scene::Wrap(wrapT));
+            normalSamplers_.emplace_back(ctx, desc);
+        }
+    }
+    // (0.5, 0.5, 1): the unperturbed normal; bound where a draw has no
+    // normal map so the binding is always valid.
+    const std::array<uint8_t, 4> flat = {128, 128, 255, 255};
+    flatNormal_ = gpu::createSampledImageWithMips(
+        ctx, {.width = 1, .height = 1, .format = VK_FORMAT_R8G8B8A8_UNORM, .name = "gbuffer.flat_normal"}, flat.data());
+    // Normal textures, each once however many materials share it. Linear
+    // (UNORM): glTF normal textures hold vectors, not colours.
+    std::vector<size_t> normalImageOf(scene.textures.size(), kNoImage);
+    for (const scene::Material& material : scene.materials) {
+        const scene::TextureRef& ref = material.normalTexture;
+        if (!ref.valid() || normalImageOf.at(size_t(ref.texture)) != kNoImage) continue;
+        const scene::Texture& texture = scene.textures[size_t(ref.texture)];
+        if (texture.format != scene::TextureFormat::Rgba8) continue;
+        normalImageOf[size_t(ref.texture)] = normalImages_.size();
+        normalImages_.push_back(gpu::createSampledImageWithMips(ctx,
+                                                                {.width = texture.width,
+                                                                 .height = texture.height,
+                                                                 .format = VK_FORMAT_R8G8B8A8_UNORM,
+                                                                 .name = "gbuffer.normal_map." + texture.name},
+                                                                texture.rgba8.data()));
+    }
+    stats_.normalMaps = uint32_t(normalImages_.size());
+
     // Every mesh's LOD 0 into one vertex and one index buffer: one binding
     // for the whole frame, draws differ only in their ranges.
     std::vector<shader::GBufferVertex> vertices;
     std::vector<uint32_t> indices;
     meshDraws_.resize(scene.meshes.size());
+    meshFirstVertex_.assign(scene.meshes.size(), 0);
+    morphBaseVertices_.resize(scene.meshes.size());
     for (size_t m = 0; m < scene.meshes.size(); ++m) {
         const scene::Mesh& mesh = scene.meshes[m];
+        meshFirstVertex_[m] = int32_t(vertices.size());
         if (mesh.lods.empty()) continue;
         for (const scene::Geometry& g : mesh.lods[0].geometries) {
             DrawRange range;
             range.firstIndex = uint32_t(indices.size());
             range.indexCount = uint32_t(g.indices.size());
             range.vertexOffset = int32_t(vertices.size());
-            range.doubleSided = scene.materials.at(g.material).doubleSided;
+            const scene::Material& material = scene.materials.at(g.material);
+            range.doubleSided = material.doubleSided;
+            const scene::TextureRef& normalRef = material.normalTexture;
+            if (normalRef.valid() && normalImageOf.at(size_t(normalRef.texture)) != kNoImage &&
+                g.tangents.size() == g.vertexCount()) {
+                range.material.normalMap = 1;
+                range.material.normalTexCoord = normalRef.texCoord;
+                range.material.normalUvTransform = normalRef.uvTransform();
+                range.material.normalScale = material.normalScale;
+                range.normalImage = normalImageOf[size_t(normalRef.texture)];
+                range.normalSampler = samplerIndex(normalRef);
+            }
             for (uint32_t v = 0; v < g.vertexCount(); ++v) {
                 const shader::SurfaceVertex s = scene::surfaceAtVertex(scene, g, v);
                 shader::GBufferVertex out{};
@@ -287,10 +364,18 @@ GBufferRenderer::GBufferRenderer(gpu::Context& ctx, const scene::Scene& scene, u
                     out.joints = {uint32_t(j.x) | uint32_t(j.y) << 16, uint32_t(j.z) | uint32_t(j.w) << 16};
                     out.weights = g.weights[v];
                 }
+                out.tangent = v < g.tangents.size() ? g.tangents[v] : glm::vec4(1.0f, 0.0f, 0.0f, 1.0f);
+                out.uv0 = v < g.texcoords0.size() ? g.texcoords0[v] : glm::vec2(0.0f);
+                out.uv1 = v < g.texcoords1.size() ? g.texcoords1[v] : glm::vec2(0.0f);
                 vertices.push_back(out);
             }
             indices.insert(indices.end(), g.indices.begin(), g.indices.end());
             meshDraws_[m].push_back(range);
+        }
+        if (!mesh.morphWeights.empty()) {
+            // Kept for the per-frame morphed copies: materials and skins stay,
+            // positions, normals and tangents are replaced.
+            morphBaseVertices_[m].assign(vertices.begin() + meshFirstVertex_[m], vertices.end());
         }
     }
     // Vulkan buffers cannot be empty; an empty scene still binds something.
@@ -351,6 +436,7 @@ std::shared_ptr<GBufferRenderer::FrameWork> GBufferRenderer::prepare(const GBuff
         }
         work->instances.push_back(gi);
         work->meshes.push_back(inst.mesh);
+        work->morphedFirstVertex.push_back(appendMorphed(inst, work->morphedVertices));
     }
     work->joints = scene_.jointMatrices;
     work->previousJoints = scene_.previousJointMatrices;
@@ -360,8 +446,35 @@ std::shared_ptr<GBufferRenderer::FrameWork> GBufferRenderer::prepare(const GBuff
     return work;
 }
 
+int64_t GBufferRenderer::appendMorphed(const scene::Instance& inst, std::vector<shader::GBufferVertex>& out) const {
+    if (inst.mesh >= scene_.meshes.size() || inst.morphWeights.empty() || morphBaseVertices_[inst.mesh].empty()) {
+        return -1;
+    }
+    const int64_t first = int64_t(out.size());
+    const std::vector<shader::GBufferVertex>& base = morphBaseVertices_[inst.mesh];
+    size_t v = 0;
+    for (const scene::Geometry& g : scene_.meshes[inst.mesh].lods[0].geometries) {
+        const scene::Geometry morphed = scene::morphedGeometry(g, inst.morphWeights);
+        for (uint32_t k = 0; k < morphed.vertexCount(); ++k, ++v) {
+            shader::GBufferVertex vertex = base.at(v);
+            vertex.position = morphed.positions[k];
+            if (k < morphed.normals.size()) vertex.normal = morphed.normals[k];
+            if (k < morphed.tangents.size()) vertex.tangent = morphed.tangents[k];
+            out.push_back(vertex);
+        }
+    }
+    return first;
+}
+
 void GBufferRenderer::upload(const FrameWork& work) {
     FrameSlot& slot = *slots_[work.slot];
+    ensureCapacity(slot.morphedVertices,
+                   std::max<size_t>(work.morphedVertices.size(), 1) * sizeof(shader::GBufferVertex),
+                   "gbuffer.morphed_vertices");
+    if (!work.morphedVertices.empty()) {
+        std::memcpy(slot.morphedVertices.mapped(), work.morphedVertices.data(),
+                    work.morphedVertices.size() * sizeof(shader::GBufferVertex));
+    }
 
     // Host writes before the submit are visible to the device without a
     // barrier; this slot's previous frame has finished.
@@ -381,6 +494,14 @@ void GBufferRenderer::upload(const FrameWork& work) {
         std::memcpy(slot.previousJoints.mapped(), work.previousJoints.data(),
                     work.previousJoints.size() * sizeof(glm::mat4));
     }
+}
+
+std::pair<const gpu::Buffer*, int32_t> GBufferRenderer::vertexSource(const FrameWork& work, size_t instance,
+                                                                     const FrameSlot& slot) const {
+    const int64_t first = work.morphedFirstVertex[instance];
+    if (first < 0) return {&vertices_, 0};
+    // The morphed copy lies at `first`; the draw ranges index the shared buffer.
+    return {&slot.morphedVertices, int32_t(first) - meshFirstVertex_[work.meshes[instance]]};
 }
 
 void GBufferRenderer::recordShadowMap(const FrameWork& work, rg::PassContext& pc, rg::Texture shadowMap) {
@@ -411,19 +532,30 @@ void GBufferRenderer::recordShadowMap(const FrameWork& work, rg::PassContext& pc
         vkCmdSetViewport(cmd, 0, 1, &viewport);
         vkCmdSetScissor(cmd, 0, 1, &scissor);
         shadowPipeline_.bind(cmd);
-        gpu::PushDescriptors(shadowPipeline_)
-            .storageBuffer(0, slot.frame)
-            .storageBuffer(1, slot.instances)
-            .storageBuffer(2, vertices_)
-            .storageBuffer(3, slot.joints)
-            .storageBuffer(4, slot.previousJoints)
-            .push(ctx_, cmd);
+        const auto pushBindings = [&](const gpu::Buffer& vertices) {
+            gpu::PushDescriptors(shadowPipeline_)
+                .storageBuffer(0, slot.frame)
+                .storageBuffer(1, slot.instances)
+                .storageBuffer(2, vertices)
+                .storageBuffer(3, slot.joints)
+                .storageBuffer(4, slot.previousJoints)
+                .push(ctx_, cmd);
+        };
+        const gpu::Buffer* boundVertices = &vertices_;
+        pushBindings(*boundVertices);
         vkCmdBindIndexBuffer(cmd, indices_.handle(), 0, VK_INDEX_TYPE_UINT32);
         for (size_t i = 0; i < work.instances.size(); ++i) {
+            const auto [vertices, vertexShift] = vertexSource(work, i, slot);
+            if (vertices != boundVertices) {
+                boundVertices = vertices;
+                pushBindings(*boundVertices);
+            }
             for (const DrawRange& range : meshDraws_.at(work.meshes[i])) {
                 if (range.indexCount == 0) continue;
-                shadowPipeline_.pushConstants(cmd, shader::GBufferDraw{uint32_t(i), 0u});
-                vkCmdDrawIndexed(cmd, range.indexCount, 1, range.firstIndex, range.vertexOffset, 0);
+                shader::GBufferDraw draw{};
+                draw.instance = uint32_t(i);
+                shadowPipeline_.pushConstants(cmd, draw);
+                vkCmdDrawIndexed(cmd, range.indexCount, 1, range.firstIndex, range.vertexOffset + vertexShift, 0);
                 ++stats_.shadowDraws;
             }
         }
@@ -471,15 +603,19 @@ void GBufferRenderer::record(const FrameWork& work, rg::PassContext& pc, const G
     vkCmdSetViewport(cmd, 0, 1, &viewport);
     vkCmdSetScissor(cmd, 0, 1, &scissor);
 
-    const auto pushBindings = [&](const gpu::Pipeline& pipeline) {
+    // Pushed again only when a draw's vertex buffer (a morphing instance's
+    // own) or normal map differs from the last one.
+    const auto pushBindings = [&](const gpu::Pipeline& pipeline, const gpu::Buffer& vertices,
+                                  const gpu::Image& normalImage, const gpu::Sampler& normalSampler) {
         gpu::PushDescriptors push(pipeline);
         push.storageBuffer(0, slot.frame)
             .storageBuffer(1, slot.instances)
-            .storageBuffer(2, vertices_)
+            .storageBuffer(2, vertices)
             .storageBuffer(3, slot.joints)
             .storageBuffer(4, slot.previousJoints)
             .sampledImage(kShadowMapBinding, pc.view(targets.shadowMap), nearest_.handle(),
-                          pc.layout(targets.shadowMap));
+                          pc.layout(targets.shadowMap))
+            .sampledImage(kNormalMapBinding, normalImage.view(), normalSampler.handle());
         // The procedural sky reads no texture: the shadow map, which the
         // pass reads anyway, fills the environment's binding.
         if (environment.valid()) {
@@ -494,22 +630,43 @@ void GBufferRenderer::record(const FrameWork& work, rg::PassContext& pc, const G
 
     stats_.draws = 0;
     stats_.triangles = 0;
+    stats_.normalMappedDraws = 0;
     surfacePipeline_.bind(cmd);
-    pushBindings(surfacePipeline_);
+    const gpu::Buffer* boundVertices = &vertices_;
+    const gpu::Image* boundImage = &flatNormal_;
+    const gpu::Sampler* boundSampler = &normalSamplers_[0];
+    pushBindings(surfacePipeline_, *boundVertices, *boundImage, *boundSampler);
     vkCmdBindIndexBuffer(cmd, indices_.handle(), 0, VK_INDEX_TYPE_UINT32);
     for (size_t i = 0; i < work.instances.size(); ++i) {
+        const auto [vertices, vertexShift] = vertexSource(work, i, slot);
         for (const DrawRange& range : meshDraws_.at(work.meshes[i])) {
             if (range.indexCount == 0) continue;
-            surfacePipeline_.pushConstants(cmd, shader::GBufferDraw{uint32_t(i), range.doubleSided ? 1u : 0u});
-            vkCmdDrawIndexed(cmd, range.indexCount, 1, range.firstIndex, range.vertexOffset, 0);
+            const gpu::Image* image = boundImage;
+            const gpu::Sampler* sampler = boundSampler;
+            if (range.material.normalMap != 0) {
+                image = &normalImages_[range.normalImage];
+                sampler = &normalSamplers_[range.normalSampler];
+                ++stats_.normalMappedDraws;
+            }
+            if (vertices != boundVertices || image != boundImage || sampler != boundSampler) {
+                boundVertices = vertices;
+                boundImage = image;
+                boundSampler = sampler;
+                pushBindings(surfacePipeline_, *boundVertices, *boundImage, *boundSampler);
+            }
+            shader::GBufferDraw draw = range.material;
+            draw.instance = uint32_t(i);
+            draw.doubleSided = range.doubleSided ? 1u : 0u;
+            surfacePipeline_.pushConstants(cmd, draw);
+            vkCmdDrawIndexed(cmd, range.indexCount, 1, range.firstIndex, range.vertexOffset + vertexShift, 0);
             ++stats_.draws;
             stats_.triangles += range.indexCount / 3;
         }
     }
     if (work.drawSky) {
         skyPipeline_.bind(cmd);
-        pushBindings(skyPipeline_);
-        skyPipeline_.pushConstants(cmd, shader::GBufferDraw{0, 0});
+        pushBindings(skyPipeline_, vertices_, flatNormal_, normalSamplers_[0]);
+        skyPipeline_.pushConstants(cmd, shader::GBufferDraw{});
         vkCmdDraw(cmd, 3, 1, 0, 0);
     }
     vkCmdEndRendering(cmd);

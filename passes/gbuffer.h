@@ -24,8 +24,15 @@
 // smaller, on a world-fixed texel grid so it does not shimmer as the camera
 // moves. It needs no BVH, so every mode and device gets the same shadows.
 // Materials are sampled at the vertices on the CPU (scene::surfaceAtVertex,
-// as the BVH's packed primitives are), so textures contribute at vertex
-// rate and normal maps not at all.
+// as the BVH's packed primitives are), so base colour and metallic-
+// roughness textures contribute at vertex rate. Normal maps are the
+// exception: uploaded with their mips and sampled per pixel (tangent space,
+// glTF's TANGENT or generated tangents, normalTexture.scale, the texture
+// coordinate set and KHR_texture_transform the material names). The packed
+// primitives of the RT hits keep the vertex normal. Instances of meshes with
+// morph targets draw from a per-frame copy of their vertices with their
+// morph weights applied on the CPU (scene::morphedGeometry); their motion
+// vectors cover transforms and skins, not last frame's morph.
 
 #include "gpu/context.h"
 #include "gpu/pipeline.h"
@@ -35,9 +42,12 @@
 #include "scene/camera.h"
 #include "scene/scene.h"
 
+#include "glint/gbuffer_shared.h"
+
 #include <cstdint>
 #include <memory>
 #include <optional>
+#include <utility>
 #include <vector>
 
 namespace glint::passes {
@@ -131,6 +141,8 @@ struct GBufferStats {
     // This frame's shadow map fit (enabled = 0 with shadows off).
     shader::GBufferShadow shadow{};
     uint64_t geometryBytes = 0;   // the uploaded vertex and index buffers
+    uint32_t normalMaps = 0;      // normal textures uploaded
+    uint32_t normalMappedDraws = 0;  // this frame
 };
 
 // Owns the scene's GPU geometry (every mesh's LOD 0, uploaded once into one
@@ -162,6 +174,14 @@ private:
     void recordShadowMap(const FrameWork& work, rg::PassContext& pc, rg::Texture shadowMap);
     void record(const FrameWork& work, rg::PassContext& pc, const GBufferOutputs& targets, rg::Texture environment);
     void ensureCapacity(gpu::Buffer& buffer, VkDeviceSize bytes, const char* name);
+    // Appends the morphed vertices of `inst` (its mesh's LOD 0 with its
+    // morph weights applied on the CPU) to `out`; their first index, or -1
+    // when the instance does not morph.
+    int64_t appendMorphed(const scene::Instance& inst, std::vector<shader::GBufferVertex>& out) const;
+    // The vertex buffer an instance's draws read and the shift of their
+    // vertex offsets into it.
+    std::pair<const gpu::Buffer*, int32_t> vertexSource(const FrameWork& work, size_t instance,
+                                                        const FrameSlot& slot) const;
 
     gpu::Context& ctx_;
     const scene::Scene& scene_;
@@ -172,9 +192,18 @@ private:
     gpu::Pipeline shadowPipeline_;
     gpu::Sampler nearest_;  // completes the shadow map's descriptor; reads are texelFetch
     gpu::Sampler environmentSampler_;
+    // Normal maps: one image per scene texture some material uses as its
+    // normal texture (by scene texture index), a 1x1 flat one bound to
+    // draws without, and one sampler per glTF wrap-mode pair.
+    std::vector<gpu::Image> normalImages_;
+    gpu::Image flatNormal_;
+    std::vector<gpu::Sampler> normalSamplers_;
     gpu::Buffer vertices_;  // GBufferVertex, every geometry of every mesh's LOD 0
     gpu::Buffer indices_;
     std::vector<std::vector<DrawRange>> meshDraws_;  // per mesh: its LOD-0 geometries
+    std::vector<int32_t> meshFirstVertex_;           // per mesh: its first vertex in vertices_
+    // Per mesh with morph targets: its vertices as uploaded (else empty).
+    std::vector<std::vector<shader::GBufferVertex>> morphBaseVertices_;
     std::vector<std::unique_ptr<FrameSlot>> slots_;
     GBufferStats stats_;
 };

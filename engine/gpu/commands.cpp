@@ -6,6 +6,7 @@
 
 #include <algorithm>
 #include <string>
+#include <bit>
 
 namespace glint::gpu {
 
@@ -197,6 +198,69 @@ Buffer createBufferWithData(Context& ctx, const BufferDesc& desc, const void* da
     Buffer buffer(ctx, d);
     uploadBuffer(ctx, buffer, data, d.size);
     return buffer;
+}
+
+Image createSampledImageWithMips(Context& ctx, const ImageDesc& desc, const void* texels) {
+    ImageDesc d = desc;
+    d.mips = uint32_t(std::bit_width(std::max(d.width, d.height)));
+    d.usage |= VK_IMAGE_USAGE_SAMPLED_BIT | VK_IMAGE_USAGE_TRANSFER_SRC_BIT | VK_IMAGE_USAGE_TRANSFER_DST_BIT;
+    Image image(ctx, d);
+    const VkDeviceSize bytes = VkDeviceSize(d.width) * d.height * bytesPerTexel(d.format);
+    Buffer staging(ctx, {bytes, VK_BUFFER_USAGE_TRANSFER_SRC_BIT, MemoryUsage::Upload, d.name + ".staging"});
+    std::memcpy(staging.mapped(), texels, bytes);
+    submitAndWait(ctx, ctx.graphicsQueue(), "upload " + d.name, [&](VkCommandBuffer cmd) {
+        const auto mipBarrier = [&](uint32_t mip, VkImageLayout from, VkImageLayout to, VkPipelineStageFlags2 srcStage,
+                                    VkAccessFlags2 srcAccess, VkPipelineStageFlags2 dstStage,
+                                    VkAccessFlags2 dstAccess) {
+            VkImageMemoryBarrier2 b{VK_STRUCTURE_TYPE_IMAGE_MEMORY_BARRIER_2};
+            b.srcStageMask = srcStage;
+            b.srcAccessMask = srcAccess;
+            b.dstStageMask = dstStage;
+            b.dstAccessMask = dstAccess;
+            b.oldLayout = from;
+            b.newLayout = to;
+            b.srcQueueFamilyIndex = b.dstQueueFamilyIndex = VK_QUEUE_FAMILY_IGNORED;
+            b.image = image.handle();
+            b.subresourceRange = {VK_IMAGE_ASPECT_COLOR_BIT, mip, 1, 0, 1};
+            VkDependencyInfo dep{VK_STRUCTURE_TYPE_DEPENDENCY_INFO};
+            dep.imageMemoryBarrierCount = 1;
+            dep.pImageMemoryBarriers = &b;
+            vkCmdPipelineBarrier2(cmd, &dep);
+        };
+        // Every mip to TRANSFER_DST; mip 0 gets the texels.
+        for (uint32_t mip = 0; mip < d.mips; ++mip) {
+            mipBarrier(mip, VK_IMAGE_LAYOUT_UNDEFINED, VK_IMAGE_LAYOUT_TRANSFER_DST_OPTIMAL, VK_PIPELINE_STAGE_2_NONE, 0,
+                       VK_PIPELINE_STAGE_2_ALL_TRANSFER_BIT, VK_ACCESS_2_TRANSFER_WRITE_BIT);
+        }
+        VkBufferImageCopy region{};
+        region.imageSubresource = {VK_IMAGE_ASPECT_COLOR_BIT, 0, 0, 1};
+        region.imageExtent = {d.width, d.height, 1};
+        vkCmdCopyBufferToImage(cmd, staging.handle(), image.handle(), VK_IMAGE_LAYOUT_TRANSFER_DST_OPTIMAL, 1, &region);
+        // Each mip from the one above it, which then becomes readable.
+        for (uint32_t mip = 1; mip < d.mips; ++mip) {
+            mipBarrier(mip - 1, VK_IMAGE_LAYOUT_TRANSFER_DST_OPTIMAL, VK_IMAGE_LAYOUT_TRANSFER_SRC_OPTIMAL,
+                       VK_PIPELINE_STAGE_2_ALL_TRANSFER_BIT, VK_ACCESS_2_TRANSFER_WRITE_BIT,
+                       VK_PIPELINE_STAGE_2_ALL_TRANSFER_BIT, VK_ACCESS_2_TRANSFER_READ_BIT);
+            const int32_t srcW = int32_t(std::max(d.width >> (mip - 1), 1u));
+            const int32_t srcH = int32_t(std::max(d.height >> (mip - 1), 1u));
+            const int32_t dstW = int32_t(std::max(d.width >> mip, 1u));
+            const int32_t dstH = int32_t(std::max(d.height >> mip, 1u));
+            VkImageBlit blit{};
+            blit.srcSubresource = {VK_IMAGE_ASPECT_COLOR_BIT, mip - 1, 0, 1};
+            blit.srcOffsets[1] = {srcW, srcH, 1};
+            blit.dstSubresource = {VK_IMAGE_ASPECT_COLOR_BIT, mip, 0, 1};
+            blit.dstOffsets[1] = {dstW, dstH, 1};
+            vkCmdBlitImage(cmd, image.handle(), VK_IMAGE_LAYOUT_TRANSFER_SRC_OPTIMAL, image.handle(),
+                           VK_IMAGE_LAYOUT_TRANSFER_DST_OPTIMAL, 1, &blit, VK_FILTER_LINEAR);
+            mipBarrier(mip - 1, VK_IMAGE_LAYOUT_TRANSFER_SRC_OPTIMAL, VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL,
+                       VK_PIPELINE_STAGE_2_ALL_TRANSFER_BIT, VK_ACCESS_2_TRANSFER_READ_BIT,
+                       VK_PIPELINE_STAGE_2_ALL_COMMANDS_BIT, VK_ACCESS_2_MEMORY_READ_BIT);
+        }
+        mipBarrier(d.mips - 1, VK_IMAGE_LAYOUT_TRANSFER_DST_OPTIMAL, VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL,
+                   VK_PIPELINE_STAGE_2_ALL_TRANSFER_BIT, VK_ACCESS_2_TRANSFER_WRITE_BIT,
+                   VK_PIPELINE_STAGE_2_ALL_COMMANDS_BIT, VK_ACCESS_2_MEMORY_READ_BIT);
+    });
+    return image;
 }
 
 std::vector<std::byte> readbackBuffer(Context& ctx, const Buffer& src, const Queue* queue) {

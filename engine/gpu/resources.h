@@ -125,8 +125,9 @@ struct SamplerDesc {
     VkSamplerAddressMode address = VK_SAMPLER_ADDRESS_MODE_CLAMP_TO_EDGE;
     float maxLod = VK_LOD_CLAMP_NONE;
     std::string name;
-    // V and W where they differ from `address` (an equirectangular image
-    // repeats in u and clamps at the poles).
+    // V's (and W's) address mode where it differs from `address` (U's):
+    // glTF samplers wrap S and T independently; an equirectangular image
+    // repeats in u and clamps at the poles.
     std::optional<VkSamplerAddressMode> addressV;
 };
 

@@ -77,17 +77,90 @@ glm::vec4 sampleAnimation(const AnimationSampler& sampler, AnimationPath path, f
     return finish(value(k0));
 }
 
+void sampleMorphWeights(const AnimationSampler& sampler, float seconds, std::span<float> out) {
+    const size_t count = sampler.weightCount;
+    const std::vector<float>& times = sampler.times;
+    const bool cubic = sampler.interpolation == Interpolation::CubicSpline;
+    const size_t stride = cubic ? 3 : 1;
+    if (times.empty() || count == 0 || sampler.weights.size() < times.size() * stride * count) {
+        return;
+    }
+    // Element w of the value (cubic: in-tangent 0, value 1, out-tangent 2) of `key`.
+    const auto at = [&](size_t key, size_t part, size_t w) { return sampler.weights[(key * stride + part) * count + w]; };
+    const size_t valuePart = cubic ? 1 : 0;
+    const size_t n = std::min(out.size(), count);
+    if (!(seconds > times.front()) || seconds >= times.back()) {  // also catches NaN
+        const size_t key = seconds >= times.back() ? times.size() - 1 : 0;
+        for (size_t w = 0; w < n; ++w) out[w] = at(key, valuePart, w);
+        return;
+    }
+    const size_t k1 = size_t(std::upper_bound(times.begin(), times.end(), seconds) - times.begin());
+    const size_t k0 = k1 - 1;
+    const float dt = times[k1] - times[k0];
+    const float s = dt > 0.0f ? (seconds - times[k0]) / dt : 0.0f;
+    for (size_t w = 0; w < n; ++w) {
+        switch (sampler.interpolation) {
+        case Interpolation::Step: out[w] = at(k0, 0, w); break;
+        case Interpolation::Linear: out[w] = at(k0, 0, w) + (at(k1, 0, w) - at(k0, 0, w)) * s; break;
+        case Interpolation::CubicSpline: {
+            // The same Hermite basis as sampleAnimation.
+            const float s2 = s * s;
+            const float s3 = s2 * s;
+            out[w] = (2.0f * s3 - 3.0f * s2 + 1.0f) * at(k0, 1, w) + (s3 - 2.0f * s2 + s) * at(k0, 2, w) * dt +
+                     (-2.0f * s3 + 3.0f * s2) * at(k1, 1, w) + (s3 - s2) * at(k1, 0, w) * dt;
+            break;
+        }
+        }
+    }
+}
+
+Geometry morphedGeometry(const Geometry& base, std::span<const float> weights) {
+    Geometry g = base;
+    const size_t targets = std::min(weights.size(), base.morphTargets.size());
+    for (size_t t = 0; t < targets; ++t) {
+        const float w = weights[t];
+        const MorphTarget& target = base.morphTargets[t];
+        if (w == 0.0f) continue;
+        for (size_t v = 0; v < target.positions.size() && v < g.positions.size(); ++v) {
+            g.positions[v] += w * target.positions[v];
+        }
+        for (size_t v = 0; v < target.normals.size() && v < g.normals.size(); ++v) {
+            g.normals[v] += w * target.normals[v];
+        }
+        for (size_t v = 0; v < target.tangents.size() && v < g.tangents.size(); ++v) {
+            g.tangents[v] += glm::vec4(w * target.tangents[v], 0.0f);
+        }
+    }
+    if (targets > 0) {
+        for (glm::vec3& n : g.normals) {
+            const float len = glm::length(n);
+            n = len > 0.0f ? n / len : glm::vec3(0.0f, 1.0f, 0.0f);
+        }
+        for (glm::vec4& t : g.tangents) {
+            const float len = glm::length(glm::vec3(t));
+            t = len > 0.0f ? glm::vec4(glm::vec3(t) / len, t.w) : glm::vec4(1.0f, 0.0f, 0.0f, t.w);
+        }
+        g.bounds = computeBounds(g.positions);
+    }
+    return g;
+}
+
 void applyAnimation(const Animation& animation, float seconds, std::span<Node> nodes) {
     for (const AnimationChannel& channel : animation.channels) {
         if (channel.sampler >= animation.samplers.size() || channel.node >= nodes.size()) {
             continue;  // validateScene reports these; evaluation just skips them
         }
-        const glm::vec4 v = sampleAnimation(animation.samplers[channel.sampler], channel.path, seconds);
         Node& node = nodes[channel.node];
+        if (channel.path == AnimationPath::Weights) {
+            sampleMorphWeights(animation.samplers[channel.sampler], seconds, node.morphWeights);
+            continue;
+        }
+        const glm::vec4 v = sampleAnimation(animation.samplers[channel.sampler], channel.path, seconds);
         switch (channel.path) {
         case AnimationPath::Translation: node.translation = glm::vec3(v); break;
         case AnimationPath::Rotation: node.rotation = toQuat(v); break;
         case AnimationPath::Scale: node.scale = glm::vec3(v); break;
+        case AnimationPath::Weights: break;
         }
     }
 }
@@ -156,6 +229,14 @@ void evaluate(Scene& scene, double seconds, const Camera* camera, bool trackDefo
     for (Instance& inst : scene.instances) {
         if (inst.node != kNone) {
             inst.transform = world[size_t(inst.node)];
+            const std::vector<float>& weights = scene.nodes[size_t(inst.node)].morphWeights;
+            if (!inst.morphWeights.empty() && weights.size() == inst.morphWeights.size() &&
+                weights != inst.morphWeights) {
+                inst.morphWeights = weights;
+                if (trackDeformation) {
+                    ++inst.deformVersion;
+                }
+            }
         }
     }
     for (Instance& inst : scene.instances) {
@@ -186,10 +267,28 @@ void prepareScene(Scene& scene, double seconds) {
         mesh.bounds = Aabb{};
         for (const Geometry& g : mesh.lods[0].geometries) {
             mesh.bounds.extend(g.bounds);
+            // Every shape the morph targets reach with weights in [0, 1]
+            // (the usual range; glTF allows others): per vertex, the base
+            // plus each target's negative or positive displacement.
+            if (g.morphTargets.empty()) continue;
+            for (size_t v = 0; v < g.positions.size(); ++v) {
+                glm::vec3 low = g.positions[v], high = g.positions[v];
+                for (const MorphTarget& target : g.morphTargets) {
+                    if (v < target.positions.size()) {
+                        low += glm::min(target.positions[v], glm::vec3(0.0f));
+                        high += glm::max(target.positions[v], glm::vec3(0.0f));
+                    }
+                }
+                mesh.bounds.extend(low);
+                mesh.bounds.extend(high);
+            }
         }
     }
     uint32_t palette = 0;
     for (Instance& inst : scene.instances) {
+        if (inst.morphWeights.empty()) {
+            inst.morphWeights = scene.meshes[inst.mesh].morphWeights;
+        }
         if (inst.motion == Motion::Skinned) {
             inst.jointOffset = palette;
             palette += uint32_t(scene.skins[size_t(inst.skin)].joints.size());

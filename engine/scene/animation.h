@@ -16,7 +16,18 @@ namespace glint::scene {
 // xyzw.
 glm::vec4 sampleAnimation(const AnimationSampler& sampler, AnimationPath path, float seconds);
 
-// Writes the TRS of every node `animation` targets, evaluated at `seconds`.
+// Morph target weights of a Weights sampler at `seconds` into `out`
+// (sampler.weightCount entries), clamped to the first and last keys.
+void sampleMorphWeights(const AnimationSampler& sampler, float seconds, std::span<float> out);
+
+// `base` with its morph targets applied (glTF 2.0 3.7.2.2): positions,
+// normals and tangents plus the weighted sum of the targets' displacements,
+// normals and tangents renormalised (the tangent keeps its sign). Weights
+// past the geometry's targets are ignored; missing ones count as 0.
+Geometry morphedGeometry(const Geometry& base, std::span<const float> weights);
+
+// Writes the TRS (and morph weights) of every node `animation` targets,
+// evaluated at `seconds`.
 void applyAnimation(const Animation& animation, float seconds, std::span<Node> nodes);
 
 // World transform of every node. Throws SceneError on a parent cycle.
@@ -38,7 +49,8 @@ void prepareScene(Scene& scene, double seconds = 0.0);
 // Every frame: keeps this frame's instance transforms and joint matrices as
 // last frame's, places the camera node at `camera` (when both exist), plays
 // the scene's animations at `seconds`, and bumps the deformVersion of every
-// skinned instance whose joint matrices changed.
+// skinned instance whose joint matrices changed and of every instance whose
+// morph weights changed.
 void advanceScene(Scene& scene, double seconds, const Camera* camera = nullptr);
 
 } // namespace glint::scene

@@ -19,6 +19,7 @@
 #include <cstring>
 #include <limits>
 #include <optional>
+#include <tuple>
 
 namespace glint::scene::gltf {
 
@@ -242,6 +243,17 @@ private:
     AccessorRule texcoordRule(const char* semantic) const {
         return {semantic, kVec2, true, kUByte | kUShort | (quantized_ ? kByte | kShort : 0u),
                 quantized_ ? kByte | kUByte | kShort | kUShort : 0u};
+    }
+    // glTF 2.0 3.7.2.2 and KHR_mesh_quantization: displacements.
+    AccessorRule morphPositionRule() const {
+        const uint32_t q = quantized_ ? kByte | kShort : 0u;
+        return {"morph target POSITION", kVec3, true, q, q};
+    }
+    AccessorRule morphDirectionRule(const char* semantic) const {
+        return {semantic, kVec3, true, quantized_ ? kByte | kShort : 0u, 0u};
+    }
+    AccessorRule weightsOutputRule() const {
+        return {"output", kScalar, true, kByte | kUByte | kShort | kUShort, 0u};
     }
     static AccessorRule colorRule() { return {"COLOR_0", kVec3 | kVec4, true, kUByte | kUShort, 0u}; }
     static AccessorRule jointsRule() { return {"JOINTS_0", kVec4, false, 0u, kUByte | kUShort}; }
@@ -479,8 +491,28 @@ private:
         }
     }
 
-    TextureRef textureRef(int textureIndex, int texCoord, const std::string& where) {
+    // Texture coordinate sets the loader keeps (Geometry::texcoords0/1).
+    static constexpr int kTexCoordSets = 2;
+
+    // A number of a KHR_texture_transform member, or `fallback` if absent.
+    glm::vec2 transformPair(const tinygltf::Value& ext, const char* key, glm::vec2 fallback,
+                            const std::string& where) const {
+        if (!ext.Has(key)) {
+            return fallback;
+        }
+        const tinygltf::Value& v = ext.Get(key);
+        if (!v.IsArray() || v.ArrayLen() != 2 || !v.Get(0).IsNumber() || !v.Get(1).IsNumber()) {
+            fail(where, std::string("KHR_texture_transform ") + key + " is not an array of two numbers");
+        }
+        return {finiteNumber(v.Get(0).GetNumberAsDouble(), where, key),
+                finiteNumber(v.Get(1).GetNumberAsDouble(), where, key)};
+    }
+
+    // glTF textureInfo (index, texCoord, extensions) -> TextureRef, with
+    // KHR_texture_transform (offset, rotation, scale, texCoord override).
+    template <typename Info> TextureRef textureRef(const Info& info, const std::string& where) {
         TextureRef ref;
+        const int textureIndex = info.index;
         if (textureIndex == -1) {
             return ref;
         }
@@ -488,14 +520,38 @@ private:
             fail(where, "texture " + std::to_string(textureIndex) + " out of range (" +
                             std::to_string(model_.textures.size()) + " textures)");
         }
+        int texCoord = info.texCoord;
+        if (const auto it = info.extensions.find("KHR_texture_transform"); it != info.extensions.end()) {
+            const tinygltf::Value& ext = it->second;
+            if (!ext.IsObject()) {
+                fail(where, "KHR_texture_transform is not an object");
+            }
+            ref.offset = transformPair(ext, "offset", glm::vec2(0.0f), where);
+            ref.scale = transformPair(ext, "scale", glm::vec2(1.0f), where);
+            if (ext.Has("rotation")) {
+                if (!ext.Get("rotation").IsNumber()) {
+                    fail(where, "KHR_texture_transform rotation is not a number");
+                }
+                ref.rotation = finiteNumber(ext.Get("rotation").GetNumberAsDouble(), where, "rotation");
+            }
+            if (ext.Has("texCoord")) {
+                const tinygltf::Value& tc = ext.Get("texCoord");
+                const double v = tc.IsNumber() ? tc.GetNumberAsDouble() : -1.0;
+                if (!(v >= 0.0 && v <= 65535.0) || v != std::floor(v)) {
+                    fail(where, "KHR_texture_transform texCoord must be a non-negative integer");
+                }
+                texCoord = int(v);
+            }
+        }
         if (texCoord < 0) {
-            fail(where, "texCoord " + std::to_string(texCoord));
+            fail(where, "texCoord " + std::to_string(texCoord) + " (must be a non-negative integer)");
         }
         if (!context_.options.loadTextures) {
             return ref;
         }
-        if (texCoord > 1) {
-            warn(where, "uses TEXCOORD_" + std::to_string(texCoord) + ", which is not loaded; flat fallback");
+        if (texCoord >= kTexCoordSets) {
+            warn(where, "uses TEXCOORD_" + std::to_string(texCoord) +
+                            " (only TEXCOORD_0 and TEXCOORD_1 are supported); the texture is not used");
             return ref;
         }
         const tinygltf::Texture& texture = model_.textures[size_t(textureIndex)];
@@ -572,16 +628,11 @@ private:
             }
             m.alphaCutoff = finiteNumber(src.alphaCutoff, where, "alphaCutoff");
             m.doubleSided = src.doubleSided;
-            m.baseColorTexture =
-                textureRef(pbr.baseColorTexture.index, pbr.baseColorTexture.texCoord, where + " baseColorTexture");
-            m.metallicRoughnessTexture =
-                textureRef(pbr.metallicRoughnessTexture.index, pbr.metallicRoughnessTexture.texCoord,
-                           where + " metallicRoughnessTexture");
-            m.normalTexture = textureRef(src.normalTexture.index, src.normalTexture.texCoord, where + " normalTexture");
-            m.emissiveTexture =
-                textureRef(src.emissiveTexture.index, src.emissiveTexture.texCoord, where + " emissiveTexture");
-            m.occlusionTexture =
-                textureRef(src.occlusionTexture.index, src.occlusionTexture.texCoord, where + " occlusionTexture");
+            m.baseColorTexture = textureRef(pbr.baseColorTexture, where + " baseColorTexture");
+            m.metallicRoughnessTexture = textureRef(pbr.metallicRoughnessTexture, where + " metallicRoughnessTexture");
+            m.normalTexture = textureRef(src.normalTexture, where + " normalTexture");
+            m.emissiveTexture = textureRef(src.emissiveTexture, where + " emissiveTexture");
+            m.occlusionTexture = textureRef(src.occlusionTexture, where + " occlusionTexture");
 
             if (const auto it = src.extensions.find("KHR_materials_emissive_strength"); it != src.extensions.end()) {
                 const tinygltf::Value& strength = it->second.Get("emissiveStrength");
@@ -630,14 +681,14 @@ private:
             Mesh& mesh = scene_.meshes[m];
             mesh.name = src.name;
             mesh.lods.resize(1);
-            bool warnedMorph = false;
             bool warnedMode = false;
             for (size_t p = 0; p < src.primitives.size(); ++p) {
                 const tinygltf::Primitive& prim = src.primitives[p];
                 const std::string context = nameOr(src.name, "mesh", m) + " primitive " + std::to_string(p);
-                if (!prim.targets.empty() && !warnedMorph) {
-                    warn(element("mesh", m, src.name), "morph targets are ignored");
-                    warnedMorph = true;
+                if (p > 0 && prim.targets.size() != src.primitives[0].targets.size()) {
+                    fail(context, std::to_string(prim.targets.size()) + " morph targets, but primitive 0 has " +
+                                      std::to_string(src.primitives[0].targets.size()) +
+                                      " (glTF requires the same number in every primitive)");
                 }
                 const int mode = prim.mode == -1 ? TINYGLTF_MODE_TRIANGLES : prim.mode;
                 if (mode >= TINYGLTF_MODE_POINTS && mode <= TINYGLTF_MODE_LINE_STRIP) {
@@ -657,6 +708,16 @@ private:
                 }
                 Geometry g = convertPrimitive(prim, mode, context);
                 mesh.lods[0].geometries.push_back(std::move(g));
+            }
+            const size_t targets = src.primitives.empty() ? 0 : src.primitives[0].targets.size();
+            const std::string meshWhere = element("mesh", m, src.name);
+            if (!src.weights.empty() && src.weights.size() != targets) {
+                fail(meshWhere, "weights has " + std::to_string(src.weights.size()) + " numbers for " +
+                                    std::to_string(targets) + " morph targets");
+            }
+            mesh.morphWeights.assign(targets, 0.0f);
+            for (size_t t = 0; t < src.weights.size(); ++t) {
+                mesh.morphWeights[t] = finiteNumber(src.weights[t], meshWhere, "weights");
             }
         }
     }
@@ -757,6 +818,23 @@ private:
             g.material = uint32_t(prim.material);
         }
 
+        // Every texture the material samples needs its coordinate set here
+        // (the glTF validator's MESH_PRIMITIVE_TOO_FEW_TEXCOORDS).
+        const Material& material = scene_.materials[g.material];
+        for (const auto& [ref, slot] : {std::pair{&material.baseColorTexture, "baseColorTexture"},
+                                        std::pair{&material.metallicRoughnessTexture, "metallicRoughnessTexture"},
+                                        std::pair{&material.normalTexture, "normalTexture"},
+                                        std::pair{&material.emissiveTexture, "emissiveTexture"},
+                                        std::pair{&material.occlusionTexture, "occlusionTexture"}}) {
+            const bool present = ref->texCoord == 0 ? !g.texcoords0.empty() : !g.texcoords1.empty();
+            if (ref->valid() && !present) {
+                fail(context, element("material", g.material, material.name) + " " + slot + " uses TEXCOORD_" +
+                                  std::to_string(ref->texCoord) + ", which the primitive does not have");
+            }
+        }
+
+        convertMorphTargets(prim, g, context);
+
         if (g.normals.empty()) {
             // glTF 2.0 3.7.2.1: without normals, flat normals.
             context_.chargeDecoded(g.indices.size() * (sizeof(glm::vec3) * 2 + sizeof(glm::vec2)), context);
@@ -768,10 +846,55 @@ private:
             }
         }
         if (g.tangents.empty()) {
+            // From the coordinates the normal map is sampled with.
             context_.chargeDecoded(g.positions.size() * sizeof(glm::vec4), context);
-            generateTangents(g);
+            generateTangents(g, material.normalTexture.valid() ? material.normalTexture.texCoord : 0);
+        } else {
+            // glTF: unit xyz, w = +-1 (the bitangent's sign). A zero tangent
+            // becomes any vector perpendicular to the normal.
+            for (size_t v = 0; v < g.tangents.size(); ++v) {
+                glm::vec4& t = g.tangents[v];
+                const glm::vec3 xyz(t);
+                const float len = glm::length(xyz);
+                t = glm::vec4(len > 0.0f ? xyz / len : anyPerpendicular(g.normals[v]), t.w < 0.0f ? -1.0f : 1.0f);
+            }
         }
         return g;
+    }
+
+    // glTF morph targets of `prim` (per-vertex displacements) into `g`.
+    void convertMorphTargets(const tinygltf::Primitive& prim, Geometry& g, const std::string& context) {
+        const size_t n = g.positions.size();
+        for (size_t t = 0; t < prim.targets.size(); ++t) {
+            const std::string targetWhere = context + " target " + std::to_string(t);
+            MorphTarget target;
+            for (const auto& [semantic, index] : prim.targets[t]) {
+                const std::string where = targetWhere + " " + semantic;
+                std::vector<glm::vec3>* out = nullptr;
+                AccessorRule rule;
+                if (semantic == "POSITION") {
+                    out = &target.positions;
+                    rule = morphPositionRule();
+                } else if (semantic == "NORMAL") {
+                    out = &target.normals;
+                    rule = morphDirectionRule("morph target NORMAL");
+                } else if (semantic == "TANGENT") {
+                    out = &target.tangents;
+                    rule = morphDirectionRule("morph target TANGENT");
+                } else {
+                    spdlog::debug("{}: {}: morph target attribute {} is not used", context_.file, targetWhere,
+                                  semantic);
+                    continue;
+                }
+                const CheckedAccessor c = checkAccessor(index, where, rule);
+                if (c.count != n) {
+                    fail(c.element, "morph target " + semantic + " count " + std::to_string(c.count) +
+                                        " differs from POSITION count " + std::to_string(n));
+                }
+                *out = toVectors<glm::vec3>(readFloats(c), 3);
+            }
+            g.morphTargets.push_back(std::move(target));
+        }
     }
 
     std::vector<uint32_t> toTriangleList(const std::vector<uint32_t>& indices, int mode,
@@ -840,6 +963,22 @@ private:
             if (src.mesh < -1 || src.mesh >= int(model_.meshes.size())) {
                 fail(where, "mesh " + std::to_string(src.mesh) + " out of range (" +
                                 std::to_string(model_.meshes.size()) + " meshes)");
+            }
+            if (src.mesh >= 0) {
+                node.morphWeights = scene_.meshes[size_t(src.mesh)].morphWeights;
+            }
+            if (!src.weights.empty()) {
+                if (src.mesh < 0) {
+                    fail(where, "has weights but no mesh");
+                }
+                if (src.weights.size() != node.morphWeights.size()) {
+                    fail(where, "weights has " + std::to_string(src.weights.size()) + " numbers for the " +
+                                    std::to_string(node.morphWeights.size()) + " morph targets of mesh " +
+                                    std::to_string(src.mesh));
+                }
+                for (size_t t = 0; t < src.weights.size(); ++t) {
+                    node.morphWeights[t] = finiteNumber(src.weights[t], where, "weights");
+                }
             }
             if (src.skin < -1 || src.skin >= int(model_.skins.size())) {
                 fail(where, "skin " + std::to_string(src.skin) + " out of range (" +
@@ -916,8 +1055,9 @@ private:
 
     // ----- animations ------------------------------------------------------
 
+    // `weightCount`: morph targets of the animated node's mesh (Weights only).
     AnimationSampler convertSampler(const tinygltf::Animation& anim, int samplerIndex, AnimationPath path,
-                                    const std::string& where) {
+                                    const std::string& where, size_t weightCount) {
         const tinygltf::AnimationSampler& src = anim.samplers[size_t(samplerIndex)];
         const std::string samplerWhere = where + " sampler " + std::to_string(samplerIndex);
         AnimationSampler out;
@@ -937,8 +1077,19 @@ private:
                 fail(input.element, "key times decrease at key " + std::to_string(k));
             }
         }
-        const CheckedAccessor output = checkAccessor(src.output, samplerWhere + " output", animationOutputRule(path));
         const size_t perKey = out.interpolation == Interpolation::CubicSpline ? 3 : 1;
+        if (path == AnimationPath::Weights) {
+            const CheckedAccessor output = checkAccessor(src.output, samplerWhere + " output", weightsOutputRule());
+            if (output.count != input.count * perKey * weightCount) {
+                fail(output.element, std::to_string(output.count) + " values for " + std::to_string(input.count) +
+                                         " keys of " + std::to_string(weightCount) + " morph target weights" +
+                                         (perKey == 3 ? " (CUBICSPLINE needs 3 per key)" : ""));
+            }
+            out.weights = readFloats(output);
+            out.weightCount = uint32_t(weightCount);
+            return out;
+        }
+        const CheckedAccessor output = checkAccessor(src.output, samplerWhere + " output", animationOutputRule(path));
         if (output.count != input.count * perKey) {
             fail(output.element, std::to_string(output.count) + " values for " + std::to_string(input.count) + " keys" +
                                      (perKey == 3 ? " (CUBICSPLINE needs 3 per key)" : ""));
@@ -955,8 +1106,7 @@ private:
             anim.name = src.name;
             // glTF samplers -> scene samplers, per path (a sampler's output
             // type follows the path of the channels using it).
-            std::map<std::pair<int, AnimationPath>, uint32_t> converted;
-            bool warnedWeights = false;
+            std::map<std::tuple<int, AnimationPath, size_t>, uint32_t> converted;
             for (size_t c = 0; c < src.channels.size(); ++c) {
                 const tinygltf::AnimationChannel& ch = src.channels[c];
                 const std::string channelWhere = where + " channel " + std::to_string(c);
@@ -979,26 +1129,28 @@ private:
                 } else if (ch.target_path == "scale") {
                     path = AnimationPath::Scale;
                 } else if (ch.target_path == "weights") {
-                    if (!warnedWeights) {
-                        warn(where, "morph target weights are not animated");
-                        warnedWeights = true;
-                    }
-                    continue;
+                    path = AnimationPath::Weights;
                 } else {
                     fail(channelWhere, "target path '" + ch.target_path + "'");
                 }
-                if (scene_.nodes[size_t(ch.target_node)].matrix) {
+                const size_t weightCount = scene_.nodes[size_t(ch.target_node)].morphWeights.size();
+                if (path == AnimationPath::Weights && weightCount == 0) {
+                    fail(channelWhere, "animates the weights of node " + std::to_string(ch.target_node) +
+                                           ", whose mesh has no morph targets");
+                }
+                if (path != AnimationPath::Weights && scene_.nodes[size_t(ch.target_node)].matrix) {
                     fail(channelWhere, "targets node " + std::to_string(ch.target_node) +
                                            ", which has a matrix (glTF allows animating TRS nodes only)");
                 }
-                const auto key = std::make_pair(ch.sampler, path);
+                const size_t keyWeights = path == AnimationPath::Weights ? weightCount : 0;
+                const auto key = std::make_tuple(ch.sampler, path, keyWeights);
                 auto it = converted.find(key);
                 if (it == converted.end()) {
                     it = converted.emplace(key, uint32_t(anim.samplers.size())).first;
-                    anim.samplers.push_back(convertSampler(src, ch.sampler, path, where));
+                    anim.samplers.push_back(convertSampler(src, ch.sampler, path, where, keyWeights));
                 }
                 anim.channels.push_back({it->second, uint32_t(ch.target_node), path});
-                animatedNodes_.insert(uint32_t(ch.target_node));
+                (path == AnimationPath::Weights ? morphedNodes_ : animatedNodes_).insert(uint32_t(ch.target_node));
             }
             scene_.animations.push_back(std::move(anim));
         }
@@ -1081,7 +1233,14 @@ private:
         inst.mesh = uint32_t(src.mesh);
         inst.node = int32_t(n);
         inst.transform = inst.previousTransform = world;
-        inst.motion = animatedOrBelowAnimated(n) ? Motion::Dynamic : Motion::Static;
+        // Morph weights deform the mesh: animated or not zero, the instance
+        // gets a BLAS of its own with its shape (a shared static BLAS holds
+        // the base shape), rebuilt when they change (deformVersion).
+        inst.morphWeights = scene_.nodes[n].morphWeights;
+        const bool morphed = morphedNodes_.count(n) != 0 ||
+                             std::any_of(inst.morphWeights.begin(), inst.morphWeights.end(),
+                                         [](float w) { return w != 0.0f; });
+        inst.motion = animatedOrBelowAnimated(n) || morphed ? Motion::Dynamic : Motion::Static;
         if (src.skin >= 0) {
             const std::string where = element("node", n, src.name);
             const size_t joints = scene_.skins[size_t(src.skin)].joints.size();
@@ -1184,7 +1343,8 @@ private:
     std::optional<uint32_t> defaultMaterial_;
     std::map<int, int32_t> imageTextures_;
     std::set<int> warnedTextures_;
-    std::set<uint32_t> animatedNodes_;
+    std::set<uint32_t> animatedNodes_;  // by translation, rotation or scale
+    std::set<uint32_t> morphedNodes_;   // by weights
     bool sunFound_ = false;
     bool cameraFound_ = false;
 };

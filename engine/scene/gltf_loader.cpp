@@ -32,8 +32,9 @@
 namespace glint::scene {
 
 bool isSupportedGltfExtension(std::string_view name) {
-    static constexpr std::array<std::string_view, 4> kSupported = {
-        "KHR_materials_emissive_strength", "KHR_lights_punctual", "KHR_materials_ior", "KHR_mesh_quantization"};
+    static constexpr std::array<std::string_view, 5> kSupported = {"KHR_materials_emissive_strength",
+                                                                   "KHR_lights_punctual", "KHR_materials_ior",
+                                                                   "KHR_mesh_quantization", "KHR_texture_transform"};
     return std::find(kSupported.begin(), kSupported.end(), name) != kSupported.end();
 }
 
@@ -569,9 +570,14 @@ Scene loadGltf(const std::filesystem::path& path, const GltfLoadOptions& options
         begin = end + 1;
     }
 
-    std::set<std::string> ignored;
+    std::set<std::string> seen;
     for (const std::string& ext : model.extensionsUsed) {
-        if (!isSupportedGltfExtension(ext) && ignored.insert(ext).second) {
+        if (!seen.insert(ext).second) {
+            continue;
+        }
+        if (isSupportedGltfExtension(ext)) {
+            spdlog::debug("{}: using glTF extension {}", file, ext);
+        } else {
             spdlog::info("{}: ignoring glTF extension {} (not supported)", file, ext);
         }
     }

@@ -11,8 +11,19 @@
 //
 // Supported extensions: KHR_materials_emissive_strength,
 // KHR_lights_punctual (the first directional light becomes the sun),
-// KHR_materials_ior (as reflectance), KHR_mesh_quantization. Others are
-// ignored with one log line each, unless the file requires them.
+// KHR_materials_ior (as reflectance), KHR_mesh_quantization,
+// KHR_texture_transform (per texture reference: offset, rotation, scale,
+// texCoord). Others are ignored with one log line each, unless the file
+// requires them.
+//
+// Texture coordinate sets TEXCOORD_0 and TEXCOORD_1 are loaded; a texture
+// reference to a higher set is dropped with a warning naming the material.
+// Missing TANGENTs are generated (mesh_tools.h, generateTangents). Morph
+// targets (POSITION, NORMAL, TANGENT) are loaded with the mesh's default
+// weights, node weights and animated `weights` channels; instances with
+// animated or non-zero weights are Motion::Dynamic, and the CPU applies the
+// weights (animation.h, morphedGeometry) for the G-buffer's and the BVH's
+// vertex data.
 
 #include "scene/scene.h"
 

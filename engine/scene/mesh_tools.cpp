@@ -45,6 +45,13 @@ void generateFlatNormals(Geometry& g) {
     unweld(g.colors, g.indices);
     unweld(g.joints, g.indices);
     unweld(g.weights, g.indices);
+    for (MorphTarget& target : g.morphTargets) {
+        unweld(target.positions, g.indices);
+        unweld(target.tangents, g.indices);
+        // Flat normals are not morphed: a target's normal displacements
+        // belong to the file's smooth normals, which this geometry lacks.
+        target.normals.clear();
+    }
     g.normals.resize(g.positions.size());
     for (size_t t = 0; t + 2 < g.positions.size(); t += 3) {
         const glm::vec3 n = faceNormal(g.positions[t], g.positions[t + 1], g.positions[t + 2]);
@@ -62,17 +69,18 @@ glm::vec3 anyPerpendicular(const glm::vec3& n) {
     return {1.0f + sign * n.x * n.x * a, sign * b, -sign * n.x};
 }
 
-void generateTangents(Geometry& g) {
+void generateTangents(Geometry& g, uint32_t texCoord) {
     const size_t n = g.positions.size();
     g.tangents.assign(n, glm::vec4(0.0f));
     std::vector<glm::vec3> bitangents(n, glm::vec3(0.0f));
-    if (!g.texcoords0.empty()) {
+    const std::vector<glm::vec2>& uvs = texCoord == 1 ? g.texcoords1 : g.texcoords0;
+    if (uvs.size() == n) {
         for (size_t t = 0; t + 2 < g.indices.size(); t += 3) {
             const uint32_t i0 = g.indices[t], i1 = g.indices[t + 1], i2 = g.indices[t + 2];
             const glm::vec3 e1 = g.positions[i1] - g.positions[i0];
             const glm::vec3 e2 = g.positions[i2] - g.positions[i0];
-            const glm::vec2 d1 = g.texcoords0[i1] - g.texcoords0[i0];
-            const glm::vec2 d2 = g.texcoords0[i2] - g.texcoords0[i0];
+            const glm::vec2 d1 = uvs[i1] - uvs[i0];
+            const glm::vec2 d2 = uvs[i2] - uvs[i0];
             const float det = d1.x * d2.y - d2.x * d1.y;
             if (!(std::abs(det) > 1e-20f) || !std::isfinite(det)) {
                 continue;  // no UV parameterisation on this triangle
@@ -94,7 +102,11 @@ void generateTangents(Geometry& g) {
         const float len = glm::length(t);
         if (len > 1e-12f && std::isfinite(len)) {
             t /= len;
-            const float w = glm::dot(glm::cross(normal, t), bitangents[i]) < 0.0f ? -1.0f : 1.0f;
+            // glTF's bitangent cross(N, T) * w points along decreasing v (up
+            // the image: glTF's v runs down it), the opposite of dP/dv; the
+            // sign MikkTSpace gives on glTF coordinates, negated (as three.js
+            // does for glTF, computeMikkTSpaceTangents' negateSign).
+            const float w = glm::dot(glm::cross(normal, t), bitangents[i]) > 0.0f ? -1.0f : 1.0f;
             g.tangents[i] = glm::vec4(t, w);
         } else {
             g.tangents[i] = glm::vec4(anyPerpendicular(normal), 1.0f);

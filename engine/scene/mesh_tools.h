@@ -13,13 +13,17 @@ Aabb computeBounds(std::span<const glm::vec3> positions);
 // triangle gets its own three vertices (all attributes are unwelded).
 void generateFlatNormals(Geometry& geometry);
 
-// Per-vertex tangents (w = bitangent sign) from texcoords0 by accumulating
-// per-triangle UV derivatives (Lengyel, "Computing Tangent Space Basis
-// Vectors for an Arbitrary Mesh", 2001), orthogonalised against the normal.
-// Vertices without usable UVs get any tangent perpendicular to the normal
-// (Duff et al., "Building an Orthonormal Basis, Revisited", JCGT 2017).
-// Requires normals.
-void generateTangents(Geometry& geometry);
+// Per-vertex tangents (w = bitangent sign, glTF convention: bitangent =
+// cross(normal, tangent) * w) from texture coordinate set `texCoord` (0 or
+// 1) by accumulating area-weighted per-triangle UV derivatives (Lengyel,
+// "Computing Tangent Space Basis Vectors for an Arbitrary Mesh", 2001),
+// orthogonalised against the normal (Gram-Schmidt). Not full MikkTSpace:
+// no angle weighting and no splitting of vertices whose triangles disagree
+// on handedness, so normal maps baked by MikkTSpace match on smooth,
+// unmirrored regions and differ slightly on seams. Vertices without usable
+// UVs get any tangent perpendicular to the normal (Duff et al., "Building
+// an Orthonormal Basis, Revisited", JCGT 2017). Requires normals.
+void generateTangents(Geometry& geometry, uint32_t texCoord = 0);
 
 // A unit vector perpendicular to unit vector `n` (Duff et al. 2017).
 glm::vec3 anyPerpendicular(const glm::vec3& n);

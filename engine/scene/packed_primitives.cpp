@@ -1,5 +1,7 @@
 #include "scene/packed_primitives.h"
 
+#include "scene/animation.h"
+
 #include <algorithm>
 
 namespace glint::scene {
@@ -11,7 +13,9 @@ glm::vec4 sampleRef(const Scene& scene, const Geometry& g, const TextureRef& ref
         return glm::vec4(1.0f);
     }
     const std::vector<glm::vec2>& uvs = ref.texCoord == 0 ? g.texcoords0 : g.texcoords1;
-    const glm::vec2 uv = vertex < uvs.size() ? uvs[vertex] : glm::vec2(0.0f);
+    // KHR_texture_transform: the same map the G-buffer's shader applies.
+    const glm::vec2 uv =
+        shader::applyUvTransform(ref.uvTransform(), vertex < uvs.size() ? uvs[vertex] : glm::vec2(0.0f));
     return sampleBilinear(scene.textures[size_t(ref.texture)], uv, ref.wrapS, ref.wrapT);
 }
 
@@ -30,6 +34,10 @@ shader::SurfaceVertex surfaceAtVertex(const Scene& scene, const Geometry& g, uin
     s.albedo = glm::clamp(albedo, glm::vec3(0.0f), glm::vec3(1.0f));
     s.roughness = std::clamp(m.roughnessFactor * mr.g, 0.0f, 1.0f);
     s.metallic = std::clamp(m.metallicFactor * mr.b, 0.0f, 1.0f);
+    // The vertex normal, never the normal map: a normal map sampled at three
+    // vertices and interpolated across a triangle is no normal map at all,
+    // and the BVH's packed primitives carry one normal per vertex. Only the
+    // G-buffer applies normal maps, per pixel.
     s.normal = vertex < g.normals.size() ? g.normals[vertex] : glm::vec3(0.0f, 1.0f, 0.0f);
     s.reflectance = m.reflectance;
     return s;
@@ -82,8 +90,18 @@ std::vector<shader::PackedPrimitive> buildPrimitivePool(const Scene& scene, cons
             joints = std::span<const glm::mat4>(scene.jointMatrices.data() + inst.jointOffset,
                                                 scene.skins[size_t(inst.skin)].joints.size());
         }
+        // A per-instance BLAS of a morphing mesh carries its instance's
+        // weights (applied before skinning, as glTF orders them).
+        std::span<const float> morphWeights;
+        if (blas.instance != kNone) {
+            morphWeights = scene.instances[size_t(blas.instance)].morphWeights;
+        }
         for (const BlasGeometry& g : blas.geometries) {
-            const UnwrappedGeometry u = unwrapGeometry(scene, lod.geometries[g.meshGeometry], joints);
+            const Geometry& source = lod.geometries[g.meshGeometry];
+            const UnwrappedGeometry u =
+                source.morphTargets.empty() || morphWeights.empty()
+                    ? unwrapGeometry(scene, source, joints)
+                    : unwrapGeometry(scene, morphedGeometry(source, morphWeights), joints);
             std::copy(u.primitives.begin(), u.primitives.end(), pool.begin() + g.poolOffset);
         }
     }

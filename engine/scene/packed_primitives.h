@@ -19,7 +19,8 @@ namespace glint::scene {
 // x base colour texture (sRGB decoded), roughness and metallic factors x the
 // metallic-roughness texture (G, B), the vertex normal, the material's
 // reflectance. Textures are sampled bilinearly from their base level at the
-// vertex's texture coordinates; normal maps do not apply at vertex rate.
+// vertex's texture coordinates (the set each reference names, through its
+// KHR_texture_transform); normal maps do not apply at vertex rate.
 shader::SurfaceVertex surfaceAtVertex(const Scene& scene, const Geometry& geometry, uint32_t vertex);
 
 struct UnwrappedGeometry {
@@ -34,7 +35,9 @@ UnwrappedGeometry unwrapGeometry(const Scene& scene, const Geometry& geometry,
                                  std::span<const glm::mat4> jointMatrices = {});
 
 // The whole pool of `plan` (poolTriangles entries), every BLAS at its
-// range; deformable BLASes use their instance's current joint matrices.
+// range; deformable BLASes use their instance's current joint matrices and
+// morph weights (morph targets applied first, as passes::BvhManager feeds
+// the pack pass).
 // Ranges no BLAS owns stay zero.
 std::vector<shader::PackedPrimitive> buildPrimitivePool(const Scene& scene, const BvhPlan& plan);
 

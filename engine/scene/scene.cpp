@@ -297,6 +297,12 @@ void checkGeometry(const Scene& scene, const Geometry& g, const std::string& ele
     if (g.joints.size() != g.weights.size()) {
         throw SceneError(scene.name, element, "joints and weights differ in length");
     }
+    for (size_t t = 0; t < g.morphTargets.size(); ++t) {
+        const std::string target = "morph target " + std::to_string(t) + " ";
+        checkLength(g.morphTargets[t].positions.size(), (target + "positions").c_str());
+        checkLength(g.morphTargets[t].normals.size(), (target + "normals").c_str());
+        checkLength(g.morphTargets[t].tangents.size(), (target + "tangents").c_str());
+    }
     if (g.indices.size() % 3 != 0) {
         throw SceneError(scene.name, element,
                          "index count " + std::to_string(g.indices.size()) + " is not a multiple of 3");
@@ -345,8 +351,15 @@ void validateScene(const Scene& scene) {
         }
         for (size_t l = 0; l < mesh.lods.size(); ++l) {
             for (size_t g = 0; g < mesh.lods[l].geometries.size(); ++g) {
-                checkGeometry(scene, mesh.lods[l].geometries[g],
-                              element + " lod " + std::to_string(l) + " geometry " + std::to_string(g));
+                const Geometry& geometry = mesh.lods[l].geometries[g];
+                const std::string geometryElement =
+                    element + " lod " + std::to_string(l) + " geometry " + std::to_string(g);
+                checkGeometry(scene, geometry, geometryElement);
+                if (l == 0 && geometry.morphTargets.size() != mesh.morphWeights.size()) {
+                    throw SceneError(scene.name, geometryElement,
+                                     std::to_string(geometry.morphTargets.size()) + " morph targets for the mesh's " +
+                                         std::to_string(mesh.morphWeights.size()) + " weights");
+                }
             }
         }
     }
@@ -384,7 +397,13 @@ void validateScene(const Scene& scene) {
         const std::string element = named("animation", a, anim.name);
         for (const AnimationSampler& s : anim.samplers) {
             const size_t perKey = s.interpolation == Interpolation::CubicSpline ? 3 : 1;
-            if (s.times.empty() || s.values.size() != s.times.size() * perKey) {
+            if (s.weightCount > 0 && (s.times.empty() || s.weights.size() != s.times.size() * perKey * s.weightCount)) {
+                throw SceneError(scene.name, element,
+                                 "sampler has " + std::to_string(s.times.size()) + " keys and " +
+                                     std::to_string(s.weights.size()) + " weights for " +
+                                     std::to_string(s.weightCount) + " morph targets");
+            }
+            if (s.weightCount == 0 && (s.times.empty() || s.values.size() != s.times.size() * perKey)) {
                 throw SceneError(scene.name, element,
                                  "sampler has " + std::to_string(s.times.size()) + " keys and " +
                                      std::to_string(s.values.size()) + " values");
@@ -398,6 +417,13 @@ void validateScene(const Scene& scene) {
                 throw SceneError(scene.name, element,
                                  "channel refers to sampler " + std::to_string(c.sampler) + " / node " +
                                      std::to_string(c.node) + " out of range");
+            }
+            const bool weights = c.path == AnimationPath::Weights;
+            if (weights != (anim.samplers[c.sampler].weightCount > 0) ||
+                (weights && anim.samplers[c.sampler].weightCount != scene.nodes[c.node].morphWeights.size())) {
+                throw SceneError(scene.name, element,
+                                 "channel of node " + std::to_string(c.node) +
+                                     ": morph weight samplers drive exactly the node's morph weights");
             }
         }
     }
@@ -414,6 +440,11 @@ void validateScene(const Scene& scene) {
         }
         if (inst.node != kNone && (inst.node < 0 || size_t(inst.node) >= scene.nodes.size())) {
             throw SceneError(scene.name, element, "node " + std::to_string(inst.node) + " out of range");
+        }
+        if (!inst.morphWeights.empty() && inst.morphWeights.size() != scene.meshes[inst.mesh].morphWeights.size()) {
+            throw SceneError(scene.name, element,
+                             std::to_string(inst.morphWeights.size()) + " morph weights for the mesh's " +
+                                 std::to_string(scene.meshes[inst.mesh].morphWeights.size()) + " targets");
         }
         const bool hasSkin = inst.skin != kNone;
         if (hasSkin != (inst.motion == Motion::Skinned)) {

@@ -8,6 +8,7 @@
 #include "scene/camera.h"
 
 #include "glint/packing.h"
+#include "glint/texture_transform.h"
 
 #include <glm/glm.hpp>
 #include <glm/gtc/quaternion.hpp>
@@ -72,11 +73,20 @@ enum class Wrap : uint8_t { Repeat, ClampToEdge, MirroredRepeat };
 
 struct TextureRef {
     int32_t texture = kNone;  // index into Scene::textures
-    uint32_t texCoord = 0;    // 0: texcoords0, 1: texcoords1
+    // 0: texcoords0, 1: texcoords1 (KHR_texture_transform's texCoord
+    // override already applied).
+    uint32_t texCoord = 0;
     Wrap wrapS = Wrap::Repeat;
     Wrap wrapT = Wrap::Repeat;
+    // KHR_texture_transform; the defaults are the identity.
+    glm::vec2 offset{0.0f};
+    float rotation = 0.0f;  // radians
+    glm::vec2 scale{1.0f};
 
     bool valid() const { return texture != kNone; }
+    // The affine map the shaders and the CPU sampling apply to the
+    // texture coordinates (glint/texture_transform.h).
+    shader::UvTransform uvTransform() const { return shader::makeUvTransform(offset, rotation, scale); }
 };
 
 // Bilinear sample of the base level at `uv` (glTF convention: (0, 0) is the
@@ -113,6 +123,15 @@ struct Material {
 // Geometry
 // ---------------------------------------------------------------------------
 
+// A morph target (glTF 2.0 3.7.2.2): per-vertex displacements added, times
+// the target's weight, to the base attributes. Arrays are empty or one
+// entry per vertex of the geometry.
+struct MorphTarget {
+    std::vector<glm::vec3> positions;
+    std::vector<glm::vec3> normals;
+    std::vector<glm::vec3> tangents;  // xyz only; the sign stays the base's
+};
+
 // One draw of one material (a glTF primitive), always an indexed triangle
 // list. Attribute arrays are either empty or one entry per position.
 struct Geometry {
@@ -125,8 +144,11 @@ struct Geometry {
     std::vector<glm::u16vec4> joints;  // skinned: indices into the skin's joints
     std::vector<glm::vec4> weights;    // skinned: weights summing to 1
     std::vector<uint32_t> indices;     // three per triangle
+    // Every geometry of a mesh has the same number of targets as the mesh
+    // has default weights (Mesh::morphWeights).
+    std::vector<MorphTarget> morphTargets;
     uint32_t material = 0;
-    Aabb bounds;  // of positions
+    Aabb bounds;  // of positions (the base shape, without morphing)
 
     uint32_t vertexCount() const { return uint32_t(positions.size()); }
     uint32_t triangleCount() const { return uint32_t(indices.size() / 3); }
@@ -143,7 +165,10 @@ struct Mesh {
     // LOD the reflection BLAS uses. Unset: lods[1] when the mesh has one
     // (Far Cry 6 traces reflections against a lower LOD).
     std::optional<uint32_t> reflectionLod;
-    Aabb bounds;  // of lods[0]
+    Aabb bounds;  // of lods[0], with every shape its morph targets reach at weights in [0, 1]
+    // Default morph target weights (glTF mesh.weights, zeros when absent),
+    // one per target of each LOD-0 geometry; empty: the mesh does not morph.
+    std::vector<float> morphWeights;
 };
 
 uint32_t reflectionLodIndex(const Mesh& mesh);
@@ -162,6 +187,10 @@ struct Node {
     // glTF lets a node give a matrix instead of TRS; such a node is not
     // animated.
     std::optional<glm::mat4> matrix;
+    // Morph target weights of the mesh this node instantiates (glTF
+    // node.weights, else the mesh's defaults); animated by `weights`
+    // channels. Empty when the mesh does not morph.
+    std::vector<float> morphWeights;
 
     glm::mat4 localTransform() const;
 };
@@ -173,7 +202,7 @@ struct Skin {
 };
 
 enum class Interpolation : uint8_t { Step, Linear, CubicSpline };
-enum class AnimationPath : uint8_t { Translation, Rotation, Scale };
+enum class AnimationPath : uint8_t { Translation, Rotation, Scale, Weights };
 
 struct AnimationSampler {
     Interpolation interpolation = Interpolation::Linear;
@@ -182,6 +211,10 @@ struct AnimationSampler {
     // rotation); CUBICSPLINE stores three per key: in-tangent, value,
     // out-tangent.
     std::vector<glm::vec4> values;
+    // Morph target weights (AnimationPath::Weights): `weightCount` floats
+    // per value, in the same key layout as `values`, which stays empty.
+    std::vector<float> weights;
+    uint32_t weightCount = 0;
 };
 
 struct AnimationChannel {
@@ -230,6 +263,10 @@ struct Instance {
     glm::mat4 transform{1.0f};
     glm::mat4 previousTransform{1.0f};
     uint32_t jointOffset = 0;  // Skinned: first joint matrix in Scene::jointMatrices
+    // Morph target weights this frame (its node's, else the mesh's
+    // defaults); empty when the mesh does not morph. Changes bump
+    // deformVersion (advanceScene).
+    std::vector<float> morphWeights;
     // Bumped every time the vertices change shape (skinning, vertex
     // animation): the BVH planner rebuilds a BLAS only when it changed.
     uint64_t deformVersion = 0;

@@ -13,6 +13,8 @@ layout(location = 2) out vec3 outAlbedo;
 layout(location = 3) out vec3 outMaterial;  // roughness, metallic, reflectance
 layout(location = 4) out vec4 outClip;      // unjittered, this frame
 layout(location = 5) out vec4 outPreviousClip;
+layout(location = 6) out vec4 outTangent;  // world xyz, w = bitangent sign
+layout(location = 7) out vec4 outUv;       // uv0, uv1
 
 void main() {
     const GBufferVertex v = vertices[gl_VertexIndex];
@@ -20,18 +22,26 @@ void main() {
     vec3 position = v.position;
     vec3 previousPosition = v.position;
     vec3 normal = v.normal;
+    vec3 tangent = v.tangent.xyz;
     if (inst.jointCount > 0u) {
         const mat4 skin = skinMatrix(v, inst, false);
         position = (skin * vec4(v.position, 1.0)).xyz;
         previousPosition = (skinMatrix(v, inst, true) * vec4(v.position, 1.0)).xyz;
         // Rigs carry no non-uniform scale: the upper 3x3 transforms normals.
         normal = mat3(skin) * v.normal;
+        tangent = mat3(skin) * tangent;
     }
     const vec4 world = inst.transform * vec4(position, 1.0);
     const vec4 previousWorld = inst.previousTransform * vec4(previousPosition, 1.0);
     // Instance transforms may scale non-uniformly: normals go through the
     // inverse transpose.
     outNormal = transpose(inverse(mat3(inst.transform))) * normal;
+    // Tangents lie in the surface: they follow the transform itself. A
+    // mirroring transform flips the bitangent's sign (mesh_tools.cpp,
+    // transformGeometry, does the same on the CPU).
+    const mat3 linear = mat3(inst.transform);
+    outTangent = vec4(linear * tangent, determinant(linear) < 0.0 ? -v.tangent.w : v.tangent.w);
+    outUv = vec4(v.uv0, v.uv1);
     outWorldPosition = world.xyz;
     outAlbedo = v.albedo;
     outMaterial = vec3(v.roughness, v.metallic, v.reflectance);

@@ -16,6 +16,7 @@
 #include "passes/gbuffer.h"
 #include "scene/animation.h"
 #include "scene/builtin_scenes.h"
+#include "scene/mesh_tools.h"
 
 #include "glint/packing.h"
 
@@ -217,6 +218,139 @@ TEST_CASE("a plane facing the camera gives the reversed-Z depth, its normal and 
             REQUIRE(img.motion[i] == glm::vec2(0.0f));  // nothing moved
             REQUIRE(finite(img.lit[i]));
             REQUIRE(img.lit[i].r > 0.0f);
+        }
+    }
+}
+
+TEST_CASE("a constant tilted normal map tilts the G-buffer normal of a plane by its tangent frame and scale") {
+    // The tangent-space normal (0.5, -0.3, 0.81) stored as 8-bit texels; the
+    // plane faces +Z with glTF UVs (u along +x, v down the image, so along
+    // -y): generated tangent +x, bitangent +y.
+    const glm::vec3 tilted = glm::normalize(glm::vec3(0.5f, -0.3f, 0.81f));
+    const glm::u8vec4 texel(glm::round((tilted * 0.5f + 0.5f) * 255.0f), 255);
+    const glm::vec3 stored = glm::vec3(texel) / 255.0f * 2.0f - 1.0f;  // what the sampler returns, decoded
+
+    for (const float scale : {1.0f, 0.5f}) {
+        INFO("normalTexture.scale " << scale);
+        test::GpuTest gpu;
+        scene::Geometry plane = square({0, 0, -5}, {1, 0, 0}, {0, 1, 0}, 20.0f);
+        for (const glm::vec3& p : plane.positions) {
+            plane.texcoords0.push_back({p.x / 40.0f + 0.5f, 0.5f - p.y / 40.0f});
+        }
+        scene::generateTangents(plane);
+        scene::Material material;
+        material.normalTexture.texture = 0;
+        material.normalScale = scale;
+        scene::Scene scene = [&] {
+            scene::Scene s;
+            s.name = "gbuffer-normal-map-test";
+            scene::Texture texture;
+            texture.name = "tilted";
+            texture.width = texture.height = 4;
+            for (int i = 0; i < 16; ++i) texture.rgba8.insert(texture.rgba8.end(), {texel.r, texel.g, texel.b, 255});
+            s.textures.push_back(texture);
+            s.materials.push_back(material);
+            scene::Mesh mesh;
+            mesh.lods.push_back({{plane}});
+            s.meshes.push_back(std::move(mesh));
+            s.instances.push_back({});
+            scene::prepareScene(s);
+            return s;
+        }();
+        passes::GBufferStats stats;
+        const GBufferImage img = render(gpu, scene, {testCamera()}, &stats);
+        CHECK(stats.normalMaps == 1);
+        CHECK(stats.normalMappedDraws == 1);
+
+        const glm::vec3 expected = glm::normalize(glm::vec3(stored.x * scale, stored.y * scale, stored.z));
+        // Against the unquantised normal too: within 8-bit quantisation.
+        const glm::vec3 ideal = glm::normalize(glm::vec3(tilted.x * scale, tilted.y * scale, tilted.z));
+        for (uint32_t y = 0; y < kSize; ++y) {
+            for (uint32_t x = 0; x < kSize; ++x) {
+                INFO("pixel " << x << ", " << y);
+                const glm::vec3 n(img.normal[img.at(x, y)]);
+                REQUIRE(glm::length(n - expected) < 2e-3f);  // half-float output
+                REQUIRE(glm::length(n - ideal) < 2.0f / 255.0f * 2.0f);
+            }
+        }
+    }
+}
+
+TEST_CASE("the normal map is sampled through its texture reference's coordinate set and KHR_texture_transform") {
+    // Two texels: left tilted, right flat. Constant UVs sit on texel centres
+    // (u = 0.25 left, 0.75 right), so bilinear filtering returns one texel.
+    const glm::vec3 tilted = glm::normalize(glm::vec3(0.6f, 0.0f, 0.8f));
+    const glm::u8vec4 left(glm::round((tilted * 0.5f + 0.5f) * 255.0f), 255);
+    const glm::u8vec4 right(128, 128, 255, 255);
+    struct Case {
+        const char* what;
+        uint32_t texCoord;
+        glm::vec2 offset;
+        bool expectTilted;
+    };
+    for (const Case& c : {Case{"set 0, identity", 0, {0.0f, 0.0f}, true},
+                          Case{"set 0, offset half a texture", 0, {0.5f, 0.0f}, false},
+                          Case{"set 1, identity", 1, {0.0f, 0.0f}, false},
+                          Case{"set 1, offset back", 1, {-0.5f, 0.0f}, true}}) {
+        INFO(c.what);
+        test::GpuTest gpu;
+        scene::Geometry plane = square({0, 0, -5}, {1, 0, 0}, {0, 1, 0}, 20.0f);
+        plane.texcoords0.assign(4, {0.25f, 0.5f});
+        plane.texcoords1.assign(4, {0.75f, 0.5f});
+        plane.tangents.assign(4, {1.0f, 0.0f, 0.0f, 1.0f});
+        scene::Scene s;
+        s.name = "gbuffer-normal-map-uv-test";
+        scene::Texture texture;
+        texture.name = "left tilted, right flat";
+        texture.width = 2;
+        texture.height = 1;
+        texture.rgba8 = {left.r, left.g, left.b, 255, right.r, right.g, right.b, 255};
+        s.textures.push_back(texture);
+        scene::Material material;
+        material.normalTexture.texture = 0;
+        material.normalTexture.texCoord = c.texCoord;
+        material.normalTexture.offset = c.offset;
+        s.materials.push_back(material);
+        scene::Mesh mesh;
+        mesh.lods.push_back({{plane}});
+        s.meshes.push_back(std::move(mesh));
+        s.instances.push_back({});
+        scene::prepareScene(s);
+        const GBufferImage img = render(gpu, s, {testCamera()});
+        const glm::vec3 expected = c.expectTilted ? glm::vec3(glm::vec3(left) / 255.0f * 2.0f - 1.0f) : glm::vec3(0, 0, 1);
+        const glm::vec3 n(img.normal[img.at(kSize / 2, kSize / 2)]);
+        CHECK(glm::length(n - glm::normalize(expected)) < 0.01f);
+    }
+}
+
+TEST_CASE("a morphing plane is drawn, and casts its shadow, where its morph weights put it") {
+    // A plane at distance 5 whose one morph target moves it 2 towards the
+    // camera: weight 0.5 puts it at distance 4, weight 0 leaves it at 5.
+    for (const float weight : {0.0f, 0.5f}) {
+        INFO("weight " << weight);
+        test::GpuTest gpu;
+        scene::Geometry plane = square({0, 0, -5}, {1, 0, 0}, {0, 1, 0}, 20.0f);
+        scene::MorphTarget target;
+        target.positions.assign(4, {0, 0, 2});
+        plane.morphTargets.push_back(target);
+        scene::Scene s;
+        s.name = "gbuffer-morph-test";
+        s.materials.emplace_back();
+        scene::Mesh mesh;
+        mesh.lods.push_back({{plane}});
+        mesh.morphWeights = {weight};
+        s.meshes.push_back(std::move(mesh));
+        s.instances.push_back({});
+        scene::prepareScene(s);
+        passes::GBufferStats stats;
+        const GBufferImage img = render(gpu, s, {testCamera()}, &stats);
+        CHECK(stats.shadowDraws == 1);
+        const float expectedDepth = kNear / (5.0f - 2.0f * weight);
+        for (uint32_t y = 0; y < kSize; y += 7) {
+            for (uint32_t x = 0; x < kSize; x += 7) {
+                INFO("pixel " << x << ", " << y);
+                REQUIRE(std::abs(img.depth[img.at(x, y)] - expectedDepth) < 1e-5f);
+            }
         }
     }
 }

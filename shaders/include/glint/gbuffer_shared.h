@@ -26,13 +26,16 @@
 #define GLINT_GBUFFER_SHARED_H
 
 #include "glint/shared.h"
+#include "glint/texture_transform.h"
 
 GLINT_BEGIN
 
-// One vertex of a LOD-0 geometry, uploaded once (72 bytes). The material is
+// One vertex of a LOD-0 geometry, uploaded once (104 bytes). The material is
 // sampled at the vertex on the CPU (scene::surfaceAtVertex), exactly as the
 // BVH manager does for the packed primitives, so the rasterised surface and
-// the ray-traced one agree.
+// the ray-traced one agree; only the normal map is sampled per pixel (a
+// normal map at vertex rate means nothing), with the tangent frame and
+// texture coordinates below.
 struct GBufferVertex {
     vec3 position;  // object space, bind pose for skinned geometry
     vec3 normal;
@@ -42,6 +45,9 @@ struct GBufferVertex {
     float reflectance;
     uvec2 joints;   // four 16-bit joint indices: x = j0 | j1 << 16, y = j2 | j3 << 16
     vec4 weights;   // zero for rigid geometry
+    vec4 tangent;   // object space xyz, w = bitangent sign (glTF: B = cross(N, T) * w)
+    vec2 uv0;       // TEXCOORD_0 (zero when absent)
+    vec2 uv1;       // TEXCOORD_1
 };
 
 // One scene instance this frame and last (144 bytes).
@@ -110,18 +116,23 @@ struct GBufferFrame {
     GBufferShadow shadow;
 };
 
-// Push constants of one draw (8 bytes).
+// Push constants of one draw (48 bytes).
 struct GBufferDraw {
     uint instance;
-    uint doubleSided;  // 1: back faces are lit with the flipped normal
+    uint doubleSided;     // 1: back faces are lit with the flipped normal
+    uint normalMap;       // 1: perturb the normal with the normal map (binding 6)
+    uint normalTexCoord;  // 0: GBufferVertex::uv0, 1: uv1
+    UvTransform normalUvTransform;  // the normal texture's KHR_texture_transform
+    float normalScale;    // glTF normalTexture.scale
+    uint pad0;
 };
 
 GLINT_END
 
 #ifdef __cplusplus
-static_assert(sizeof(glint::shader::GBufferVertex) == 72);
+static_assert(sizeof(glint::shader::GBufferVertex) == 104);
 static_assert(sizeof(glint::shader::GBufferInstance) == 144);
-static_assert(sizeof(glint::shader::GBufferDraw) == 8);
+static_assert(sizeof(glint::shader::GBufferDraw) == 48);
 static_assert(sizeof(glint::shader::GBufferShadow) == 112);
 static_assert(sizeof(glint::shader::SceneLighting) == 240);
 #endif
