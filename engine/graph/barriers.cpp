@@ -495,10 +495,9 @@ private:
         st_.plan.resources[r].entryLayout = entry;
     }
 
-    const std::string& lastUserName(uint32_t r) const {
-        static const std::string kNone = "(none)";
+    std::string_view lastUserName(uint32_t r) const {
         const Lifetime& life = st_.lifetimes[r];
-        return life.used() ? d_.passes[st_.order[life.last]].name : kNone;
+        return life.used() ? d_.passes[st_.order[life.last]].name : std::string_view("(none)");
     }
 
     // A transient sharing bytes starts after the last uses of every resource
