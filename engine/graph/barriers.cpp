@@ -269,6 +269,55 @@ void addPrior(Cell& c, const EndState& e) {
     }
 }
 
+// The last uses on some bytes of a heap, merged over the resources on them:
+// EndState less the layout, in 40 bytes, for startAliased's tree. Writes
+// already made available still matter to the next layout transition on
+// these bytes (see analyse(): write after write), so they are carried too;
+// only pending ones set `pending`. One queue per heap: the write's queue is
+// the same for all.
+struct LastUses {
+    VkPipelineStageFlags2 rStages[kQueueCount] = {0, 0};
+    VkPipelineStageFlags2 wStages = 0;
+    VkAccessFlags2 wAccess = 0;
+    int8_t wQueue = -1;
+    bool touched = false;
+    bool pending = false;
+
+    void add(const EndState& e) {
+        if (!e.touched) return;
+        touched = true;
+        for (uint32_t q = 0; q < kQueueCount; ++q) rStages[q] |= e.rStages[q];
+        if (e.wQueue >= 0 && e.wStages) {
+            if (wQueue < 0 || e.wPending) wQueue = e.wQueue;
+            pending = pending || e.wPending;
+            wStages |= e.wStages;
+            wAccess |= e.wAccess;
+        }
+    }
+    void merge(const LastUses& from) {
+        if (!from.touched) return;
+        touched = true;
+        for (uint32_t q = 0; q < kQueueCount; ++q) rStages[q] |= from.rStages[q];
+        if (from.wQueue >= 0 && from.wStages) {
+            if (wQueue < 0 || from.pending) wQueue = from.wQueue;
+            pending = pending || from.pending;
+            wStages |= from.wStages;
+            wAccess |= from.wAccess;
+        }
+    }
+    EndState endState() const {
+        EndState e;
+        e.touched = touched;
+        e.wQueue = wQueue;
+        e.wPending = pending;
+        e.wStages = wStages;
+        e.wAccess = wAccess;
+        e.rStages[0] = rStages[0];
+        e.rStages[1] = rStages[1];
+        return e;
+    }
+};
+
 // What one use of one cell needs.
 struct Need {
     uint32_t cell;
@@ -310,7 +359,8 @@ struct Scratch {
     std::vector<uint32_t> imports;
     std::vector<uint64_t> cuts;
     std::vector<uint64_t> cutsScratch;
-    std::vector<EndState> tree;
+    std::vector<LastUses> tree;
+    std::vector<std::pair<uint32_t, uint32_t>> pieces; // per aliased member: its pieces [first, second)
     std::vector<std::vector<uint32_t>> heapMembers;
 };
 
@@ -504,8 +554,9 @@ private:
     // on any of its bytes, itself included (one queue per heap, so stages
     // are all that matter). Per heap: cut the bytes at every placement
     // boundary, OR each resource's last uses into the pieces it covers, then
-    // OR back over each resource's pieces -- two segment trees, O(n log n)
-    // however many placements overlap.
+    // OR back over each resource's pieces -- a segment tree over the pieces
+    // (bottom-up, 2 x pieces nodes: OR is commutative, so any size works),
+    // O(n log n) however many placements overlap.
     void startAliased() {
         std::vector<std::vector<uint32_t>>& members = scratch_.heapMembers;
         members.resize(st_.plan.heaps.size());
@@ -513,7 +564,8 @@ private:
         for (uint32_t r = 0; r < d_.resources.size(); ++r)
             if (st_.aliased[r]) members[st_.plan.resources[r].heap].push_back(r);
         std::vector<uint64_t>& cuts = scratch_.cuts;
-        std::vector<EndState>& tree = scratch_.tree;
+        std::vector<LastUses>& tree = scratch_.tree;
+        std::vector<std::pair<uint32_t, uint32_t>>& pieces = scratch_.pieces;
         for (const std::vector<uint32_t>& list : members) {
             if (list.empty()) continue;
             cuts.clear();
@@ -523,43 +575,42 @@ private:
             }
             radixSort(cuts, scratch_.cutsScratch, [](uint64_t cut) { return cut; });
             cuts.erase(std::unique(cuts.begin(), cuts.end()), cuts.end());
-            const size_t pieces = cuts.size() - 1;
-            size_t width = 1;
-            while (width < pieces) width *= 2;
-            auto pieceRange = [&](uint32_t r) {
-                const uint64_t begin = st_.plan.resources[r].offset, end = begin + st_.plan.resources[r].size;
-                return std::pair{static_cast<size_t>(std::lower_bound(cuts.begin(), cuts.end(), begin) - cuts.begin()),
-                                 static_cast<size_t>(std::lower_bound(cuts.begin(), cuts.end(), end) - cuts.begin())};
-            };
-            // Range-OR updates, pushed down to the pieces.
-            tree.assign(2 * width, EndState{});
+            const size_t width = cuts.size() - 1;
+            pieces.clear();
             for (uint32_t r : list) {
-                const EndState last = summary(r);
-                auto [lo, hi] = pieceRange(r);
-                for (size_t l = lo + width, h = hi + width; l < h; l /= 2, h /= 2) {
-                    if (l & 1) merge(tree[l++], last);
-                    if (h & 1) merge(tree[--h], last);
+                const uint64_t begin = st_.plan.resources[r].offset, end = begin + st_.plan.resources[r].size;
+                pieces.emplace_back(
+                    static_cast<uint32_t>(std::lower_bound(cuts.begin(), cuts.end(), begin) - cuts.begin()),
+                    static_cast<uint32_t>(std::lower_bound(cuts.begin(), cuts.end(), end) - cuts.begin()));
+            }
+            // Range-OR updates, pushed down to the pieces.
+            tree.assign(2 * width, LastUses{});
+            for (size_t i = 0; i < list.size(); ++i) {
+                const LastUses last = summary(list[i]);
+                for (size_t l = pieces[i].first + width, h = pieces[i].second + width; l < h; l /= 2, h /= 2) {
+                    if (l & 1) tree[l++].merge(last);
+                    if (h & 1) tree[--h].merge(last);
                 }
             }
             for (size_t n = 1; n < width; ++n) {
-                merge(tree[2 * n], tree[n]);
-                merge(tree[2 * n + 1], tree[n]);
+                tree[2 * n].merge(tree[n]);
+                tree[2 * n + 1].merge(tree[n]);
             }
             // Range-OR queries over the pieces.
             for (size_t n = width - 1; n >= 1; --n) {
                 tree[n] = tree[2 * n];
-                merge(tree[n], tree[2 * n + 1]);
+                tree[n].merge(tree[2 * n + 1]);
             }
-            for (uint32_t r : list) {
-                EndState priors;
-                auto [lo, hi] = pieceRange(r);
-                for (size_t l = lo + width, h = hi + width; l < h; l /= 2, h /= 2) {
-                    if (l & 1) merge(priors, tree[l++]);
-                    if (h & 1) merge(priors, tree[--h]);
+            for (size_t i = 0; i < list.size(); ++i) {
+                LastUses priors;
+                for (size_t l = pieces[i].first + width, h = pieces[i].second + width; l < h; l /= 2, h /= 2) {
+                    if (l & 1) priors.merge(tree[l++]);
+                    if (h & 1) priors.merge(tree[--h]);
                 }
-                const ir::Resource& res = d_.resources[r];
+                const EndState prior = priors.endState();
+                const ir::Resource& res = d_.resources[list[i]];
                 for (uint32_t c = res.cellBase; c < res.cellBase + res.cellCount; ++c) {
-                    addPrior(cells_[c], priors);
+                    addPrior(cells_[c], prior);
                     cells_[c].aliased = true;
                 }
             }
@@ -567,37 +618,11 @@ private:
     }
 
     // The last uses of any subresource of `r`.
-    EndState summary(uint32_t r) const {
+    LastUses summary(uint32_t r) const {
         const ir::Resource& res = d_.resources[r];
-        EndState out;
-        for (uint32_t c = res.cellBase; c < res.cellBase + res.cellCount; ++c) {
-            const EndState& e = ends_[c];
-            if (!e.touched) continue;
-            out.touched = true;
-            for (uint32_t q = 0; q < kQueueCount; ++q) out.rStages[q] |= e.rStages[q];
-            if (e.wQueue >= 0 && e.wStages) {  // available writes too: see merge()
-                if (out.wQueue < 0 || e.wPending) out.wQueue = e.wQueue;
-                out.wPending = out.wPending || e.wPending;
-                out.wStages |= e.wStages;
-                out.wAccess |= e.wAccess;
-            }
-        }
+        LastUses out;
+        for (uint32_t c = res.cellBase; c < res.cellBase + res.cellCount; ++c) out.add(ends_[c]);
         return out;
-    }
-
-    static void merge(EndState& into, const EndState& from) {
-        if (!from.touched) return;
-        into.touched = true;
-        for (uint32_t q = 0; q < kQueueCount; ++q) into.rStages[q] |= from.rStages[q];
-        // Writes already made available still matter to the next layout
-        // transition on these bytes (see analyse(): write after write), so
-        // they are carried too; only pending ones set wPending.
-        if (from.wQueue >= 0 && from.wStages) {
-            if (into.wQueue < 0 || from.wPending) into.wQueue = from.wQueue;
-            into.wPending = into.wPending || from.wPending;
-            into.wStages |= from.wStages;
-            into.wAccess |= from.wAccess;
-        }
     }
 
     template <class F>
