@@ -342,6 +342,12 @@ struct FinalImport {
     SyncScope scope;
 };
 
+// Where an aliased transient's bytes begin or end in its heap.
+struct Cut {
+    uint64_t offset;
+    uint32_t side; // 2 * the member's index, + 1 at its end
+};
+
 // compile() runs every frame: the walk keeps its working memory per thread
 // so a frame's compile reuses last frame's allocations instead of asking
 // the allocator (and the kernel, for fresh pages) again.
@@ -357,8 +363,8 @@ struct Scratch {
     std::vector<FinalImport> finalImports;
     std::vector<uint32_t> deferred;
     std::vector<uint32_t> imports;
-    std::vector<uint64_t> cuts;
-    std::vector<uint64_t> cutsScratch;
+    std::vector<Cut> cuts;
+    std::vector<Cut> cutsScratch;
     std::vector<LastUses> tree;
     std::vector<std::pair<uint32_t, uint32_t>> pieces; // per aliased member: its pieces [first, second)
     std::vector<std::vector<uint32_t>> heapMembers;
@@ -563,26 +569,27 @@ private:
         for (auto& list : members) list.clear();
         for (uint32_t r = 0; r < d_.resources.size(); ++r)
             if (st_.aliased[r]) members[st_.plan.resources[r].heap].push_back(r);
-        std::vector<uint64_t>& cuts = scratch_.cuts;
+        std::vector<Cut>& cuts = scratch_.cuts;
         std::vector<LastUses>& tree = scratch_.tree;
         std::vector<std::pair<uint32_t, uint32_t>>& pieces = scratch_.pieces;
         for (const std::vector<uint32_t>& list : members) {
             if (list.empty()) continue;
+            // Both ends of every member, sorted; equal offsets are one cut.
             cuts.clear();
-            for (uint32_t r : list) {
-                cuts.push_back(st_.plan.resources[r].offset);
-                cuts.push_back(st_.plan.resources[r].offset + st_.plan.resources[r].size);
+            for (uint32_t i = 0; i < list.size(); ++i) {
+                const PlannedResource& placed = st_.plan.resources[list[i]];
+                cuts.push_back({placed.offset, 2 * i});
+                cuts.push_back({placed.offset + placed.size, 2 * i + 1});
             }
-            radixSort(cuts, scratch_.cutsScratch, [](uint64_t cut) { return cut; });
-            cuts.erase(std::unique(cuts.begin(), cuts.end()), cuts.end());
-            const size_t width = cuts.size() - 1;
-            pieces.clear();
-            for (uint32_t r : list) {
-                const uint64_t begin = st_.plan.resources[r].offset, end = begin + st_.plan.resources[r].size;
-                pieces.emplace_back(
-                    static_cast<uint32_t>(std::lower_bound(cuts.begin(), cuts.end(), begin) - cuts.begin()),
-                    static_cast<uint32_t>(std::lower_bound(cuts.begin(), cuts.end(), end) - cuts.begin()));
+            radixSort(cuts, scratch_.cutsScratch, [](const Cut& cut) { return cut.offset; });
+            pieces.resize(list.size());
+            uint32_t cut = 0;
+            for (size_t k = 0; k < cuts.size(); ++k) {
+                if (k > 0 && cuts[k].offset != cuts[k - 1].offset) ++cut;
+                auto& [first, last] = pieces[cuts[k].side / 2];
+                (cuts[k].side & 1 ? last : first) = cut;
             }
+            const size_t width = cut;
             // Range-OR updates, pushed down to the pieces.
             tree.assign(2 * width, LastUses{});
             for (size_t i = 0; i < list.size(); ++i) {
