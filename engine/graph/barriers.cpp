@@ -913,7 +913,10 @@ private:
             const SyncScope& s = info.scope;
             const size_t first = useNeed_[i];
             const size_t last = i + 1 < pass.useCount ? useNeed_[i + 1] : needs_.size();
-            emit(use.resource, use.range, s, first, last);
+            // Most uses need no barrier; emit() is not worth a call for them.
+            size_t firstBarrier = first;
+            while (firstBarrier < last && !needs_[firstBarrier].barrier) ++firstBarrier;
+            if (firstBarrier < last) emit(use.resource, use.range, s, first, last);
             for (size_t k = first; k < last; ++k) update(needs_[k], q, info, use.writes, now);
         }
         st_.barrierCount[pos] = static_cast<uint32_t>(st_.plan.barriers.size()) - st_.barrierFirst[pos];
