@@ -349,16 +349,17 @@ PassId Graph::endPass(uint32_t pass) {
     ir::Pass& p = d.passes[pass];
     const uint32_t end = p.firstUse + p.useCount;
     // Pipeline-dependent checks wait until setup has had its chance to call
-    // setPipeline().
-    for (uint32_t u = p.firstUse; u < end; ++u) {
-        const ir::Use& use = d.uses[u];
-        const ir::Resource& r = d.resources[use.resource];
-        for (AccessSet rest = use.kinds; rest; rest &= static_cast<AccessSet>(rest - 1)) {
-            const auto a = static_cast<Access>(std::countr_zero(rest));
-            if (accessNeedsRaster(a) && p.pipeline != Pipeline::Raster)
-                throw GraphError(
-                    ErrorKind::InvalidAccess, p.name, r.name,
-                    std::string(toString(a)) + " needs a raster pipeline; call setPipeline(Pipeline::Raster)");
+    // setPipeline(). (A raster pass may use anything these look for.)
+    if (p.pipeline != Pipeline::Raster) {
+        for (uint32_t u = p.firstUse; u < end; ++u) {
+            const ir::Use& use = d.uses[u];
+            for (AccessSet rest = use.kinds; rest; rest &= static_cast<AccessSet>(rest - 1)) {
+                const auto a = static_cast<Access>(std::countr_zero(rest));
+                if (accessNeedsRaster(a))
+                    throw GraphError(
+                        ErrorKind::InvalidAccess, p.name, d.resources[use.resource].name,
+                        std::string(toString(a)) + " needs a raster pipeline; call setPipeline(Pipeline::Raster)");
+            }
         }
     }
     if (!queueSupports(p.queue, Access::None, p.pipeline))
