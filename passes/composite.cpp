@@ -159,7 +159,7 @@ CompositeOutputs addDebugViewPass(rg::Graph& graph, CompositePipelines& pipeline
         throw gpu::GpuError("addDebugViewPass: the source is not a texture of this graph");
     }
     const rg::TextureDesc& desc = graph.declaration().resources[source.index].texture;
-    const std::string name = graph.declaration().resources[source.index].name;
+    const std::string name(graph.declaration().resources[source.index].name);
     if (desc.mips != 1 || desc.layers != 1 || desc.depth != 1) {
         throw gpu::GpuError("addDebugViewPass: '" + name + "' must be a 2D texture of one mip and one layer");
     }

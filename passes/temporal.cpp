@@ -101,8 +101,8 @@ TemporalOutputs addTemporalPass(rg::Graph& graph, TemporalPipelines& pipelines, 
         if (t.graph == graph.id() && t.index < graph.declaration().resources.size()) {
             const rg::TextureDesc& d = graph.declaration().resources[t.index].texture;
             if (d.width != gbuf.width || d.height != gbuf.height) {
-                throw gpu::GpuError("addTemporalPass: '" + graph.declaration().resources[t.index].name +
-                                    "' must have the G-buffer's size");
+                const std::string name(graph.declaration().resources[t.index].name);
+                throw gpu::GpuError("addTemporalPass: '" + name + "' must have the G-buffer's size");
             }
         }
     }

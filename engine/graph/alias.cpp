@@ -45,7 +45,13 @@ struct Block {
     uint64_t size;
 };
 
-uint64_t alignUp(uint64_t v, uint64_t a) { return (v + a - 1) / a * a; }
+// Vulkan alignments are powers of two: a mask, not a 64-bit division, in
+// the best-fit scan.
+uint64_t alignUp(uint64_t v, uint64_t a) {
+    if ((a & (a - 1)) == 0) [[likely]]
+        return (v + a - 1) & ~(a - 1);
+    return (v + a - 1) / a * a;
+}
 
 // Places items (sorted by first use) into one heap; returns its size.
 uint64_t place(std::vector<Item>& items, std::vector<uint64_t>& offsets, bool alias) {
@@ -88,6 +94,7 @@ uint64_t place(std::vector<Item>& items, std::vector<uint64_t>& offsets, bool al
             if (waste < bestWaste) {
                 bestWaste = waste;
                 best = b;
+                if (waste == 0) break; // nothing fits better
             }
         }
         uint64_t offset;

@@ -269,6 +269,55 @@ void addPrior(Cell& c, const EndState& e) {
     }
 }
 
+// The last uses on some bytes of a heap, merged over the resources on them:
+// EndState less the layout, in 40 bytes, for startAliased's tree. Writes
+// already made available still matter to the next layout transition on
+// these bytes (see analyse(): write after write), so they are carried too;
+// only pending ones set `pending`. One queue per heap: the write's queue is
+// the same for all.
+struct LastUses {
+    VkPipelineStageFlags2 rStages[kQueueCount] = {0, 0};
+    VkPipelineStageFlags2 wStages = 0;
+    VkAccessFlags2 wAccess = 0;
+    int8_t wQueue = -1;
+    bool touched = false;
+    bool pending = false;
+
+    void add(const EndState& e) {
+        if (!e.touched) return;
+        touched = true;
+        for (uint32_t q = 0; q < kQueueCount; ++q) rStages[q] |= e.rStages[q];
+        if (e.wQueue >= 0 && e.wStages) {
+            if (wQueue < 0 || e.wPending) wQueue = e.wQueue;
+            pending = pending || e.wPending;
+            wStages |= e.wStages;
+            wAccess |= e.wAccess;
+        }
+    }
+    void merge(const LastUses& from) {
+        if (!from.touched) return;
+        touched = true;
+        for (uint32_t q = 0; q < kQueueCount; ++q) rStages[q] |= from.rStages[q];
+        if (from.wQueue >= 0 && from.wStages) {
+            if (wQueue < 0 || from.pending) wQueue = from.wQueue;
+            pending = pending || from.pending;
+            wStages |= from.wStages;
+            wAccess |= from.wAccess;
+        }
+    }
+    EndState endState() const {
+        EndState e;
+        e.touched = touched;
+        e.wQueue = wQueue;
+        e.wPending = pending;
+        e.wStages = wStages;
+        e.wAccess = wAccess;
+        e.rStages[0] = rStages[0];
+        e.rStages[1] = rStages[1];
+        return e;
+    }
+};
+
 // What one use of one cell needs.
 struct Need {
     uint32_t cell;
@@ -293,6 +342,12 @@ struct FinalImport {
     SyncScope scope;
 };
 
+// Where an aliased transient's bytes begin or end in its heap.
+struct Cut {
+    uint64_t offset;
+    uint32_t side; // 2 * the member's index, + 1 at its end
+};
+
 // compile() runs every frame: the walk keeps its working memory per thread
 // so a frame's compile reuses last frame's allocations instead of asking
 // the allocator (and the kernel, for fresh pages) again.
@@ -308,9 +363,10 @@ struct Scratch {
     std::vector<FinalImport> finalImports;
     std::vector<uint32_t> deferred;
     std::vector<uint32_t> imports;
-    std::vector<uint64_t> cuts;
-    std::vector<uint64_t> cutsScratch;
-    std::vector<EndState> tree;
+    std::vector<Cut> cuts;
+    std::vector<Cut> cutsScratch;
+    std::vector<LastUses> tree;
+    std::vector<std::pair<uint32_t, uint32_t>> pieces; // per aliased member: its pieces [first, second)
     std::vector<std::vector<uint32_t>> heapMembers;
 };
 
@@ -495,72 +551,73 @@ private:
         st_.plan.resources[r].entryLayout = entry;
     }
 
-    const std::string& lastUserName(uint32_t r) const {
-        static const std::string kNone = "(none)";
+    std::string_view lastUserName(uint32_t r) const {
         const Lifetime& life = st_.lifetimes[r];
-        return life.used() ? d_.passes[st_.order[life.last]].name : kNone;
+        return life.used() ? d_.passes[st_.order[life.last]].name : std::string_view("(none)");
     }
 
     // A transient sharing bytes starts after the last uses of every resource
     // on any of its bytes, itself included (one queue per heap, so stages
     // are all that matter). Per heap: cut the bytes at every placement
     // boundary, OR each resource's last uses into the pieces it covers, then
-    // OR back over each resource's pieces -- two segment trees, O(n log n)
-    // however many placements overlap.
+    // OR back over each resource's pieces -- a segment tree over the pieces
+    // (bottom-up, 2 x pieces nodes: OR is commutative, so any size works),
+    // O(n log n) however many placements overlap.
     void startAliased() {
         std::vector<std::vector<uint32_t>>& members = scratch_.heapMembers;
         members.resize(st_.plan.heaps.size());
         for (auto& list : members) list.clear();
         for (uint32_t r = 0; r < d_.resources.size(); ++r)
             if (st_.aliased[r]) members[st_.plan.resources[r].heap].push_back(r);
-        std::vector<uint64_t>& cuts = scratch_.cuts;
-        std::vector<EndState>& tree = scratch_.tree;
+        std::vector<Cut>& cuts = scratch_.cuts;
+        std::vector<LastUses>& tree = scratch_.tree;
+        std::vector<std::pair<uint32_t, uint32_t>>& pieces = scratch_.pieces;
         for (const std::vector<uint32_t>& list : members) {
             if (list.empty()) continue;
+            // Both ends of every member, sorted; equal offsets are one cut.
             cuts.clear();
-            for (uint32_t r : list) {
-                cuts.push_back(st_.plan.resources[r].offset);
-                cuts.push_back(st_.plan.resources[r].offset + st_.plan.resources[r].size);
+            for (uint32_t i = 0; i < list.size(); ++i) {
+                const PlannedResource& placed = st_.plan.resources[list[i]];
+                cuts.push_back({placed.offset, 2 * i});
+                cuts.push_back({placed.offset + placed.size, 2 * i + 1});
             }
-            radixSort(cuts, scratch_.cutsScratch, [](uint64_t cut) { return cut; });
-            cuts.erase(std::unique(cuts.begin(), cuts.end()), cuts.end());
-            const size_t pieces = cuts.size() - 1;
-            size_t width = 1;
-            while (width < pieces) width *= 2;
-            auto pieceRange = [&](uint32_t r) {
-                const uint64_t begin = st_.plan.resources[r].offset, end = begin + st_.plan.resources[r].size;
-                return std::pair{static_cast<size_t>(std::lower_bound(cuts.begin(), cuts.end(), begin) - cuts.begin()),
-                                 static_cast<size_t>(std::lower_bound(cuts.begin(), cuts.end(), end) - cuts.begin())};
-            };
+            radixSort(cuts, scratch_.cutsScratch, [](const Cut& cut) { return cut.offset; });
+            pieces.resize(list.size());
+            uint32_t cut = 0;
+            for (size_t k = 0; k < cuts.size(); ++k) {
+                if (k > 0 && cuts[k].offset != cuts[k - 1].offset) ++cut;
+                auto& [first, last] = pieces[cuts[k].side / 2];
+                (cuts[k].side & 1 ? last : first) = cut;
+            }
+            const size_t width = cut;
             // Range-OR updates, pushed down to the pieces.
-            tree.assign(2 * width, EndState{});
-            for (uint32_t r : list) {
-                const EndState last = summary(r);
-                auto [lo, hi] = pieceRange(r);
-                for (size_t l = lo + width, h = hi + width; l < h; l /= 2, h /= 2) {
-                    if (l & 1) merge(tree[l++], last);
-                    if (h & 1) merge(tree[--h], last);
+            tree.assign(2 * width, LastUses{});
+            for (size_t i = 0; i < list.size(); ++i) {
+                const LastUses last = summary(list[i]);
+                for (size_t l = pieces[i].first + width, h = pieces[i].second + width; l < h; l /= 2, h /= 2) {
+                    if (l & 1) tree[l++].merge(last);
+                    if (h & 1) tree[--h].merge(last);
                 }
             }
             for (size_t n = 1; n < width; ++n) {
-                merge(tree[2 * n], tree[n]);
-                merge(tree[2 * n + 1], tree[n]);
+                tree[2 * n].merge(tree[n]);
+                tree[2 * n + 1].merge(tree[n]);
             }
             // Range-OR queries over the pieces.
             for (size_t n = width - 1; n >= 1; --n) {
                 tree[n] = tree[2 * n];
-                merge(tree[n], tree[2 * n + 1]);
+                tree[n].merge(tree[2 * n + 1]);
             }
-            for (uint32_t r : list) {
-                EndState priors;
-                auto [lo, hi] = pieceRange(r);
-                for (size_t l = lo + width, h = hi + width; l < h; l /= 2, h /= 2) {
-                    if (l & 1) merge(priors, tree[l++]);
-                    if (h & 1) merge(priors, tree[--h]);
+            for (size_t i = 0; i < list.size(); ++i) {
+                LastUses priors;
+                for (size_t l = pieces[i].first + width, h = pieces[i].second + width; l < h; l /= 2, h /= 2) {
+                    if (l & 1) priors.merge(tree[l++]);
+                    if (h & 1) priors.merge(tree[--h]);
                 }
-                const ir::Resource& res = d_.resources[r];
+                const EndState prior = priors.endState();
+                const ir::Resource& res = d_.resources[list[i]];
                 for (uint32_t c = res.cellBase; c < res.cellBase + res.cellCount; ++c) {
-                    addPrior(cells_[c], priors);
+                    addPrior(cells_[c], prior);
                     cells_[c].aliased = true;
                 }
             }
@@ -568,37 +625,11 @@ private:
     }
 
     // The last uses of any subresource of `r`.
-    EndState summary(uint32_t r) const {
+    LastUses summary(uint32_t r) const {
         const ir::Resource& res = d_.resources[r];
-        EndState out;
-        for (uint32_t c = res.cellBase; c < res.cellBase + res.cellCount; ++c) {
-            const EndState& e = ends_[c];
-            if (!e.touched) continue;
-            out.touched = true;
-            for (uint32_t q = 0; q < kQueueCount; ++q) out.rStages[q] |= e.rStages[q];
-            if (e.wQueue >= 0 && e.wStages) {  // available writes too: see merge()
-                if (out.wQueue < 0 || e.wPending) out.wQueue = e.wQueue;
-                out.wPending = out.wPending || e.wPending;
-                out.wStages |= e.wStages;
-                out.wAccess |= e.wAccess;
-            }
-        }
+        LastUses out;
+        for (uint32_t c = res.cellBase; c < res.cellBase + res.cellCount; ++c) out.add(ends_[c]);
         return out;
-    }
-
-    static void merge(EndState& into, const EndState& from) {
-        if (!from.touched) return;
-        into.touched = true;
-        for (uint32_t q = 0; q < kQueueCount; ++q) into.rStages[q] |= from.rStages[q];
-        // Writes already made available still matter to the next layout
-        // transition on these bytes (see analyse(): write after write), so
-        // they are carried too; only pending ones set wPending.
-        if (from.wQueue >= 0 && from.wStages) {
-            if (into.wQueue < 0 || from.wPending) into.wQueue = from.wQueue;
-            into.wPending = into.wPending || from.wPending;
-            into.wStages |= from.wStages;
-            into.wAccess |= from.wAccess;
-        }
     }
 
     template <class F>
@@ -882,7 +913,10 @@ private:
             const SyncScope& s = info.scope;
             const size_t first = useNeed_[i];
             const size_t last = i + 1 < pass.useCount ? useNeed_[i + 1] : needs_.size();
-            emit(use.resource, use.range, s, first, last);
+            // Most uses need no barrier; emit() is not worth a call for them.
+            size_t firstBarrier = first;
+            while (firstBarrier < last && !needs_[firstBarrier].barrier) ++firstBarrier;
+            if (firstBarrier < last) emit(use.resource, use.range, s, first, last);
             for (size_t k = first; k < last; ++k) update(needs_[k], q, info, use.writes, now);
         }
         st_.barrierCount[pos] = static_cast<uint32_t>(st_.plan.barriers.size()) - st_.barrierFirst[pos];

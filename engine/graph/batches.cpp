@@ -18,8 +18,7 @@ BatchBuilder::BatchBuilder(CompileState& state) : st_(state) {
     for (auto& p : positions_) p.reserve(state.order.size());
 }
 
-VkPipelineStageFlags2 BatchBuilder::reachingStages(Queue waiter, Queue signaller, TimelinePoint need) const {
-    const std::vector<Reach>& list = byPair_[queueIndex(waiter)][queueIndex(signaller)];
+VkPipelineStageFlags2 BatchBuilder::reachingStagesSearch(const std::vector<Reach>& list, TimelinePoint need) {
     const auto first =
         std::partition_point(list.begin(), list.end(), [&](const Reach& r) { return !reaches(r.point, need); });
     return first == list.end() ? 0 : first->suffixStages;
@@ -38,6 +37,9 @@ uint32_t BatchBuilder::open(Queue q, uint32_t firstPosition, const WaitRequest (
         const auto signaller = static_cast<Queue>(s);
         std::vector<Reach>& reach = byPair_[queueIndex(q)][s];
         for (Reach& r : reach) r.suffixStages |= w.stages;
+        std::vector<uint32_t>& first = firstReaching_[queueIndex(q)][s];
+        if (w.point.frame == 0 && w.point.ordinal >= first.size())
+            first.resize(size_t{w.point.ordinal} + 1, static_cast<uint32_t>(reach.size()));
         reach.push_back({w.point, w.stages});
         waits_.push_back({q, signaller, w.point, w.stages});
         ++b.waitCount;

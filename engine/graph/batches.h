@@ -45,7 +45,16 @@ public:
     // earlier) have ordered after `need` on `signaller`: the union over the
     // waits that reach it (each orders its own stages; together, theirs).
     // 0 when none reaches.
-    VkPipelineStageFlags2 reachingStages(Queue waiter, Queue signaller, TimelinePoint need) const;
+    VkPipelineStageFlags2 reachingStages(Queue waiter, Queue signaller, TimelinePoint need) const {
+        const std::vector<Reach>& list = byPair_[queueIndex(waiter)][queueIndex(signaller)];
+        // Most questions are about a point no wait reaches yet (the latest
+        // wait is the furthest) or one every wait reaches.
+        if (list.empty() || !reaches(list.back().point, need)) return 0;
+        if (reaches(list.front().point, need)) return list.front().suffixStages;
+        const std::vector<uint32_t>& first = firstReaching_[queueIndex(waiter)][queueIndex(signaller)];
+        if (need.frame == 0 && need.ordinal < first.size()) return list[first[need.ordinal]].suffixStages;
+        return reachingStagesSearch(list, need);
+    }
 
     // Puts the pass at schedule position `pos` on `q`, opening a new batch
     // when it has waits to place (waits[i] is on queue i). Returns the
@@ -85,6 +94,8 @@ private:
     };
 
     uint32_t open(Queue q, uint32_t firstPosition, const WaitRequest (&waits)[kQueueCount]);
+    struct Reach;
+    static VkPipelineStageFlags2 reachingStagesSearch(const std::vector<Reach>& list, TimelinePoint need);
 
     CompileState& st_;
     std::vector<Build> builds_;
@@ -98,6 +109,10 @@ private:
         VkPipelineStageFlags2 suffixStages;
     };
     std::vector<Reach> byPair_[kQueueCount][kQueueCount];
+    // Per (waiter, signaller), for this frame's points: ordinal -> index of
+    // the first entry of byPair_ that reaches it (the binary search was a
+    // few percent of compile, called per hazard).
+    std::vector<uint32_t> firstReaching_[kQueueCount][kQueueCount];
     std::vector<uint32_t> positions_[kQueueCount]; // schedule positions per queue, in order
     uint32_t open_[kQueueCount] = {kNoIndex, kNoIndex};
     uint32_t last_[kQueueCount] = {kNoIndex, kNoIndex};

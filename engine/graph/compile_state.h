@@ -73,7 +73,7 @@ void aliasMemory(CompileState& state);
 void placeBarriersAndBatches(CompileState& state);
 
 // Stable LSD radix sort by an unsigned 64-bit key, 8 bits a pass and only
-// as many passes as the largest key needs. The phases sort thousands of
+// as many passes as the keys' set bits span. The phases sort thousands of
 // byte offsets per compile; comparison sorts spent most of their time on
 // mispredicted branches there.
 template <class T, class Key>
@@ -86,9 +86,13 @@ void radixSort(std::vector<T>& items, std::vector<T>& scratch, Key key) {
     }
     uint64_t largest = 0;
     for (const T& item : items) largest |= key(item);
+    if (largest == 0) return;
     scratch.resize(items.size());
     uint32_t count[kBuckets];
-    for (uint32_t shift = 0; shift < 64 && (largest >> shift) != 0; shift += kBits) {
+    // Bits below the lowest one any key sets order nothing: byte offsets
+    // are aligned, so this saves a pass or two.
+    for (uint32_t shift = static_cast<uint32_t>(std::countr_zero(largest)); shift < 64 && (largest >> shift) != 0;
+         shift += kBits) {
         std::fill(std::begin(count), std::end(count), 0u);
         for (const T& item : items) ++count[(key(item) >> shift) & (kBuckets - 1)];
         uint32_t sum = 0;

@@ -3,7 +3,7 @@
 namespace glint::rg {
 namespace {
 
-std::string describe(ErrorKind kind, const std::string& pass, const std::string& resource, std::string_view detail) {
+std::string describe(ErrorKind kind, std::string_view pass, std::string_view resource, std::string_view detail) {
     std::string message = "render graph: ";
     message += toString(kind);
     message += ": pass '";
@@ -47,10 +47,7 @@ std::string_view toString(ErrorKind kind) {
     return "error";
 }
 
-GraphError::GraphError(ErrorKind kind, std::string pass, std::string resource, std::string_view detail)
-    : std::runtime_error(describe(kind, pass, resource, detail)),
-      kind_(kind),
-      pass_(std::move(pass)),
-      resource_(std::move(resource)) {}
+GraphError::GraphError(ErrorKind kind, std::string_view pass, std::string_view resource, std::string_view detail)
+    : std::runtime_error(describe(kind, pass, resource, detail)), kind_(kind), pass_(pass), resource_(resource) {}
 
 } // namespace glint::rg

@@ -30,7 +30,7 @@ std::string_view toString(ErrorKind);
 
 class GraphError : public std::runtime_error {
 public:
-    GraphError(ErrorKind kind, std::string pass, std::string resource, std::string_view detail);
+    GraphError(ErrorKind kind, std::string_view pass, std::string_view resource, std::string_view detail);
 
     ErrorKind kind() const noexcept { return kind_; }
     const std::string& pass() const noexcept { return pass_; }

@@ -218,7 +218,7 @@ void Executor::prepareTransients(const Plan& plan) {
         }
         const ir::Resource& d = decl.resources[i];
         if (r.heap >= t->heaps.size()) {
-            throw gpu::GpuError("render graph: transient '" + d.name + "' has no heap in the plan");
+            throw gpu::GpuError("render graph: transient '" + std::string(d.name) + "' has no heap in the plan");
         }
         gpu::MemoryRange range = t->heaps[r.heap].range();
         range.offset += r.offset;
@@ -227,11 +227,11 @@ void Executor::prepareTransients(const Plan& plan) {
         Physical p;
         if (r.kind == ResourceKind::Texture) {
             t->images.push_back(std::make_unique<gpu::Image>(
-                gpu_, imageDescOf(d.texture, r.imageUsage, d.name, r.crossQueue), range));
+                gpu_, imageDescOf(d.texture, r.imageUsage, std::string(d.name), r.crossQueue), range));
             p.image = t->images.back().get();
         } else {
             t->buffers.push_back(std::make_unique<gpu::Buffer>(
-                gpu_, bufferDescOf(d.buffer, r.bufferUsage, d.name, r.crossQueue), range));
+                gpu_, bufferDescOf(d.buffer, r.bufferUsage, std::string(d.name), r.crossQueue), range));
             p.buffer = t->buffers.back().get();
         }
         t->byResource[i] = p;
@@ -298,7 +298,7 @@ void Executor::prepareHistory(const Plan& plan) {
             continue;
         }
         const ir::Resource& current = decl.resources[i];
-        const std::string name = historyName(current.name);
+        const std::string name = historyName(std::string(current.name));
         const PlannedResource& prevPlan = plan.resources[r.partner];
         const bool shared = r.crossQueue || prevPlan.crossQueue;
         auto it = history_.find(name);
@@ -434,7 +434,7 @@ void Executor::bindResources(const Plan& plan, const FrameResources& imports) {
         case ir::Origin::Transient: p = transients_->byResource.at(i); break;
         case ir::Origin::HistoryPrevious:
         case ir::Origin::HistoryCurrent: {
-            const History& h = *history_.at(historyName(d.name));
+            const History& h = *history_.at(historyName(std::string(d.name)));
             const uint32_t k = r.origin == ir::Origin::HistoryCurrent ? h.current : 1u - h.current;
             p.image = h.images[k].get();
             p.buffer = h.buffers[k].get();
@@ -456,13 +456,13 @@ void Executor::bindResources(const Plan& plan, const FrameResources& imports) {
                 if (bound) p.accel = it->second;
             }
             if (!bound) {
-                throw gpu::GpuError("render graph: imported " + std::string(toString(r.kind)) + " '" + d.name +
+                throw gpu::GpuError("render graph: imported " + std::string(toString(r.kind)) + " '" + std::string(d.name) +
                                     "' has no resource bound for this frame (FrameResources::bind)");
             }
             if (r.crossQueue && plan.caps.separateComputeFamily &&
                 ((p.image && !p.image->desc().sharedAcrossQueues) || (p.buffer && !p.buffer->desc().sharedAcrossQueues) ||
                  (p.accel && !p.accel->buffer().desc().sharedAcrossQueues))) {
-                throw gpu::GpuError("render graph: imported '" + d.name +
+                throw gpu::GpuError("render graph: imported '" + std::string(d.name) +
                                     "' is used on both queues but was not created with sharedAcrossQueues");
             }
             break;

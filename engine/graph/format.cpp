@@ -236,7 +236,7 @@ std::string Plan::toText() const {
            "\n";
     if (!culled.empty()) {
         out += "culled:";
-        for (uint32_t p : culled) out += " '" + declaration->passes[p].name + "'";
+        for (uint32_t p : culled) out += " '" + std::string(declaration->passes[p].name) + "'";
         out += "\n";
     }
     // Negative on tiny graphs: padding placements to bufferImageGranularity
@@ -254,11 +254,11 @@ std::string Plan::toText() const {
                std::to_string(batch.ordinal) + "\n";
         for (const SemaphoreWait& w : waitsOf(batch)) out += "  wait " + waitText(w) + "\n";
         for (const PlannedPass& p : passesOf(batch)) {
-            out += "  pass '" + passName(p) + "' (" + std::string(toString(pipeline(p))) + ", timestamps " +
+            out += "  pass '" + std::string(passName(p)) + "' (" + std::string(toString(pipeline(p))) + ", timestamps " +
                    std::to_string(p.timestampQuery) + "-" + std::to_string(p.timestampQuery + 1) + ")\n";
             for (const Barrier& br : barriersBefore(p)) out += "    barrier " + barrierText(*this, br) + "\n";
             for (const ir::Use& u : uses(p))
-                out += std::string("    ") + (u.writes ? "write " : "read  ") + "'" + resourceName(u.resource) + "' " +
+                out += std::string("    ") + (u.writes ? "write " : "read  ") + "'" + std::string(resourceName(u.resource)) + "' " +
                        accessSetNames(u.kinds) + "\n";
         }
         for (const Barrier& br : barriersAfter(batch)) out += "  end barrier " + barrierText(*this, br) + "\n";
@@ -267,7 +267,7 @@ std::string Plan::toText() const {
     for (uint32_t r = 0; r < resources.size(); ++r) {
         const PlannedResource& res = resources[r];
         if (!res.used && res.origin != ir::Origin::Imported) continue;
-        out += "resource '" + resourceName(r) + "' " + originName(res.origin) + " " + describeResource(*this, r);
+        out += "resource '" + std::string(resourceName(r)) + "' " + originName(res.origin) + " " + describeResource(*this, r);
         if (res.heap != kNoIndex)
             out += ", heap " + std::to_string(res.heap) + " @" + std::to_string(res.offset) + " +" +
                    std::to_string(res.size);
@@ -289,7 +289,7 @@ std::string Plan::toDot() const {
                std::string(toString(batch.queue)) + " batch " + std::to_string(batch.ordinal) +
                "\";\n    style=rounded; color=" + (batch.queue == Queue::Graphics ? "steelblue" : "darkorange") + ";\n";
         for (const PlannedPass& p : passesOf(batch)) {
-            std::string label = passName(p);
+            std::string label = std::string(passName(p));
             for (const Barrier& br : barriersBefore(p)) label += "\\n| " + barrierText(*this, br);
             out += "    " + nodeId('p', static_cast<size_t>(&p - passes.data())) + " [shape=box, label=\"" +
                    dotEscape(label) + "\"];\n";
@@ -304,7 +304,7 @@ std::string Plan::toDot() const {
     for (uint32_t r = 0; r < resources.size(); ++r) {
         if (!resources[r].used) continue;
         out += "  " + nodeId('r', r) + " [shape=ellipse, label=\"" +
-               dotEscape(resourceName(r) + "\\n" + describeResource(*this, r)) + "\"" +
+               dotEscape(std::string(resourceName(r)) + "\\n" + describeResource(*this, r)) + "\"" +
                (resources[r].origin == ir::Origin::Transient ? "" : ", style=dashed") + "];\n";
     }
     for (uint32_t i = 0; i < passes.size(); ++i) {

@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <atomic>
 #include <bit>
+#include <cstring>
 #include <string>
 
 #include "graph/compile.h"
@@ -42,6 +43,32 @@ bool rangesOverlap(const Subresource& a, const Subresource& b) {
 VkImageLayout layoutOf(AccessSet kinds) { return accessScope(kinds, ResourceKind::Texture, Pipeline::Compute).layout; }
 
 } // namespace
+
+// ---- Names -------------------------------------------------------------------
+
+std::string_view ir::NameArena::store(std::string_view a, std::string_view b) {
+    const size_t size = a.size() + b.size();
+    if (used_ + size > capacity_) {
+        // Chunks double (4 KiB first, 64 KiB at most): a 1024-pass frame's
+        // names take a handful.
+        constexpr size_t kFirst = 4096, kLargest = 65536;
+        capacity_ = std::max(size, chunks_.empty() ? kFirst : std::min(2 * capacity_, kLargest));
+        chunks_.push_back(std::make_unique_for_overwrite<char[]>(capacity_));
+        used_ = 0;
+    }
+    char* out = chunks_.back().get() + used_;
+    if (!a.empty()) std::memcpy(out, a.data(), a.size());
+    if (!b.empty()) std::memcpy(out + a.size(), b.data(), b.size());
+    used_ += size;
+    return {out, size};
+}
+
+ir::Declaration::Declaration(const Declaration& other)
+    : graphId(other.graphId), passes(other.passes), uses(other.uses), resources(other.resources),
+      outputs(other.outputs), orderings(other.orderings), written(other.written), cellCount(other.cellCount) {
+    for (Pass& p : passes) p.name = names.store(p.name);
+    for (Resource& r : resources) r.name = names.store(r.name);
+}
 
 // ---- Builder -----------------------------------------------------------------
 
@@ -113,7 +140,7 @@ uint32_t Graph::newResource(std::string_view name, ResourceKind kind, ir::Origin
     ir::Declaration& d = mutableDecl();
     const auto index = static_cast<uint32_t>(d.resources.size());
     ir::Resource& r = d.resources.emplace_back();
-    r.name = name;
+    r.name = d.names.store(name);
     r.kind = kind;
     r.origin = origin;
     return index;
@@ -230,12 +257,13 @@ HistoryBuffer Graph::createHistoryBuffer(std::string_view name, const BufferDesc
 
 // Both halves of a pair; the description is filled in by the caller.
 std::pair<uint32_t, uint32_t> Graph::addHistory(std::string_view name, ResourceKind kind) {
-    const uint32_t previous = newResource(std::string(name) + ".previous", kind, ir::Origin::HistoryPrevious);
+    ir::Declaration& d = mutableDecl();
+    const uint32_t previous = newResource(d.names.store(name, ".previous"), kind, ir::Origin::HistoryPrevious);
     decl_->resources[previous].contentsAtStart = true;
     const uint32_t current = previous + 1;
     decl_->resources.emplace_back();
     ir::Resource& c = decl_->resources[current];
-    c.name = std::string(name) + ".current";
+    c.name = d.names.store(name, ".current");
     c.kind = kind;
     c.origin = ir::Origin::HistoryCurrent;
     decl_->resources[previous].partner = current;
@@ -295,7 +323,7 @@ void Graph::order(PassId before, PassId after) {
 Builder Graph::beginPass(std::string_view name, Queue queue, ExecuteFn execute) {
     ir::Declaration& d = mutableDecl();
     ir::Pass& p = d.passes.emplace_back();
-    p.name = name;
+    p.name = d.names.store(name);
     p.queue = queue;
     p.firstUse = static_cast<uint32_t>(d.uses.size());
     p.execute = std::move(execute);
@@ -321,16 +349,17 @@ PassId Graph::endPass(uint32_t pass) {
     ir::Pass& p = d.passes[pass];
     const uint32_t end = p.firstUse + p.useCount;
     // Pipeline-dependent checks wait until setup has had its chance to call
-    // setPipeline().
-    for (uint32_t u = p.firstUse; u < end; ++u) {
-        const ir::Use& use = d.uses[u];
-        const ir::Resource& r = d.resources[use.resource];
-        for (AccessSet rest = use.kinds; rest; rest &= static_cast<AccessSet>(rest - 1)) {
-            const auto a = static_cast<Access>(std::countr_zero(rest));
-            if (accessNeedsRaster(a) && p.pipeline != Pipeline::Raster)
-                throw GraphError(
-                    ErrorKind::InvalidAccess, p.name, r.name,
-                    std::string(toString(a)) + " needs a raster pipeline; call setPipeline(Pipeline::Raster)");
+    // setPipeline(). (A raster pass may use anything these look for.)
+    if (p.pipeline != Pipeline::Raster) {
+        for (uint32_t u = p.firstUse; u < end; ++u) {
+            const ir::Use& use = d.uses[u];
+            for (AccessSet rest = use.kinds; rest; rest &= static_cast<AccessSet>(rest - 1)) {
+                const auto a = static_cast<Access>(std::countr_zero(rest));
+                if (accessNeedsRaster(a))
+                    throw GraphError(
+                        ErrorKind::InvalidAccess, p.name, d.resources[use.resource].name,
+                        std::string(toString(a)) + " needs a raster pipeline; call setPipeline(Pipeline::Raster)");
+            }
         }
     }
     if (!queueSupports(p.queue, Access::None, p.pipeline))
@@ -354,7 +383,7 @@ PassId Graph::endPass(uint32_t pass) {
 uint32_t Graph::use(uint32_t pass, ResourceKind kind, uint32_t index, uint32_t version, uint32_t graph, Access access,
                     Subresource range, bool write) {
     ir::Declaration& d = mutableDecl();
-    const std::string& passName = d.passes[pass].name;
+    const std::string_view passName = d.passes[pass].name;
     const ir::Resource& r = checkHandle(kind, index, graph, passName);
     const ir::Pass& p = d.passes[pass];
 
@@ -379,7 +408,7 @@ uint32_t Graph::use(uint32_t pass, ResourceKind kind, uint32_t index, uint32_t v
 
     if (version != r.version) {
         if (version > r.version) fail(ErrorKind::ForeignHandle, "names a version this graph never made");
-        const std::string& writer = r.lastWriter != kNoIndex ? d.passes[r.lastWriter].name : std::string("?");
+        const std::string writer(r.lastWriter != kNoIndex ? d.passes[r.lastWriter].name : std::string_view("?"));
         if (write)
             fail(ErrorKind::UnorderedWriters,
                  "writes from version " + std::to_string(version) + ", which pass '" + writer +

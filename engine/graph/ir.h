@@ -4,8 +4,10 @@
 // and the verifier read. Flat vectors indexed by pass, use and resource;
 // a pass's uses are contiguous.
 
+#include <cstddef>
 #include <cstdint>
-#include <string>
+#include <memory>
+#include <string_view>
 #include <vector>
 
 #include "graph/access.h"
@@ -20,8 +22,23 @@ enum class Origin : uint8_t {
     HistoryCurrent,  // this frame's image of the pair
 };
 
+// The names of one declaration, back to back in chunks that never move, so
+// views into them survive the vectors growing. Tiled names such as
+// "f12/gbuffer.depth" outgrow std::string's small buffer: one allocation
+// per name to declare it and one to free it were a tenth of declaring.
+class NameArena {
+public:
+    // Stores a + b; the view lives as long as the arena.
+    std::string_view store(std::string_view a, std::string_view b = {});
+
+private:
+    std::vector<std::unique_ptr<char[]>> chunks_;
+    size_t used_ = 0;
+    size_t capacity_ = 0;
+};
+
 struct Resource {
-    std::string name;
+    std::string_view name; // in Declaration::names
     ResourceKind kind = ResourceKind::Texture;
     Origin origin = Origin::Transient;
     TextureDesc texture;
@@ -52,7 +69,7 @@ struct Use {
 };
 
 struct Pass {
-    std::string name;
+    std::string_view name; // in Declaration::names
     Queue queue = Queue::Graphics; // as declared; compile() maps it to a family
     Pipeline pipeline = Pipeline::Compute;
     bool sideEffects = false;
@@ -73,6 +90,12 @@ struct Ordering {
 };
 
 struct Declaration {
+    Declaration() = default;
+    Declaration(const Declaration& other); // stores the names again in its own arena
+    Declaration& operator=(const Declaration&) = delete;
+    Declaration(Declaration&&) noexcept = default;
+    Declaration& operator=(Declaration&&) noexcept = default;
+
     uint32_t graphId = 0;
     std::vector<Pass> passes;
     std::vector<Use> uses;
@@ -81,6 +104,7 @@ struct Declaration {
     std::vector<Ordering> orderings;
     std::vector<uint8_t> written; // per cell: holds data some pass (or the frame's start) wrote
     uint32_t cellCount = 0;
+    NameArena names;
 };
 
 inline uint32_t cellOf(const Resource& r, uint32_t mip, uint32_t layer) {

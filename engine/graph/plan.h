@@ -147,8 +147,9 @@ struct Plan {
         return {barriers.data() + b.firstEndBarrier, b.endBarrierCount};
     }
 
-    const std::string& passName(const PlannedPass& p) const { return declaration->passes[p.pass].name; }
-    const std::string& resourceName(uint32_t resource) const { return declaration->resources[resource].name; }
+    // Views into the declaration, which the plan keeps alive.
+    std::string_view passName(const PlannedPass& p) const { return declaration->passes[p.pass].name; }
+    std::string_view resourceName(uint32_t resource) const { return declaration->resources[resource].name; }
     const ExecuteFn& execute(const PlannedPass& p) const { return declaration->passes[p.pass].execute; }
     std::span<const ir::Use> uses(const PlannedPass& p) const;
     Pipeline pipeline(const PlannedPass& p) const { return declaration->passes[p.pass].pipeline; }

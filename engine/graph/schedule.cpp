@@ -51,11 +51,11 @@ struct Edge {
     // path[seenAt[p]..] is the cycle, walked backwards.
     std::vector<const Edge*> cycle(path.begin() + seenAt[p], path.end());
     std::reverse(cycle.begin(), cycle.end());
-    std::string detail = "passes wait on each other: '" + d.passes[cycle.front()->from].name + "'";
+    std::string detail = "passes wait on each other: '" + std::string(d.passes[cycle.front()->from].name) + "'";
     std::string resource;
     for (const Edge* e : cycle) {
-        detail += e->resource == kNoIndex ? " -> (order) -> " : " -> (" + d.resources[e->resource].name + ") -> ";
-        detail += "'" + d.passes[e->to].name + "'";
+        detail += e->resource == kNoIndex ? " -> (order) -> " : " -> (" + std::string(d.resources[e->resource].name) + ") -> ";
+        detail += "'" + std::string(d.passes[e->to].name) + "'";
         if (resource.empty() && e->resource != kNoIndex) resource = d.resources[e->resource].name;
     }
     throw GraphError(ErrorKind::Cycle, d.passes[cycle.front()->from].name, resource, detail);

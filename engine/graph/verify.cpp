@@ -148,7 +148,7 @@ public:
             for (uint32_t b = 0; b < plan_.barriers.size(); ++b)
                 if (!useful_[b])
                     fail(Kind::RedundantBarrier, options_.frames - 1,
-                         "barrier on '" + plan_.resourceName(plan_.barriers[b].resource) + "' " + barrierWhere(b) +
+                         "barrier on '" + std::string(plan_.resourceName(plan_.barriers[b].resource)) + "' " + barrierWhere(b) +
                              " orders nothing its resource needs in any frame");
     }
 
@@ -162,7 +162,7 @@ private:
         report_.violations.push_back({kind, frame, std::move(message)});
     }
 
-    std::string passName(uint32_t planned) const { return "'" + plan_.passName(plan_.passes[planned]) + "'"; }
+    std::string passName(uint32_t planned) const { return "'" + std::string(plan_.passName(plan_.passes[planned])) + "'"; }
 
     std::string describe(const Event& e) const {
         std::string who;
@@ -186,7 +186,7 @@ private:
 
     std::string cellName(uint32_t resource, uint32_t cell) const {
         const ir::Resource& r = d_.resources[resource];
-        std::string s = "'" + r.name + "'";
+        std::string s = "'" + std::string(r.name) + "'";
         if (r.kind == ResourceKind::Texture && r.cellCount > 1) {
             const uint32_t i = cell - r.cellBase;
             s += " (mip " + std::to_string(i / r.texture.layers) + ", layer " + std::to_string(i % r.texture.layers) +
@@ -246,7 +246,7 @@ private:
         }
         for (uint32_t p = 0; p < d_.passes.size(); ++p)
             if (seen[p] != 1)
-                bad("declared pass '" + d_.passes[p].name + "' appears " + std::to_string(seen[p]) +
+                bad("declared pass '" + std::string(d_.passes[p].name) + "' appears " + std::to_string(seen[p]) +
                     " times among planned and culled passes");
 
         // Waits: another queue, an existing batch, submitted before.
@@ -283,7 +283,7 @@ private:
             if (r.kind == ResourceKind::Texture && (b.range.mipCount == 0 || b.range.layerCount == 0 ||
                                                     b.range.baseMip + b.range.mipCount > r.texture.mips ||
                                                     b.range.baseLayer + b.range.layerCount > r.texture.layers)) {
-                bad("barrier on '" + r.name + "' is outside its subresources");
+                bad("barrier on '" + std::string(r.name) + "' is outside its subresources");
                 return false;
             }
         }
@@ -299,7 +299,7 @@ private:
                                          c.range.baseLayer < a.range.baseLayer + a.range.layerCount;
                     if (overlap)
                         fail(Kind::UnmergedBarriers, 0,
-                             "two barriers on one subresource of '" + plan_.resourceName(a.resource) + "' " + where);
+                             "two barriers on one subresource of '" + std::string(plan_.resourceName(a.resource)) + "' " + where);
                 }
         };
         for (uint32_t p = 0; p < plan_.passes.size(); ++p)
@@ -317,17 +317,17 @@ private:
                 queues[r] | (d_.resources[r].partner != kNoIndex ? queues[d_.resources[r].partner] : 0));
             const PlannedResource& res = plan_.resources[r];
             if (both == 3 && !res.crossQueue)
-                bad("'" + d_.resources[r].name + "' is used on both queues without concurrent sharing");
+                bad("'" + std::string(d_.resources[r].name) + "' is used on both queues without concurrent sharing");
             if (d_.resources[r].origin != ir::Origin::Transient || !queues[r]) continue;
             if (res.heap >= plan_.heaps.size()) {
-                bad("transient '" + d_.resources[r].name + "' has no memory");
+                bad("transient '" + std::string(d_.resources[r].name) + "' has no memory");
                 return false;
             }
             const MemoryHeap& heap = plan_.heaps[res.heap];
             if (res.offset + res.size > heap.size || res.offset % res.alignment != 0)
-                bad("transient '" + d_.resources[r].name + "' does not fit its heap");
+                bad("transient '" + std::string(d_.resources[r].name) + "' does not fit its heap");
             if (heap.crossQueue ? queues[r] != 3 : queues[r] != (1u << static_cast<uint32_t>(heap.queue)))
-                bad("transient '" + d_.resources[r].name + "' is in a heap of another queue");
+                bad("transient '" + std::string(d_.resources[r].name) + "' is in a heap of another queue");
         }
         return ok;
     }
@@ -526,7 +526,7 @@ private:
             const uint32_t want = expected_[u][i++];
             if (writer_[c] == want) return;
             auto name = [&](uint32_t p) {
-                return p == kNoIndex ? std::string("the frame's start") : "'" + d_.passes[p].name + "'";
+                return p == kNoIndex ? std::string("the frame's start") : "'" + std::string(d_.passes[p].name) + "'";
             };
             fail(Kind::Order, f,
                  "pass " + passName(planned) + " finds " + cellName(use.resource, c) + " last written by " +

@@ -162,7 +162,7 @@ TEST_CASE("an explicit order moves a pass ahead of independent ones") {
     g.order(ids[2], ids[1]); // readback of the previous frame's data before rendering
     Plan plan = compileChecked(g);
     std::string order;
-    for (const PlannedPass& p : plan.passes) order += plan.passName(p) + " ";
+    for (const PlannedPass& p : plan.passes) order += std::string(plan.passName(p)) + " ";
     CHECK(order == "upload readback render ");
 }
 
