@@ -569,7 +569,7 @@ Executor::ExternalSync Executor::placeSemaphores(const Plan& plan, const FrameRe
             if (point.batch != kNoIndex) batch = point.batch;
             if (stages == 0) {
                 if (!res.hasInitial || boundaryScope(res.initial, ResourceKind::Texture).stages == 0) {
-                    throw gpu::GpuError("render graph: '" + res.name +
+                    throw gpu::GpuError("render graph: '" + std::string(res.name) +
                                         "' waits on a semaphore, but its initial state names no stage, so its first "
                                         "layout transition would not wait for it: import it with "
                                         "BoundaryState::acquired(stages of its first use)");
