@@ -1021,3 +1021,30 @@ TEST_CASE("the base colour texture is read through its reference's coordinate se
         for (const int n : seen) CHECK(n > 20);
     }
 }
+
+TEST_CASE("only the textures drawn materials sample are uploaded, once per texture and colour space") {
+    // Texture 0 serves as base colour (sRGB) and metallic-roughness (linear)
+    // of the drawn material: two images. Texture 1 belongs to a material no
+    // geometry uses, texture 2 to none: neither is uploaded.
+    const std::array<glm::u8vec4, 4> cells = {glm::u8vec4(255), glm::u8vec4(128), glm::u8vec4(64), glm::u8vec4(32)};
+    scene::Material drawn;
+    drawn.baseColorTexture.texture = 0;
+    drawn.metallicRoughnessTexture.texture = 0;
+    scene::Scene s = checkerPlaneScene(checkerTexture(cells), drawn);
+    s.textures.push_back(checkerTexture(cells));
+    s.textures.push_back(checkerTexture(cells));
+    scene::Material unused;
+    unused.baseColorTexture.texture = 1;
+    unused.normalTexture.texture = 1;
+    s.materials.push_back(unused);
+    test::GpuTest gpu;
+    passes::GBufferStats stats;
+    render(gpu, s, {testCamera()}, &stats);
+    CHECK(stats.textureImages == 2);
+    CHECK(stats.normalMaps == 0);
+    // 64x64 RGBA8 and its mips down to 1x1, twice.
+    uint64_t bytes = 0;
+    for (uint32_t side = 64; side >= 1; side /= 2) bytes += uint64_t(side) * side * 4;
+    CHECK(stats.textureBytes == 2 * bytes);
+    CHECK(stats.texturedDraws == 1);
+}
