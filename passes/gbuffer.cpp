@@ -11,6 +11,7 @@
 #include "glint/gbuffer_shared.h"
 
 #include <glm/gtc/constants.hpp>
+#include <spdlog/spdlog.h>
 
 #include <algorithm>
 #include <array>
@@ -18,6 +19,8 @@
 #include <cmath>
 #include <cstring>
 #include <limits>
+#include <map>
+#include <set>
 #include <string>
 
 namespace glint::passes {
@@ -40,12 +43,18 @@ std::vector<gpu::Binding> geometryBindings() {
 // and the prefiltered environment (glint/environment.glsl).
 constexpr uint32_t kShadowMapBinding = 5;
 constexpr uint32_t kEnvironmentBinding = 6;
-constexpr uint32_t kNormalMapBinding = 7;
+// The material textures a draw samples per pixel, at bindings 7, 8 and 9
+// (gbuffer.frag), in MaterialSlot order.
+constexpr uint32_t kFirstMaterialTextureBinding = 7;
+enum MaterialSlot : size_t { kNormalSlot, kBaseColorSlot, kMetalRoughSlot, kMaterialSlots };
 std::vector<gpu::Binding> gbufferBindings() {
     std::vector<gpu::Binding> bindings = geometryBindings();
     bindings.push_back({kShadowMapBinding, VK_DESCRIPTOR_TYPE_COMBINED_IMAGE_SAMPLER, VK_SHADER_STAGE_FRAGMENT_BIT});
     bindings.push_back({kEnvironmentBinding, VK_DESCRIPTOR_TYPE_COMBINED_IMAGE_SAMPLER, VK_SHADER_STAGE_FRAGMENT_BIT});
-    bindings.push_back({kNormalMapBinding, VK_DESCRIPTOR_TYPE_COMBINED_IMAGE_SAMPLER, VK_SHADER_STAGE_FRAGMENT_BIT});
+    for (uint32_t slot = 0; slot < kMaterialSlots; ++slot) {
+        bindings.push_back({kFirstMaterialTextureBinding + slot, VK_DESCRIPTOR_TYPE_COMBINED_IMAGE_SAMPLER,
+                            VK_SHADER_STAGE_FRAGMENT_BIT});
+    }
     return bindings;
 }
 
@@ -58,7 +67,8 @@ VkSamplerAddressMode addressMode(scene::Wrap wrap) {
     return VK_SAMPLER_ADDRESS_MODE_REPEAT;
 }
 
-// A scene texture no material uses as its normal texture.
+// A material texture the G-buffer does not sample per pixel (none, or not
+// 8-bit): the draw binds its slot's fallback.
 constexpr size_t kNoImage = std::numeric_limits<size_t>::max();
 
 // glTF's three wrap modes for S and T: nine samplers.
@@ -217,11 +227,11 @@ struct GBufferRenderer::DrawRange {
     uint32_t indexCount = 0;
     int32_t vertexOffset = 0;
     bool doubleSided = false;
-    // The draw's push constants less the instance; normalMap = 1 with
-    // normalImage and normalSampler set.
+    // The draw's push constants less the instance; per MaterialSlot the
+    // image (kNoImage: the slot's fallback) and sampler it binds.
     shader::GBufferDraw material{};
-    size_t normalImage = 0;
-    size_t normalSampler = 0;
+    std::array<size_t, kMaterialSlots> image{kNoImage, kNoImage, kNoImage};
+    std::array<size_t, kMaterialSlots> sampler{};
 };
 
 // Host-visible buffers of one frame in flight, written when the frame
@@ -294,33 +304,48 @@ GBufferRenderer::GBufferRenderer(gpu::Context& ctx, const scene::Scene& scene, u
     for (size_t wrapS = 0; wrapS < kWrapModes; ++wrapS) {
         for (size_t wrapT = 0; wrapT < kWrapModes; ++wrapT) {
             gpu::SamplerDesc desc{VK_FILTER_LINEAR, VK_SAMPLER_MIPMAP_MODE_LINEAR,
-                                  addressMode(scene::Wrap(wrapS)), VK_LOD_CLAMP_NONE, "gbuffer.normal_map"};
+                                  addressMode(scene::Wrap(wrapS)), VK_LOD_CLAMP_NONE, "gbuffer.material_texture"};
             desc.addressV = addressMode(scene::Wrap(wrapT));
-            normalSamplers_.emplace_back(ctx, desc);
+            textureSamplers_.emplace_back(ctx, desc);
         }
     }
-    // (0.5, 0.5, 1): the unperturbed normal; bound where a draw has no
-    // normal map so the binding is always valid.
+    // Bound where a draw has no texture in a slot, so every binding is
+    // valid: (0.5, 0.5, 1) is the unperturbed normal; white leaves the
+    // factors as they are.
     const std::array<uint8_t, 4> flat = {128, 128, 255, 255};
+    const std::array<uint8_t, 4> white = {255, 255, 255, 255};
     flatNormal_ = gpu::createSampledImageWithMips(
         ctx, {.width = 1, .height = 1, .format = VK_FORMAT_R8G8B8A8_UNORM, .name = "gbuffer.flat_normal"}, flat.data());
-    // Normal textures, each once however many materials share it. Linear
-    // (UNORM): glTF normal textures hold vectors, not colours.
-    std::vector<size_t> normalImageOf(scene.textures.size(), kNoImage);
-    for (const scene::Material& material : scene.materials) {
-        const scene::TextureRef& ref = material.normalTexture;
-        if (!ref.valid() || normalImageOf.at(size_t(ref.texture)) != kNoImage) continue;
-        const scene::Texture& texture = scene.textures[size_t(ref.texture)];
-        if (texture.format != scene::TextureFormat::Rgba8) continue;
-        normalImageOf[size_t(ref.texture)] = normalImages_.size();
-        normalImages_.push_back(gpu::createSampledImageWithMips(ctx,
-                                                                {.width = texture.width,
-                                                                 .height = texture.height,
-                                                                 .format = VK_FORMAT_R8G8B8A8_UNORM,
-                                                                 .name = "gbuffer.normal_map." + texture.name},
-                                                                texture.rgba8.data()));
-    }
-    stats_.normalMaps = uint32_t(normalImages_.size());
+    white_ = gpu::createSampledImageWithMips(
+        ctx, {.width = 1, .height = 1, .format = VK_FORMAT_R8G8B8A8_UNORM, .name = "gbuffer.white"}, white.data());
+
+    // Material textures, uploaded with their mips the first time a drawn
+    // geometry's material needs them, each once per colour space however
+    // many materials share it. glTF: base colour is sRGB (the sampler
+    // decodes before filtering; the CPU sampling at vertices decodes after,
+    // which agrees at texel centres), metallic-roughness and normal linear.
+    std::map<std::pair<int32_t, VkFormat>, size_t> imageOf;
+    uint64_t textureBytes = 0;
+    std::set<size_t> normalImages;
+    const auto textureImage = [&](const scene::TextureRef& ref, VkFormat format, const char* slotName) {
+        if (!ref.valid()) return kNoImage;
+        const scene::Texture& texture = scene.textures.at(size_t(ref.texture));
+        if (texture.format != scene::TextureFormat::Rgba8) return kNoImage;
+        const auto [it, added] = imageOf.try_emplace({ref.texture, format}, textureImages_.size());
+        if (!added) return it->second;
+        textureImages_.push_back(gpu::createSampledImageWithMips(ctx,
+                                                                 {.width = texture.width,
+                                                                  .height = texture.height,
+                                                                  .format = format,
+                                                                  .name = std::string("gbuffer.") + slotName + "." +
+                                                                          texture.name},
+                                                                 texture.rgba8.data()));
+        for (uint32_t w = texture.width, h = texture.height;; w = std::max(w / 2, 1u), h = std::max(h / 2, 1u)) {
+            textureBytes += uint64_t(w) * h * 4;
+            if (w == 1 && h == 1) break;
+        }
+        return it->second;
+    };
 
     // Every mesh's LOD 0 into one vertex and one index buffer: one binding
     // for the whole frame, draws differ only in their ranges.
@@ -341,14 +366,32 @@ GBufferRenderer::GBufferRenderer(gpu::Context& ctx, const scene::Scene& scene, u
             const scene::Material& material = scene.materials.at(g.material);
             range.doubleSided = material.doubleSided;
             const scene::TextureRef& normalRef = material.normalTexture;
-            if (normalRef.valid() && normalImageOf.at(size_t(normalRef.texture)) != kNoImage &&
-                g.tangents.size() == g.vertexCount()) {
+            if (g.tangents.size() == g.vertexCount()) {
+                range.image[kNormalSlot] = textureImage(normalRef, VK_FORMAT_R8G8B8A8_UNORM, "normal_map");
+            }
+            if (range.image[kNormalSlot] != kNoImage) {
                 range.material.normalMap = 1;
                 range.material.normalTexCoord = normalRef.texCoord;
                 range.material.normalUvTransform = normalRef.uvTransform();
                 range.material.normalScale = material.normalScale;
-                range.normalImage = normalImageOf[size_t(normalRef.texture)];
-                range.normalSampler = samplerIndex(normalRef);
+                range.sampler[kNormalSlot] = samplerIndex(normalRef);
+                normalImages.insert(range.image[kNormalSlot]);
+            }
+            const scene::TextureRef& baseRef = material.baseColorTexture;
+            range.image[kBaseColorSlot] = textureImage(baseRef, VK_FORMAT_R8G8B8A8_SRGB, "base_color");
+            if (range.image[kBaseColorSlot] != kNoImage) {
+                range.material.baseColorMap = 1;
+                range.material.baseColorTexCoord = baseRef.texCoord;
+                range.material.baseColorUvTransform = baseRef.uvTransform();
+                range.sampler[kBaseColorSlot] = samplerIndex(baseRef);
+            }
+            const scene::TextureRef& metalRoughRef = material.metallicRoughnessTexture;
+            range.image[kMetalRoughSlot] = textureImage(metalRoughRef, VK_FORMAT_R8G8B8A8_UNORM, "metal_rough");
+            if (range.image[kMetalRoughSlot] != kNoImage) {
+                range.material.metalRoughMap = 1;
+                range.material.metalRoughTexCoord = metalRoughRef.texCoord;
+                range.material.metalRoughUvTransform = metalRoughRef.uvTransform();
+                range.sampler[kMetalRoughSlot] = samplerIndex(metalRoughRef);
             }
             for (uint32_t v = 0; v < g.vertexCount(); ++v) {
                 const shader::SurfaceVertex s = scene::surfaceAtVertex(scene, g, v);
@@ -358,6 +401,17 @@ GBufferRenderer::GBufferRenderer(gpu::Context& ctx, const scene::Scene& scene, u
                 out.albedo = s.albedo;
                 out.roughness = s.roughness;
                 out.metallic = s.metallic;
+                // Textures sampled per pixel leave their factors (and
+                // COLOR_0) here; the fragment shader multiplies the texel in.
+                if (range.material.baseColorMap != 0) {
+                    glm::vec3 albedo = glm::vec3(material.baseColorFactor);
+                    if (v < g.colors.size()) albedo *= glm::vec3(g.colors[v]);
+                    out.albedo = glm::clamp(albedo, glm::vec3(0.0f), glm::vec3(1.0f));
+                }
+                if (range.material.metalRoughMap != 0) {
+                    out.roughness = std::clamp(material.roughnessFactor, 0.0f, 1.0f);
+                    out.metallic = std::clamp(material.metallicFactor, 0.0f, 1.0f);
+                }
                 out.reflectance = s.reflectance;
                 if (g.skinned()) {
                     const glm::u16vec4 j = g.joints[v];
@@ -388,6 +442,12 @@ GBufferRenderer::GBufferRenderer(gpu::Context& ctx, const scene::Scene& scene, u
                                                gpu::MemoryUsage::DeviceLocal, "gbuffer.indices"},
                                          indices.data());
     stats_.geometryBytes = vertices_.size() + indices_.size();
+    stats_.textureImages = uint32_t(textureImages_.size());
+    stats_.textureBytes = textureBytes;
+    stats_.normalMaps = uint32_t(normalImages.size());
+    spdlog::info("G-buffer: {} material textures uploaded for per-pixel sampling ({:.2f} MiB with mips), {} of them "
+                 "normal maps",
+                 stats_.textureImages, double(textureBytes) / (1024.0 * 1024.0), stats_.normalMaps);
 
     for (uint32_t i = 0; i < framesInFlight_; ++i) {
         slots_.push_back(std::make_unique<FrameSlot>());
@@ -604,9 +664,10 @@ void GBufferRenderer::record(const FrameWork& work, rg::PassContext& pc, const G
     vkCmdSetScissor(cmd, 0, 1, &scissor);
 
     // Pushed again only when a draw's vertex buffer (a morphing instance's
-    // own) or normal map differs from the last one.
+    // own) or one of its material textures differs from the last draw's.
+    using MaterialTextures = std::array<std::pair<const gpu::Image*, const gpu::Sampler*>, kMaterialSlots>;
     const auto pushBindings = [&](const gpu::Pipeline& pipeline, const gpu::Buffer& vertices,
-                                  const gpu::Image& normalImage, const gpu::Sampler& normalSampler) {
+                                  const MaterialTextures& textures) {
         gpu::PushDescriptors push(pipeline);
         push.storageBuffer(0, slot.frame)
             .storageBuffer(1, slot.instances)
@@ -614,8 +675,10 @@ void GBufferRenderer::record(const FrameWork& work, rg::PassContext& pc, const G
             .storageBuffer(3, slot.joints)
             .storageBuffer(4, slot.previousJoints)
             .sampledImage(kShadowMapBinding, pc.view(targets.shadowMap), nearest_.handle(),
-                          pc.layout(targets.shadowMap))
-            .sampledImage(kNormalMapBinding, normalImage.view(), normalSampler.handle());
+                          pc.layout(targets.shadowMap));
+        for (uint32_t t = 0; t < kMaterialSlots; ++t) {
+            push.sampledImage(kFirstMaterialTextureBinding + t, textures[t].first->view(), textures[t].second->handle());
+        }
         // The procedural sky reads no texture: the shadow map, which the
         // pass reads anyway, fills the environment's binding.
         if (environment.valid()) {
@@ -627,32 +690,37 @@ void GBufferRenderer::record(const FrameWork& work, rg::PassContext& pc, const G
         }
         push.push(ctx_, cmd);
     };
+    const MaterialTextures fallbacks = {std::pair{&flatNormal_, &textureSamplers_[0]},
+                                        std::pair{&white_, &textureSamplers_[0]},
+                                        std::pair{&white_, &textureSamplers_[0]}};
 
     stats_.draws = 0;
     stats_.triangles = 0;
     stats_.normalMappedDraws = 0;
+    stats_.texturedDraws = 0;
     surfacePipeline_.bind(cmd);
     const gpu::Buffer* boundVertices = &vertices_;
-    const gpu::Image* boundImage = &flatNormal_;
-    const gpu::Sampler* boundSampler = &normalSamplers_[0];
-    pushBindings(surfacePipeline_, *boundVertices, *boundImage, *boundSampler);
+    MaterialTextures boundTextures = fallbacks;
+    pushBindings(surfacePipeline_, *boundVertices, boundTextures);
     vkCmdBindIndexBuffer(cmd, indices_.handle(), 0, VK_INDEX_TYPE_UINT32);
     for (size_t i = 0; i < work.instances.size(); ++i) {
         const auto [vertices, vertexShift] = vertexSource(work, i, slot);
         for (const DrawRange& range : meshDraws_.at(work.meshes[i])) {
             if (range.indexCount == 0) continue;
-            const gpu::Image* image = boundImage;
-            const gpu::Sampler* sampler = boundSampler;
-            if (range.material.normalMap != 0) {
-                image = &normalImages_[range.normalImage];
-                sampler = &normalSamplers_[range.normalSampler];
-                ++stats_.normalMappedDraws;
+            // A slot the draw does not sample keeps whatever is bound.
+            MaterialTextures textures = boundTextures;
+            bool textured = false;
+            for (size_t t = 0; t < kMaterialSlots; ++t) {
+                if (range.image[t] == kNoImage) continue;
+                textures[t] = {&textureImages_[range.image[t]], &textureSamplers_[range.sampler[t]]};
+                textured = true;
             }
-            if (vertices != boundVertices || image != boundImage || sampler != boundSampler) {
+            stats_.normalMappedDraws += range.material.normalMap;
+            stats_.texturedDraws += textured ? 1u : 0u;
+            if (vertices != boundVertices || textures != boundTextures) {
                 boundVertices = vertices;
-                boundImage = image;
-                boundSampler = sampler;
-                pushBindings(surfacePipeline_, *boundVertices, *boundImage, *boundSampler);
+                boundTextures = textures;
+                pushBindings(surfacePipeline_, *boundVertices, boundTextures);
             }
             shader::GBufferDraw draw = range.material;
             draw.instance = uint32_t(i);
@@ -665,7 +733,7 @@ void GBufferRenderer::record(const FrameWork& work, rg::PassContext& pc, const G
     }
     if (work.drawSky) {
         skyPipeline_.bind(cmd);
-        pushBindings(skyPipeline_, vertices_, flatNormal_, normalSamplers_[0]);
+        pushBindings(skyPipeline_, vertices_, fallbacks);
         skyPipeline_.pushConstants(cmd, shader::GBufferDraw{});
         vkCmdDraw(cmd, 3, 1, 0, 0);
     }

@@ -23,13 +23,15 @@
 // camera's view up to a distance or to the whole scene where that is
 // smaller, on a world-fixed texel grid so it does not shimmer as the camera
 // moves. It needs no BVH, so every mode and device gets the same shadows.
-// Materials are sampled at the vertices on the CPU (scene::surfaceAtVertex,
-// as the BVH's packed primitives are), so base colour and metallic-
-// roughness textures contribute at vertex rate. Normal maps are the
-// exception: uploaded with their mips and sampled per pixel (tangent space,
-// glTF's TANGENT or generated tangents, normalTexture.scale, the texture
-// coordinate set and KHR_texture_transform the material names). The packed
-// primitives of the RT hits keep the vertex normal. Instances of meshes with
+// Material textures are sampled per pixel: base colour (an sRGB image),
+// metallic-roughness (G roughness, B metallic) and normal maps (tangent
+// space, glTF's TANGENT or generated tangents, normalTexture.scale), each
+// uploaded once with its mips and read through the texture coordinate set
+// and KHR_texture_transform its reference names, times the factors (and
+// COLOR_0) the vertices carry. The rest of the material (reflectance, and
+// every texture when it is not 8-bit) is evaluated at the vertices on the
+// CPU (scene::surfaceAtVertex). The packed primitives of the RT hits keep
+// sampling every texture at their vertices, and keep the vertex normal. Instances of meshes with
 // morph targets draw from a per-frame copy of their vertices with their
 // morph weights applied on the CPU (scene::morphedGeometry); their motion
 // vectors cover transforms and skins, not last frame's morph.
@@ -141,8 +143,11 @@ struct GBufferStats {
     // This frame's shadow map fit (enabled = 0 with shadows off).
     shader::GBufferShadow shadow{};
     uint64_t geometryBytes = 0;   // the uploaded vertex and index buffers
-    uint32_t normalMaps = 0;      // normal textures uploaded
+    uint32_t textureImages = 0;   // material textures uploaded (one per texture and colour space)
+    uint64_t textureBytes = 0;    // their bytes, mips included
+    uint32_t normalMaps = 0;      // of them, normal textures
     uint32_t normalMappedDraws = 0;  // this frame
+    uint32_t texturedDraws = 0;   // this frame: draws sampling any material texture
 };
 
 // Owns the scene's GPU geometry (every mesh's LOD 0, uploaded once into one
@@ -192,12 +197,14 @@ private:
     gpu::Pipeline shadowPipeline_;
     gpu::Sampler nearest_;  // completes the shadow map's descriptor; reads are texelFetch
     gpu::Sampler environmentSampler_;
-    // Normal maps: one image per scene texture some material uses as its
-    // normal texture (by scene texture index), a 1x1 flat one bound to
-    // draws without, and one sampler per glTF wrap-mode pair.
-    std::vector<gpu::Image> normalImages_;
+    // Material textures: one image per scene texture and colour space some
+    // drawn geometry's material samples (base colour sRGB; metallic-
+    // roughness and normal UNORM), 1x1 fallbacks bound to draws without (a
+    // flat normal, white), and one sampler per glTF wrap-mode pair.
+    std::vector<gpu::Image> textureImages_;
     gpu::Image flatNormal_;
-    std::vector<gpu::Sampler> normalSamplers_;
+    gpu::Image white_;
+    std::vector<gpu::Sampler> textureSamplers_;
     gpu::Buffer vertices_;  // GBufferVertex, every geometry of every mesh's LOD 0
     gpu::Buffer indices_;
     std::vector<std::vector<DrawRange>> meshDraws_;  // per mesh: its LOD-0 geometries

@@ -17,15 +17,23 @@ layout(location = 5) in vec4 inPreviousClip;
 layout(location = 6) in vec4 inTangent;
 layout(location = 7) in vec4 inUv;
 
-// The draw's normal texture (linear, tangent space); a flat one when the
-// material has none and draw.normalMap is 0.
-layout(set = 0, binding = 7) uniform sampler2D normalMap;
+// The draw's material textures; 1x1 fallbacks (flat normal, white) where the
+// material has none and the draw's flag is 0.
+layout(set = 0, binding = 7) uniform sampler2D normalMap;     // linear, tangent space
+layout(set = 0, binding = 8) uniform sampler2D baseColorMap;  // sRGB image: texels decode to linear
+layout(set = 0, binding = 9) uniform sampler2D metalRoughMap; // linear; G = roughness, B = metallic
 
 layout(location = 0) out vec4 outNormal;
 layout(location = 1) out vec4 outAlbedo;
 layout(location = 2) out vec4 outRoughnessMetal;
 layout(location = 3) out vec2 outMotion;
 layout(location = 4) out vec4 outLit;
+
+// A texture reference's coordinates: its set (glTF texCoord), then its
+// KHR_texture_transform.
+vec2 textureUv(uint texCoord, UvTransform transform) {
+    return applyUvTransform(transform, texCoord == 0u ? inUv.xy : inUv.zw);
+}
 
 vec2 pixelOf(vec4 clip) {
     return (clip.xy / clip.w * 0.5 + 0.5) * frame.size;
@@ -50,8 +58,7 @@ vec3 normalMapped(vec3 n, bool backFace) {
         b = -b;
         frameNormal = -n;
     }
-    const vec2 uv = applyUvTransform(draw.normalUvTransform, draw.normalTexCoord == 0u ? inUv.xy : inUv.zw);
-    vec3 m = texture(normalMap, uv).xyz * 2.0 - 1.0;
+    vec3 m = texture(normalMap, textureUv(draw.normalTexCoord, draw.normalUvTransform)).xyz * 2.0 - 1.0;
     m.xy *= draw.normalScale;
     const vec3 perturbed = t * m.x + b * m.y + frameNormal * m.z;
     const float lengthSq = dot(perturbed, perturbed);
@@ -68,12 +75,22 @@ void main() {
     // the shadow map rasterised, not the normal map's detail.
     const vec3 geometricNormal = backFace ? -n : n;
     n = draw.normalMap != 0u ? normalMapped(n, backFace) : geometricNormal;
+    // glTF: factor (and COLOR_0, both in the vertex) times texel, per pixel.
+    // The flags are push constants, so the branches are uniform per draw.
+    vec3 albedo = inAlbedo;
+    if (draw.baseColorMap != 0u) {
+        albedo *= texture(baseColorMap, textureUv(draw.baseColorTexCoord, draw.baseColorUvTransform)).rgb;
+    }
+    vec2 roughnessMetallic = inMaterial.xy;
+    if (draw.metalRoughMap != 0u) {
+        roughnessMetallic *= texture(metalRoughMap, textureUv(draw.metalRoughTexCoord, draw.metalRoughUvTransform)).gb;
+    }
     Surface s;
     s.position = inWorldPosition;
     s.normal = n;
-    s.albedo = clamp(inAlbedo, 0.0, 1.0);
-    s.roughness = clamp(inMaterial.x, 0.0, 1.0);
-    s.metallic = clamp(inMaterial.y, 0.0, 1.0);
+    s.albedo = clamp(albedo, 0.0, 1.0);
+    s.roughness = clamp(roughnessMetallic.x, 0.0, 1.0);
+    s.metallic = clamp(roughnessMetallic.y, 0.0, 1.0);
     s.reflectance = clamp(inMaterial.z, 0.0, 1.0);
 
     const vec3 toViewer = normalize(frame.cameraPosition.xyz - inWorldPosition);

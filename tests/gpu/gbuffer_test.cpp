@@ -853,3 +853,198 @@ TEST_CASE("a camera without pixels is an error naming the G-buffer") {
     CHECK_THROWS_WITH_AS(passes::addGBufferPass(graph, renderer, {camera}), doctest::Contains("G-buffer"),
                          gpu::GpuError);
 }
+
+namespace {
+
+// A 64x64 texture of 2x2 checker cells, 32 texels each, `cells` in the
+// order top-left, top-right, bottom-left, bottom-right of the image.
+scene::Texture checkerTexture(const std::array<glm::u8vec4, 4>& cells) {
+    scene::Texture texture;
+    texture.name = "checker";
+    texture.width = texture.height = 64;
+    for (uint32_t y = 0; y < 64; ++y) {
+        for (uint32_t x = 0; x < 64; ++x) {
+            const glm::u8vec4 c = cells[(y / 32) * 2 + x / 32];
+            texture.rgba8.insert(texture.rgba8.end(), {c.r, c.g, c.b, c.a});
+        }
+    }
+    return texture;
+}
+
+// A plane at distance 5 that fills the test image exactly (90-degree lens),
+// so texture coordinates (x + 0.5, y + 0.5) / 64 land on texel centres of a
+// 64x64 texture at pixel (x, y): set 0 as is, set 1 mirrored in u. Sampled
+// at its four corners (the vertex path) the checker would give the average
+// of its cells everywhere.
+scene::Scene checkerPlaneScene(const scene::Texture& texture, const scene::Material& material,
+                               const std::vector<glm::vec4>& colors = {}) {
+    scene::Geometry plane = square({0, 0, -5}, {1, 0, 0}, {0, 1, 0}, 5.0f);
+    for (const glm::vec3& p : plane.positions) {
+        const glm::vec2 uv(p.x / 10.0f + 0.5f, 0.5f - p.y / 10.0f);
+        plane.texcoords0.push_back(uv);
+        plane.texcoords1.push_back({1.0f - uv.x, uv.y});
+    }
+    plane.colors = colors;
+    scene::Scene s;
+    s.name = "gbuffer-checker-test";
+    s.textures.push_back(texture);
+    s.materials.push_back(material);
+    scene::Mesh mesh;
+    mesh.lods.push_back({{plane}});
+    s.meshes.push_back(std::move(mesh));
+    s.instances.push_back({});
+    scene::prepareScene(s);
+    return s;
+}
+
+// The checker cell the texture reference reads at pixel (x, y) of
+// checkerPlaneScene, or -1 within `margin` (in texture coordinates) of a
+// cell's edge, where filtering mixes cells.
+int checkerCellAt(const scene::TextureRef& ref, uint32_t x, uint32_t y, float margin) {
+    glm::vec2 uv((float(x) + 0.5f) / float(kSize), (float(y) + 0.5f) / float(kSize));
+    if (ref.texCoord == 1) uv.x = 1.0f - uv.x;
+    const glm::vec2 t = shader::applyUvTransform(ref.uvTransform(), uv) * 2.0f;
+    const glm::vec2 inCell = t - glm::floor(t);
+    if (std::min(std::min(inCell.x, 1.0f - inCell.x), std::min(inCell.y, 1.0f - inCell.y)) < 2.0f * margin) return -1;
+    const glm::ivec2 cell = glm::ivec2(glm::floor(t)) & 1;
+    return cell.y * 2 + cell.x;
+}
+
+float unorm8(uint8_t v) {
+    return float(v) / 255.0f;
+}
+
+} // namespace
+
+TEST_CASE("the base colour texture is sampled per pixel: each checker cell gives its texel times factor and COLOR_0") {
+    const std::array<glm::u8vec4, 4> cells = {glm::u8vec4(200, 40, 90, 255), glm::u8vec4(30, 180, 250, 255),
+                                              glm::u8vec4(120, 120, 20, 255), glm::u8vec4(250, 250, 250, 255)};
+    scene::Material material;
+    material.baseColorTexture.texture = 0;
+    material.baseColorFactor = {0.8f, 1.0f, 0.6f, 1.0f};
+    const glm::vec4 color(1.0f, 0.5f, 1.0f, 1.0f);
+    test::GpuTest gpu;
+    const scene::Scene scene = checkerPlaneScene(checkerTexture(cells), material, std::vector<glm::vec4>(4, color));
+    passes::GBufferStats stats;
+    const GBufferImage img = render(gpu, scene, {testCamera()}, &stats);
+    CHECK(stats.textureImages == 1);
+    CHECK(stats.normalMaps == 0);
+    CHECK(stats.texturedDraws == 1);
+
+    std::array<int, 4> seen{};
+    for (uint32_t y = 0; y < kSize; ++y) {
+        for (uint32_t x = 0; x < kSize; ++x) {
+            const int cell = checkerCellAt(material.baseColorTexture, x, y, 2.0f / 64.0f);
+            if (cell < 0) continue;
+            ++seen[size_t(cell)];
+            INFO("pixel " << x << ", " << y << ", cell " << cell);
+            const glm::u8vec4 albedo = img.albedo[img.at(x, y)];
+            for (int c = 0; c < 3; ++c) {
+                // sRGB texel decoded, times factor and vertex colour, stored sRGB.
+                const float texel = shader::srgbToLinear(unorm8(cells[size_t(cell)][c]));
+                const float linear = texel * material.baseColorFactor[c] * color[c];
+                REQUIRE(std::abs(int(albedo[c]) - srgbByte(linear)) <= 1);
+            }
+        }
+    }
+    for (const int n : seen) CHECK(n > 100);
+}
+
+TEST_CASE("the metallic-roughness texture is sampled per pixel: G times the roughness factor, B times the metallic") {
+    const std::array<glm::u8vec4, 4> cells = {glm::u8vec4(0, 30, 250, 255), glm::u8vec4(0, 240, 10, 255),
+                                              glm::u8vec4(0, 128, 128, 255), glm::u8vec4(0, 200, 60, 255)};
+    scene::Material material;
+    material.metallicRoughnessTexture.texture = 0;
+    material.metallicRoughnessTexture.texCoord = 1;  // mirrored in u
+    material.roughnessFactor = 0.5f;
+    material.metallicFactor = 0.9f;
+    test::GpuTest gpu;
+    const scene::Scene scene = checkerPlaneScene(checkerTexture(cells), material);
+    passes::GBufferStats stats;
+    const GBufferImage img = render(gpu, scene, {testCamera()}, &stats);
+    CHECK(stats.textureImages == 1);
+
+    std::array<int, 4> seen{};
+    for (uint32_t y = 0; y < kSize; ++y) {
+        for (uint32_t x = 0; x < kSize; ++x) {
+            const int cell = checkerCellAt(material.metallicRoughnessTexture, x, y, 2.0f / 64.0f);
+            if (cell < 0) continue;
+            ++seen[size_t(cell)];
+            INFO("pixel " << x << ", " << y << ", cell " << cell);
+            const glm::u8vec4 rm = img.roughnessMetal[img.at(x, y)];
+            const float roughness = unorm8(cells[size_t(cell)].g) * material.roughnessFactor;
+            const float metallic = unorm8(cells[size_t(cell)].b) * material.metallicFactor;
+            REQUIRE(std::abs(int(rm.r) - int(shader::encodeUnorm8(roughness))) <= 1);
+            REQUIRE(std::abs(int(rm.g) - int(shader::encodeUnorm8(metallic))) <= 1);
+        }
+    }
+    for (const int n : seen) CHECK(n > 100);
+}
+
+TEST_CASE("the base colour texture is read through its reference's coordinate set and KHR_texture_transform") {
+    const std::array<glm::u8vec4, 4> cells = {glm::u8vec4(255, 0, 0, 255), glm::u8vec4(0, 255, 0, 255),
+                                              glm::u8vec4(0, 0, 255, 255), glm::u8vec4(255, 255, 0, 255)};
+    struct Case {
+        const char* what;
+        uint32_t texCoord;
+        glm::vec2 offset;
+        float rotation;
+        glm::vec2 scale;
+    };
+    for (const Case& c : {Case{"set 0, identity", 0, {0.0f, 0.0f}, 0.0f, {1.0f, 1.0f}},
+                          Case{"set 1, identity", 1, {0.0f, 0.0f}, 0.0f, {1.0f, 1.0f}},
+                          Case{"set 0, offset a quarter", 0, {0.25f, 0.0f}, 0.0f, {1.0f, 1.0f}},
+                          Case{"set 1, rotated a quarter turn, scaled twice", 1, {0.0f, 0.0f},
+                               glm::half_pi<float>(), {2.0f, 2.0f}}}) {
+        INFO(c.what);
+        scene::Material material;
+        material.baseColorTexture.texture = 0;
+        material.baseColorTexture.texCoord = c.texCoord;
+        material.baseColorTexture.offset = c.offset;
+        material.baseColorTexture.rotation = c.rotation;
+        material.baseColorTexture.scale = c.scale;
+        test::GpuTest gpu;
+        const scene::Scene scene = checkerPlaneScene(checkerTexture(cells), material);
+        const GBufferImage img = render(gpu, scene, {testCamera()});
+        std::array<int, 4> seen{};
+        for (uint32_t y = 0; y < kSize; ++y) {
+            for (uint32_t x = 0; x < kSize; ++x) {
+                // Scaled twice, a pixel spans two texels: a wider margin.
+                const int cell = checkerCellAt(material.baseColorTexture, x, y, 3.0f / 64.0f * c.scale.x);
+                if (cell < 0) continue;
+                ++seen[size_t(cell)];
+                INFO("pixel " << x << ", " << y << ", cell " << cell);
+                const glm::u8vec4 albedo = img.albedo[img.at(x, y)];
+                for (int k = 0; k < 3; ++k) REQUIRE(std::abs(int(albedo[k]) - int(cells[size_t(cell)][k])) <= 1);
+            }
+        }
+        for (const int n : seen) CHECK(n > 20);
+    }
+}
+
+TEST_CASE("only the textures drawn materials sample are uploaded, once per texture and colour space") {
+    // Texture 0 serves as base colour (sRGB) and metallic-roughness (linear)
+    // of the drawn material: two images. Texture 1 belongs to a material no
+    // geometry uses, texture 2 to none: neither is uploaded.
+    const std::array<glm::u8vec4, 4> cells = {glm::u8vec4(255), glm::u8vec4(128), glm::u8vec4(64), glm::u8vec4(32)};
+    scene::Material drawn;
+    drawn.baseColorTexture.texture = 0;
+    drawn.metallicRoughnessTexture.texture = 0;
+    scene::Scene s = checkerPlaneScene(checkerTexture(cells), drawn);
+    s.textures.push_back(checkerTexture(cells));
+    s.textures.push_back(checkerTexture(cells));
+    scene::Material unused;
+    unused.baseColorTexture.texture = 1;
+    unused.normalTexture.texture = 1;
+    s.materials.push_back(unused);
+    test::GpuTest gpu;
+    passes::GBufferStats stats;
+    render(gpu, s, {testCamera()}, &stats);
+    CHECK(stats.textureImages == 2);
+    CHECK(stats.normalMaps == 0);
+    // 64x64 RGBA8 and its mips down to 1x1, twice.
+    uint64_t bytes = 0;
+    for (uint32_t side = 64; side >= 1; side /= 2) bytes += uint64_t(side) * side * 4;
+    CHECK(stats.textureBytes == 2 * bytes);
+    CHECK(stats.texturedDraws == 1);
+}

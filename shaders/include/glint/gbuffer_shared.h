@@ -30,17 +30,18 @@
 
 GLINT_BEGIN
 
-// One vertex of a LOD-0 geometry, uploaded once (104 bytes). The material is
-// sampled at the vertex on the CPU (scene::surfaceAtVertex), exactly as the
-// BVH manager does for the packed primitives, so the rasterised surface and
-// the ray-traced one agree; only the normal map is sampled per pixel (a
-// normal map at vertex rate means nothing), with the tangent frame and
-// texture coordinates below.
+// One vertex of a LOD-0 geometry, uploaded once (104 bytes). The material
+// is evaluated at the vertex on the CPU (scene::surfaceAtVertex, as the BVH
+// manager does for the packed primitives), except for the textures the
+// G-buffer samples per pixel (base colour, metallic-roughness, normal; see
+// GBufferDraw): for those the vertex holds only the factors (and COLOR_0),
+// and the fragment shader multiplies in the texel at the texture
+// coordinates below.
 struct GBufferVertex {
     vec3 position;  // object space, bind pose for skinned geometry
     vec3 normal;
-    vec3 albedo;    // linear
-    float roughness;
+    vec3 albedo;    // linear; without the base colour texture when it is sampled per pixel
+    float roughness;  // likewise without the metallic-roughness texture
     float metallic;
     float reflectance;
     uvec2 joints;   // four 16-bit joint indices: x = j0 | j1 << 16, y = j2 | j3 << 16
@@ -116,14 +117,24 @@ struct GBufferFrame {
     GBufferShadow shadow;
 };
 
-// Push constants of one draw (48 bytes).
+// Push constants of one draw (112 bytes, within the 128 Vulkan guarantees).
 struct GBufferDraw {
     uint instance;
     uint doubleSided;     // 1: back faces are lit with the flipped normal
-    uint normalMap;       // 1: perturb the normal with the normal map (binding 6)
+    uint normalMap;       // 1: perturb the normal with the normal map (binding 7)
     uint normalTexCoord;  // 0: GBufferVertex::uv0, 1: uv1
     UvTransform normalUvTransform;  // the normal texture's KHR_texture_transform
     float normalScale;    // glTF normalTexture.scale
+    // 1: multiply the vertex albedo (factor times COLOR_0) per pixel by the
+    // base colour texture (binding 8, sRGB-decoded by the sampler).
+    uint baseColorMap;
+    uint baseColorTexCoord;
+    UvTransform baseColorUvTransform;
+    // 1: multiply the vertex roughness and metallic (the factors) per pixel
+    // by the metallic-roughness texture's G and B (binding 9, linear).
+    uint metalRoughMap;
+    uint metalRoughTexCoord;
+    UvTransform metalRoughUvTransform;
     uint pad0;
 };
 
@@ -132,7 +143,7 @@ GLINT_END
 #ifdef __cplusplus
 static_assert(sizeof(glint::shader::GBufferVertex) == 104);
 static_assert(sizeof(glint::shader::GBufferInstance) == 144);
-static_assert(sizeof(glint::shader::GBufferDraw) == 48);
+static_assert(sizeof(glint::shader::GBufferDraw) == 112);
 static_assert(sizeof(glint::shader::GBufferShadow) == 112);
 static_assert(sizeof(glint::shader::SceneLighting) == 240);
 #endif
