@@ -21,6 +21,8 @@
 #include "metrics/pixel_metrics.h"
 #include "scene/builtin_scenes.h"
 
+#include "glint_commit.h"  // generated: GLINT_BUILD_COMMIT
+
 #include <spdlog/spdlog.h>
 
 #include <algorithm>
@@ -104,22 +106,8 @@ std::vector<passes::ReflectionMode> parseModes(const std::string& flag, const st
     return modes;
 }
 
-// The commit: git at run time (right after new commits without a
-// reconfigure), else the one CMake saw, else "unknown".
-std::string gitCommit() {
-    std::string out;
-    const std::string command =
-        std::string("git -C '") + GLINT_SOURCE_DIR + "' describe --always --dirty --abbrev=12 2>/dev/null";
-    if (FILE* pipe = popen(command.c_str(), "r")) {
-        char buffer[128];
-        while (std::fgets(buffer, sizeof buffer, pipe)) out += buffer;
-        const int rc = pclose(pipe);
-        while (!out.empty() && (out.back() == '\n' || out.back() == '\r')) out.pop_back();
-        if (rc == 0 && !out.empty()) return out;
-    }
-    const std::string configured = GLINT_CONFIGURED_COMMIT;
-    return configured.empty() ? "unknown" : configured + " (at configure time)";
-}
+// The commit the binary was built from (cmake/write_commit.cmake).
+std::string gitCommit() { return GLINT_BUILD_COMMIT; }
 
 std::string utcNow() {
     const std::time_t now = std::time(nullptr);
