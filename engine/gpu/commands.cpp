@@ -124,6 +124,12 @@ void bufferBarrier(VkCommandBuffer cmd, const Buffer& buffer, VkPipelineStageFla
 void imageBarrier(VkCommandBuffer cmd, const Image& image, VkImageLayout oldLayout, VkImageLayout newLayout,
                   VkPipelineStageFlags2 srcStage, VkAccessFlags2 srcAccess, VkPipelineStageFlags2 dstStage,
                   VkAccessFlags2 dstAccess) {
+    imageBarrier(cmd, image, image.fullRange(), oldLayout, newLayout, srcStage, srcAccess, dstStage, dstAccess);
+}
+
+void imageBarrier(VkCommandBuffer cmd, const Image& image, const VkImageSubresourceRange& range,
+                  VkImageLayout oldLayout, VkImageLayout newLayout, VkPipelineStageFlags2 srcStage,
+                  VkAccessFlags2 srcAccess, VkPipelineStageFlags2 dstStage, VkAccessFlags2 dstAccess) {
     VkImageMemoryBarrier2 b{VK_STRUCTURE_TYPE_IMAGE_MEMORY_BARRIER_2};
     b.srcStageMask = srcStage;
     b.srcAccessMask = srcAccess;
@@ -133,7 +139,7 @@ void imageBarrier(VkCommandBuffer cmd, const Image& image, VkImageLayout oldLayo
     b.newLayout = newLayout;
     b.srcQueueFamilyIndex = b.dstQueueFamilyIndex = VK_QUEUE_FAMILY_IGNORED;
     b.image = image.handle();
-    b.subresourceRange = image.fullRange();
+    b.subresourceRange = range;
     VkDependencyInfo dep{VK_STRUCTURE_TYPE_DEPENDENCY_INFO};
     dep.imageMemoryBarrierCount = 1;
     dep.pImageMemoryBarriers = &b;
@@ -212,20 +218,8 @@ Image createSampledImageWithMips(Context& ctx, const ImageDesc& desc, const void
         const auto mipBarrier = [&](uint32_t mip, VkImageLayout from, VkImageLayout to, VkPipelineStageFlags2 srcStage,
                                     VkAccessFlags2 srcAccess, VkPipelineStageFlags2 dstStage,
                                     VkAccessFlags2 dstAccess) {
-            VkImageMemoryBarrier2 b{VK_STRUCTURE_TYPE_IMAGE_MEMORY_BARRIER_2};
-            b.srcStageMask = srcStage;
-            b.srcAccessMask = srcAccess;
-            b.dstStageMask = dstStage;
-            b.dstAccessMask = dstAccess;
-            b.oldLayout = from;
-            b.newLayout = to;
-            b.srcQueueFamilyIndex = b.dstQueueFamilyIndex = VK_QUEUE_FAMILY_IGNORED;
-            b.image = image.handle();
-            b.subresourceRange = {VK_IMAGE_ASPECT_COLOR_BIT, mip, 1, 0, 1};
-            VkDependencyInfo dep{VK_STRUCTURE_TYPE_DEPENDENCY_INFO};
-            dep.imageMemoryBarrierCount = 1;
-            dep.pImageMemoryBarriers = &b;
-            vkCmdPipelineBarrier2(cmd, &dep);
+            imageBarrier(cmd, image, {VK_IMAGE_ASPECT_COLOR_BIT, mip, 1, 0, 1}, from, to, srcStage, srcAccess, dstStage,
+                         dstAccess);
         };
         // Every mip to TRANSFER_DST; mip 0 gets the texels.
         for (uint32_t mip = 0; mip < d.mips; ++mip) {
