@@ -329,6 +329,7 @@ struct Need {
     bool barrier;
     bool rawByBarrier;
     bool aliased;
+    bool waits; // asked crossQueue(): the only part of analyse() that reads pending_
 };
 
 struct Final {
@@ -683,6 +684,7 @@ private:
         const VkPipelineStageFlags2 own = s.stages ? s.stages : VK_PIPELINE_STAGE_2_ALL_COMMANDS_BIT;
 
         auto viaOtherQueue = [&](uint32_t from, TimelinePoint point, bool makesVisible) {
+            n.waits = true;
             const VkPipelineStageFlags2 waited = crossQueue(q, from, point, s.stages);
             if (n.transition || !within(own, waited)) {
                 n.srcStages |= waited; // chain through the wait
@@ -902,7 +904,20 @@ private:
             }
         };
         analysePass();
-        if (pending_[0].active || pending_[1].active) analysePass();
+        // A new wait changes only what uses that asked crossQueue() get;
+        // whether a use asks depends on its cell alone, so those needs,
+        // analysed again in the same order, replay the requests as a
+        // second full pass would.
+        if (pending_[0].active || pending_[1].active) {
+            for (uint32_t i = 0; i < pass.useCount; ++i) {
+                const uint32_t u = pass.firstUse + i;
+                const ir::Use& use = d_.uses[u];
+                const bool texture = d_.resources[use.resource].kind == ResourceKind::Texture;
+                const size_t last = i + 1 < pass.useCount ? useNeed_[i + 1] : needs_.size();
+                for (size_t k = useNeed_[i]; k < last; ++k)
+                    if (needs_[k].waits) analyse(needs_[k], needs_[k].cell, q, *useInfo_[u], use.writes, texture);
+            }
+        }
         const uint32_t ordinal = batches_.placePass(static_cast<Queue>(q), pos, pending_);
         const TimelinePoint now{0, ordinal};
 
