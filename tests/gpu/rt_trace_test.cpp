@@ -1037,3 +1037,64 @@ TEST_CASE("an unsupported backend is refused with a clear error") {
     passes::RtTracePipelines pipelines(gpu.ctx());
     CHECK((pipelines.backend() == passes::RtBackend::Pipeline));
 }
+
+TEST_CASE("an RT hit on an emissive triangle returns its emission: factor x strength x the texture's mean, scaled") {
+    test::GpuTest gpu;
+    const auto backends = availableBackends(gpu.ctx());
+    REQUIRE_FALSE(backends.empty());
+    // The target emits through a 2x2 sRGB texture; the packed primitives
+    // cannot carry it, so the hit adds the texture's mean (linear).
+    scene::Scene s = hitScene();
+    scene::Texture texture;
+    texture.name = "emissive";
+    texture.width = texture.height = 2;
+    texture.rgba8 = {255, 0, 0, 255, 0, 128, 0, 255, 0, 0, 64, 255, 200, 200, 200, 255};
+    s.textures.push_back(texture);
+    scene::Material& target = s.materials[1];
+    target.baseColorFactor = {0.0f, 0.0f, 0.0f, 1.0f};
+    target.emissiveFactor = {1.0f, 0.5f, 0.25f};
+    target.emissiveStrength = 6.0f;
+    target.emissiveTexture.texture = 0;
+    glm::vec3 mean(0.0f);
+    for (size_t t = 0; t < 4; ++t) {
+        for (int c = 0; c < 3; ++c) {
+            mean[c] += shader::srgbToLinear(float(texture.rgba8[t * 4 + size_t(c)]) / 255.0f) / 4.0f;
+        }
+    }
+    constexpr float kEmissiveScale = 0.75f;
+    const glm::vec3 expected = target.emissiveFactor * target.emissiveStrength * mean * kEmissiveScale;
+    CHECK(near(scene::meanEmission(s, target), expected / kEmissiveScale, 1e-5f, 1e-6f));
+
+    Rig rig(gpu.ctx(), s, test::testCamera());
+    const std::vector<ListedRay> rays = hitTestRays(rig, 3);
+    const RayList list = toList(rays);
+    // No sun, a black sky: a hit's radiance is its emission alone, a miss's zero.
+    shader::SceneLighting dark{};
+    dark.sunDirection = glm::vec4(kSun, kEmissiveScale);
+    std::vector<RtFrame> frames;
+    for (const passes::RtBackend backend : backends) {
+        const std::string name = passes::rtBackendName(backend);
+        CAPTURE(name);
+        passes::RtTracePipelines pipelines(gpu.ctx(), backend);
+        frames.push_back(rig.trace(pipelines, list, dark, settingsFor(backend)));
+        const RtFrame& f = frames.back();
+        uint32_t targetHits = 0;
+        for (const ListedRay& r : rays) {
+            const size_t i = pixelIndex(r.pixel);
+            const glm::vec3 got(f.radiance[i]);
+            if (!r.aimedAtTarget) {
+                CHECK(got == glm::vec3(0.0f));
+                continue;
+            }
+            INFO("pixel " << r.pixel.x << ", " << r.pixel.y << ": " << text(got) << " vs " << text(expected));
+            // Half-float output: 2^-11 relative rounding.
+            CHECK(near(got, expected, 1.0f / 1024.0f, 1e-6f));
+            ++targetHits;
+        }
+        CHECK(targetHits > 40);
+    }
+    if (frames.size() == 2) {
+        CHECK(frames[0].radianceBits == frames[1].radianceBits);
+        CHECK(frames[0].hitDistance == frames[1].hitDistance);
+    }
+}
