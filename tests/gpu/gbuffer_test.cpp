@@ -1093,7 +1093,7 @@ TEST_CASE("an emissive plane's lit colour is factor x strength x its sRGB texel 
     for (const int n : seen) CHECK(n > 100);
 }
 
-TEST_CASE("emission adds to the sunlit colour unshadowed; an emissive texture of a material that does not emit is not uploaded") {
+TEST_CASE("emission adds to the lit colour of a sunlit plane; a material that does not emit uploads no emissive texture") {
     // The same plane twice, emitting (factor only, no texture) and not: the
     // difference is the emission wherever the plane is.
     scene::Material plain;
