@@ -35,6 +35,7 @@ uint64_t grownCapacity(uint64_t needed, uint64_t minimum) {
 constexpr uint64_t kMinScratchBytes = 64 * 1024;
 constexpr uint32_t kMinTlasInstances = 64;
 constexpr uint32_t kMinOffsetEntries = 256;
+constexpr VkDeviceSize kEmissionEntryBytes = 3 * sizeof(float);  // glm::vec3, scalar layout
 constexpr uint32_t kMinParticles = 64;
 
 // The pack pass's source vertices of `g`. Material attributes are sampled
@@ -126,6 +127,7 @@ struct BvhManager::FrameWork {
     std::vector<Build> builds;
     std::vector<VkAccelerationStructureInstanceKHR> instances;
     std::vector<uint32_t> offsets;
+    std::vector<glm::vec3> emission;  // parallel to offsets
     std::vector<glm::mat4> joints;  // the palette as it was when the frame was declared
     std::optional<gpu::AccelBuild> tlasBuild;
     std::shared_ptr<gpu::Buffer> poolCopySource;  // the outgrown pool, copied into the new one first
@@ -184,6 +186,13 @@ BvhManager::BvhManager(gpu::Context& ctx, const scene::Scene& scene, uint32_t fr
     particleStaging_.resize(framesInFlight_);
     particleInstances_.resize(framesInFlight_);
     offsetStaging_.resize(framesInFlight_);
+    emissionStaging_.resize(framesInFlight_);
+    // O(texels) per emissive texture, once: the hits' emission is a
+    // material's mean (scene::meanEmission).
+    materialEmission_.reserve(scene.materials.size());
+    for (const scene::Material& material : scene.materials) {
+        materialEmission_.push_back(scene::meanEmission(scene, material));
+    }
     instanceBuffers_.resize(framesInFlight_);
     jointPalettes_.resize(framesInFlight_);
 }
@@ -203,6 +212,7 @@ void BvhManager::bind(rg::FrameResources& resources, const BvhUpdateOutputs& out
     resources.bind(outputs.tlas, *tlas_);
     resources.bind(outputs.primitivePool, pool_);
     resources.bind(outputs.primitiveOffsets, offsets_);
+    resources.bind(outputs.emission, emission_);
     if (outputs.particleTlas.valid()) {
         resources.bind(outputs.particleTlas, *particleTlas_);
         resources.bind(outputs.particles, particleData_);
@@ -350,6 +360,16 @@ void BvhManager::ensureOffsets(size_t entries) {
         if (staging) retire(std::move(staging));
         staging = gpu::Buffer(ctx_, {capacity, VK_BUFFER_USAGE_TRANSFER_SRC_BIT, gpu::MemoryUsage::Upload,
                                      "bvh.primitive_offsets.staging", true});
+    }
+    // The emission table has as many entries, three floats each.
+    const VkDeviceSize emissionCapacity = capacity / sizeof(uint32_t) * kEmissionEntryBytes;
+    if (emission_) retire(std::move(emission_));
+    emission_ = gpu::Buffer(ctx_, {emissionCapacity, VK_BUFFER_USAGE_STORAGE_BUFFER_BIT | VK_BUFFER_USAGE_TRANSFER_DST_BIT,
+                                   gpu::MemoryUsage::DeviceLocal, "bvh.emission", true});
+    for (gpu::Buffer& staging : emissionStaging_) {
+        if (staging) retire(std::move(staging));
+        staging = gpu::Buffer(ctx_, {emissionCapacity, VK_BUFFER_USAGE_TRANSFER_SRC_BIT, gpu::MemoryUsage::Upload,
+                                     "bvh.emission.staging", true});
     }
 }
 
@@ -587,12 +607,21 @@ std::shared_ptr<BvhManager::FrameWork> BvhManager::prepare(const scene::BvhPlan&
     ensureTlas(uint32_t(plan.tlas.size()));
     ensureOffsets(plan.primitiveOffsets.size());
     work->offsets = plan.primitiveOffsets;
+    work->emission.assign(plan.primitiveOffsets.size(), glm::vec3(0.0f));
     work->instances.reserve(plan.tlas.size());
     for (const scene::TlasInstance& ti : plan.tlas) {
         const auto it = blases_.find(ti.blas);
         if (it == blases_.end()) {
             throw gpu::GpuError("BVH update: TLAS instance of scene instance " + std::to_string(ti.sceneInstance) +
                                 " uses BLAS " + std::to_string(ti.blas) + ", which was never built");
+        }
+        // The emission rows beside the offset rows the planner wrote.
+        const std::vector<scene::BlasGeometry>& geometries = it->second->desc.geometries;
+        for (size_t g = 0; g < geometries.size(); ++g) {
+            const size_t row = shader::primitiveOffsetSlot(ti.customIndex, uint32_t(g));
+            if (row < work->emission.size() && geometries[g].material < materialEmission_.size()) {
+                work->emission[row] = materialEmission_[geometries[g].material];
+            }
         }
         const auto transform = scene::rowMajor3x4(ti.transform);
         work->instances.push_back(gpu::makeInstance(it->second->structure, transform.data(), ti.customIndex, ti.mask,
@@ -629,6 +658,7 @@ void BvhManager::record(FrameWork& work, rg::PassContext& pc, const BvhUpdateOut
     // when the frame was declared).
     const gpu::Buffer& pool = pc.buffer(handles.primitivePool);
     const gpu::Buffer& offsets = pc.buffer(handles.primitiveOffsets);
+    const gpu::Buffer& emission = pc.buffer(handles.emission);
     const gpu::Buffer& scratch = pc.buffer(handles.scratch);
     const gpu::AccelerationStructure& tlas = pc.accel(handles.tlas);
     const uint32_t slot = work.slot;
@@ -645,6 +675,7 @@ void BvhManager::record(FrameWork& work, rg::PassContext& pc, const BvhUpdateOut
     }
     if (!work.offsets.empty()) {
         std::memcpy(offsetStaging_[slot].mapped(), work.offsets.data(), work.offsets.size() * sizeof(uint32_t));
+        std::memcpy(emissionStaging_[slot].mapped(), work.emission.data(), work.emission.size() * kEmissionEntryBytes);
     }
     for (const FrameWork::Pack& pack : work.packs) {
         if (pack.vertices && !pack.morphed.empty()) {
@@ -688,6 +719,8 @@ void BvhManager::record(FrameWork& work, rg::PassContext& pc, const BvhUpdateOut
         if (!work.offsets.empty()) {
             const VkBufferCopy region{0, 0, work.offsets.size() * sizeof(uint32_t)};
             vkCmdCopyBuffer(cmd, offsetStaging_[slot].handle(), offsets.handle(), 1, &region);
+            const VkBufferCopy emissionRegion{0, 0, work.emission.size() * kEmissionEntryBytes};
+            vkCmdCopyBuffer(cmd, emissionStaging_[slot].handle(), emission.handle(), 1, &emissionRegion);
         }
         if (particles) {
             const VkBufferCopy region{0, 0, work.particles.size() * sizeof(shader::ParticleData)};
@@ -773,6 +806,8 @@ BvhUpdateOutputs BvhManager::declare(rg::Graph& graph, BvhManager& manager, cons
         graph.importBuffer("bvh.primitive_pool", {{manager.pool_.size()}, bufferState, bufferState});
     const rg::Buffer offsets =
         graph.importBuffer("bvh.primitive_offsets", {{manager.offsets_.size()}, bufferState, bufferState});
+    const rg::Buffer emission =
+        graph.importBuffer("bvh.emission", {{manager.emission_.size()}, bufferState, bufferState});
     const uint64_t scratchBytes = manager.scratchCapacity_;
     const bool particles = !work->particles.empty();
     rg::AccelStruct particleTlas;
@@ -789,6 +824,7 @@ BvhUpdateOutputs BvhManager::declare(rg::Graph& graph, BvhManager& manager, cons
             d.tlas = b.write(tlas, rg::Access::AccelBuildWrite);
             d.primitivePool = b.write(pool, rg::Access::StorageWrite);
             d.primitiveOffsets = b.write(offsets, rg::Access::TransferDst);
+            d.emission = b.write(emission, rg::Access::TransferDst);
             d.scratch = b.write(b.createBuffer("bvh.scratch", {scratchBytes}), rg::Access::AccelBuildWrite);
             if (particles) {
                 d.particleTlas = b.write(particleTlas, rg::Access::AccelBuildWrite);

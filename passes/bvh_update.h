@@ -9,7 +9,8 @@
 // targets applied on the CPU, per build), one AccelerationStructure per
 // resident BLAS, the unwrapped build positions of the deformable ones, the
 // one primitive pool (PackedPrimitive per triangle, glint/packing.h), the
-// primitive offset buffer, the TLAS and its per-frame instance buffers.
+// primitive offset buffer and its parallel emission table, the TLAS and its
+// per-frame instance buffers.
 //
 // addBvhUpdatePass() declares the frame's builds as ONE render-graph pass on
 // the async compute queue (the graphics queue on one-queue devices, or where
@@ -71,6 +72,11 @@ struct BvhUpdateOutputs {
     rg::AccelStruct tlas;          // built; read it with Access::AccelRead
     rg::Buffer primitivePool;      // PackedPrimitive per triangle; Access::StorageRead
     rg::Buffer primitiveOffsets;   // uint per (custom index + geometry); Access::StorageRead
+    // Parallel to primitiveOffsets: the geometry's material emission, a
+    // vec3 (three floats, scalar layout) in glTF units (emissiveFactor x
+    // strength x the emissive texture's mean, scene::meanEmission); the
+    // packed primitives have no room for it. Access::StorageRead.
+    rg::Buffer emission;
     rg::Buffer scratch;            // the builds' scratch (transient)
     // Invalid when the frame has no particles (or was declared without a
     // camera): the particle TLAS (Access::AccelRead; one instance, SBT
@@ -149,6 +155,7 @@ public:
     // The current objects, for tools and tests (valid after addBvhUpdatePass).
     const gpu::Buffer& primitivePool() const { return pool_; }
     const gpu::Buffer& primitiveOffsets() const { return offsets_; }
+    const gpu::Buffer& emission() const { return emission_; }
     const gpu::AccelerationStructure& tlas() const { return *tlas_; }
     // Nullptr when the BLAS is not resident.
     const gpu::AccelerationStructure* blas(scene::BlasId id) const;
@@ -193,6 +200,11 @@ private:
     gpu::Buffer pool_;
     gpu::Buffer offsets_;                         // device-local, read by the traces
     std::vector<gpu::Buffer> offsetStaging_;      // host-visible, one per frame in flight
+    // Per offset row, its material's emission (BvhUpdateOutputs::emission),
+    // sized with the offsets; from materialEmission_, computed once.
+    gpu::Buffer emission_;
+    std::vector<gpu::Buffer> emissionStaging_;
+    std::vector<glm::vec3> materialEmission_;     // per scene material: scene::meanEmission
     std::vector<gpu::Buffer> instanceBuffers_;    // host-visible TLAS instances, one per frame in flight
     std::vector<gpu::Buffer> jointPalettes_;      // host-visible joint matrices, one per frame in flight
     std::unique_ptr<gpu::AccelerationStructure> tlas_;

@@ -43,10 +43,10 @@ std::vector<gpu::Binding> geometryBindings() {
 // and the prefiltered environment (glint/environment.glsl).
 constexpr uint32_t kShadowMapBinding = 5;
 constexpr uint32_t kEnvironmentBinding = 6;
-// The material textures a draw samples per pixel, at bindings 7, 8 and 9
+// The material textures a draw samples per pixel, at bindings 7 to 10
 // (gbuffer.frag), in MaterialSlot order.
 constexpr uint32_t kFirstMaterialTextureBinding = 7;
-enum MaterialSlot : size_t { kNormalSlot, kBaseColorSlot, kMetalRoughSlot, kMaterialSlots };
+enum MaterialSlot : size_t { kNormalSlot, kBaseColorSlot, kMetalRoughSlot, kEmissiveSlot, kMaterialSlots };
 std::vector<gpu::Binding> gbufferBindings() {
     std::vector<gpu::Binding> bindings = geometryBindings();
     bindings.push_back({kShadowMapBinding, VK_DESCRIPTOR_TYPE_COMBINED_IMAGE_SAMPLER, VK_SHADER_STAGE_FRAGMENT_BIT});
@@ -230,7 +230,7 @@ struct GBufferRenderer::DrawRange {
     // The draw's push constants less the instance; per MaterialSlot the
     // image (kNoImage: the slot's fallback) and sampler it binds.
     shader::GBufferDraw material{};
-    std::array<size_t, kMaterialSlots> image{kNoImage, kNoImage, kNoImage};
+    std::array<size_t, kMaterialSlots> image{kNoImage, kNoImage, kNoImage, kNoImage};
     std::array<size_t, kMaterialSlots> sampler{};
 };
 
@@ -321,7 +321,7 @@ GBufferRenderer::GBufferRenderer(gpu::Context& ctx, const scene::Scene& scene, u
 
     // Material textures, uploaded with their mips the first time a drawn
     // geometry's material needs them, each once per colour space however
-    // many materials share it. glTF: base colour is sRGB (the sampler
+    // many materials share it. glTF: base colour and emissive are sRGB (the sampler
     // decodes before filtering; the CPU sampling at vertices decodes after,
     // which agrees at texel centres), metallic-roughness and normal linear.
     std::map<std::pair<int32_t, VkFormat>, size_t> imageOf;
@@ -370,8 +370,7 @@ GBufferRenderer::GBufferRenderer(gpu::Context& ctx, const scene::Scene& scene, u
                 range.image[kNormalSlot] = textureImage(normalRef, VK_FORMAT_R8G8B8A8_UNORM, "normal_map");
             }
             if (range.image[kNormalSlot] != kNoImage) {
-                range.material.normalMap = 1;
-                range.material.normalTexCoord = normalRef.texCoord;
+                range.material.normalMap = normalRef.texCoord + 1;
                 range.material.normalUvTransform = normalRef.uvTransform();
                 range.material.normalScale = material.normalScale;
                 range.sampler[kNormalSlot] = samplerIndex(normalRef);
@@ -380,18 +379,27 @@ GBufferRenderer::GBufferRenderer(gpu::Context& ctx, const scene::Scene& scene, u
             const scene::TextureRef& baseRef = material.baseColorTexture;
             range.image[kBaseColorSlot] = textureImage(baseRef, VK_FORMAT_R8G8B8A8_SRGB, "base_color");
             if (range.image[kBaseColorSlot] != kNoImage) {
-                range.material.baseColorMap = 1;
-                range.material.baseColorTexCoord = baseRef.texCoord;
+                range.material.baseColorMap = baseRef.texCoord + 1;
                 range.material.baseColorUvTransform = baseRef.uvTransform();
                 range.sampler[kBaseColorSlot] = samplerIndex(baseRef);
             }
             const scene::TextureRef& metalRoughRef = material.metallicRoughnessTexture;
             range.image[kMetalRoughSlot] = textureImage(metalRoughRef, VK_FORMAT_R8G8B8A8_UNORM, "metal_rough");
             if (range.image[kMetalRoughSlot] != kNoImage) {
-                range.material.metalRoughMap = 1;
-                range.material.metalRoughTexCoord = metalRoughRef.texCoord;
+                range.material.metalRoughMap = metalRoughRef.texCoord + 1;
                 range.material.metalRoughUvTransform = metalRoughRef.uvTransform();
                 range.sampler[kMetalRoughSlot] = samplerIndex(metalRoughRef);
+            }
+            // Only a material that emits uploads its emissive texture.
+            const scene::TextureRef& emissiveRef = material.emissiveTexture;
+            const glm::vec3 emissiveFactor = material.emissiveFactor * material.emissiveStrength;
+            if (emissiveFactor != glm::vec3(0.0f)) {
+                range.image[kEmissiveSlot] = textureImage(emissiveRef, VK_FORMAT_R8G8B8A8_SRGB, "emissive");
+            }
+            if (range.image[kEmissiveSlot] != kNoImage) {
+                range.material.emissiveMap = emissiveRef.texCoord + 1;
+                range.material.emissiveUvTransform = emissiveRef.uvTransform();
+                range.sampler[kEmissiveSlot] = samplerIndex(emissiveRef);
             }
             for (uint32_t v = 0; v < g.vertexCount(); ++v) {
                 const shader::SurfaceVertex s = scene::surfaceAtVertex(scene, g, v);
@@ -413,6 +421,10 @@ GBufferRenderer::GBufferRenderer(gpu::Context& ctx, const scene::Scene& scene, u
                     out.metallic = std::clamp(material.metallicFactor, 0.0f, 1.0f);
                 }
                 out.reflectance = s.reflectance;
+                // Per pixel the texel multiplies the factor; else (no
+                // texture, or not 8-bit) the vertex holds it all.
+                out.emissive = range.material.emissiveMap != 0 ? emissiveFactor
+                                                               : scene::emissionAtVertex(scene, g, v);
                 if (g.skinned()) {
                     const glm::u16vec4 j = g.joints[v];
                     out.joints = {uint32_t(j.x) | uint32_t(j.y) << 16, uint32_t(j.z) | uint32_t(j.w) << 16};
@@ -692,6 +704,7 @@ void GBufferRenderer::record(const FrameWork& work, rg::PassContext& pc, const G
     };
     const MaterialTextures fallbacks = {std::pair{&flatNormal_, &textureSamplers_[0]},
                                         std::pair{&white_, &textureSamplers_[0]},
+                                        std::pair{&white_, &textureSamplers_[0]},
                                         std::pair{&white_, &textureSamplers_[0]}};
 
     stats_.draws = 0;
@@ -715,7 +728,7 @@ void GBufferRenderer::record(const FrameWork& work, rg::PassContext& pc, const G
                 textures[t] = {&textureImages_[range.image[t]], &textureSamplers_[range.sampler[t]]};
                 textured = true;
             }
-            stats_.normalMappedDraws += range.material.normalMap;
+            stats_.normalMappedDraws += range.material.normalMap != 0 ? 1u : 0u;
             stats_.texturedDraws += textured ? 1u : 0u;
             if (vertices != boundVertices || textures != boundTextures) {
                 boundVertices = vertices;

@@ -24,13 +24,17 @@
 // smaller, on a world-fixed texel grid so it does not shimmer as the camera
 // moves. It needs no BVH, so every mode and device gets the same shadows.
 // Material textures are sampled per pixel: base colour (an sRGB image),
-// metallic-roughness (G roughness, B metallic) and normal maps (tangent
-// space, glTF's TANGENT or generated tangents, normalTexture.scale), each
+// metallic-roughness (G roughness, B metallic), normal maps (tangent
+// space, glTF's TANGENT or generated tangents, normalTexture.scale) and the
+// emissive texture (sRGB; uploaded only for materials that emit), each
 // uploaded once with its mips and read through the texture coordinate set
 // and KHR_texture_transform its reference names, times the factors (and
 // COLOR_0) the vertices carry. The rest of the material (reflectance, and
 // every texture when it is not 8-bit) is evaluated at the vertices on the
-// CPU (scene::surfaceAtVertex). The packed primitives of the RT hits keep
+// CPU (scene::surfaceAtVertex). Emission (factor x strength x texel, times
+// LightingSettings::emissiveScale) is added to the lit colour unlit and
+// unshadowed; the RT hits add their geometry's mean emission
+// (passes/bvh_update.h). The packed primitives of the RT hits keep
 // sampling every texture at their vertices, and keep the vertex normal. Instances of meshes with
 // morph targets draw from a per-frame copy of their vertices with their
 // morph weights applied on the CPU (scene::morphedGeometry); their motion
@@ -198,9 +202,9 @@ private:
     gpu::Sampler nearest_;  // completes the shadow map's descriptor; reads are texelFetch
     gpu::Sampler environmentSampler_;
     // Material textures: one image per scene texture and colour space some
-    // drawn geometry's material samples (base colour sRGB; metallic-
-    // roughness and normal UNORM), 1x1 fallbacks bound to draws without (a
-    // flat normal, white), and one sampler per glTF wrap-mode pair.
+    // drawn geometry's material samples (base colour and emissive sRGB;
+    // metallic-roughness and normal UNORM), 1x1 fallbacks bound to draws
+    // without (a flat normal, white), and one sampler per glTF wrap-mode pair.
     std::vector<gpu::Image> textureImages_;
     gpu::Image flatNormal_;
     gpu::Image white_;

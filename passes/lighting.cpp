@@ -39,7 +39,7 @@ shader::SceneLighting sceneLighting(const scene::Scene& scene, const SkyColors& 
     const scene::DirectionalLight& sun = scene.sun;
     const float skyScale = scene.environment.intensity * settings.ambientScale;
     shader::SceneLighting l{};
-    l.sunDirection = glm::vec4(glm::normalize(sun.directionToLight), 0.0f);
+    l.sunDirection = glm::vec4(glm::normalize(sun.directionToLight), settings.emissiveScale);
     l.sunIrradiance = glm::vec4(sun.color * (sun.illuminance * settings.sunIlluminanceScale), 0.0f);
     l.skyZenith = glm::vec4(sky[0] * skyScale, 0.0f);
     l.skyHorizon = glm::vec4(sky[1] * skyScale, 0.0f);

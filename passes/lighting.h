@@ -24,6 +24,15 @@ struct LightingSettings {
     float sunIlluminanceScale = 8.0f / 100000.0f;
     // Multiplies the sky's contribution (environment intensity still applies).
     float ambientScale = 1.0f;
+    // glTF emissive radiance (emissiveFactor x KHR_materials_emissive_strength
+    // x texel) -> lit-colour units. glTF gives emission no physical unit;
+    // viewers (the Khronos sample viewer, Blender's glTF I/O) show emissive
+    // 1.0 as the display's white at exposure 1, and so does 1.0 here: lit
+    // 1.0 leaves the composite's default exposure and PBR Neutral tonemap
+    // at about display white, near a sunlit white wall (~2.5 at the sun
+    // scale above). Emission is added unlit and unshadowed, in the
+    // G-buffer's lit colour and at ray-traced hits alike.
+    float emissiveScale = 1.0f;
 };
 
 // Zenith, horizon and ground radiance, unscaled.

@@ -38,6 +38,7 @@ enum Binding : uint32_t {
     kRadiance,
     kHitDistance,
     kEnvironment,
+    kEmission,
     kBindingCount
 };
 
@@ -174,8 +175,9 @@ RtTraceOutputs addRtTracePass(rg::Graph& graph, RtTracePipelines& pipelines, con
     if (!inputs.rayList.valid() || !inputs.rayListArgs.valid()) {
         throw gpu::GpuError("addRtTracePass: the RT ray list and its args are required");
     }
-    if (!inputs.bvh.tlas.valid() || !inputs.bvh.primitivePool.valid() || !inputs.bvh.primitiveOffsets.valid()) {
-        throw gpu::GpuError("addRtTracePass: the BVH update's TLAS, primitive pool and offsets are required");
+    if (!inputs.bvh.tlas.valid() || !inputs.bvh.primitivePool.valid() || !inputs.bvh.primitiveOffsets.valid() ||
+        !inputs.bvh.emission.valid()) {
+        throw gpu::GpuError("addRtTracePass: the BVH update's TLAS, primitive pool, offsets and emission are required");
     }
     if (!(settings.maxDistance > 0.0f) || !(settings.shortRangeFraction >= 0.0f) ||
         !(settings.shadowDistance >= 0.0f) || !(settings.originOffsetScale >= 0.0f)) {
@@ -240,7 +242,7 @@ RtTraceOutputs addRtTracePass(rg::Graph& graph, RtTracePipelines& pipelines, con
     struct TraceData {
         rg::Texture depth, normal, roughnessMetal;
         rg::Texture environment;  // the prefiltered image, or the normal as a stand-in (never read)
-        rg::Buffer rayList, rayListArgs, pool, offsets, constants;
+        rg::Buffer rayList, rayListArgs, pool, offsets, emission, constants;
         rg::AccelStruct tlas;
         RtTraceOutputs out;
     };
@@ -261,6 +263,7 @@ RtTraceOutputs addRtTracePass(rg::Graph& graph, RtTracePipelines& pipelines, con
             d.tlas = b.read(inputs.bvh.tlas, rg::Access::AccelRead);
             d.pool = b.read(inputs.bvh.primitivePool, rg::Access::StorageRead);
             d.offsets = b.read(inputs.bvh.primitiveOffsets, rg::Access::StorageRead);
+            d.emission = b.read(inputs.bvh.emission, rg::Access::StorageRead);
             d.constants = b.read(clear.constants, rg::Access::StorageRead);
             d.out.width = gbuf.width;
             d.out.height = gbuf.height;
@@ -283,6 +286,7 @@ RtTraceOutputs addRtTracePass(rg::Graph& graph, RtTracePipelines& pipelines, con
                 .storageBuffer(kRayListArgs, pc.buffer(d.rayListArgs))
                 .storageBuffer(kPool, pc.buffer(d.pool))
                 .storageBuffer(kOffsets, pc.buffer(d.offsets))
+                .storageBuffer(kEmission, pc.buffer(d.emission))
                 .storageBuffer(kConstants, pc.buffer(d.constants))
                 .storageImage(kRadiance, pc.view(d.out.radiance))
                 .storageImage(kHitDistance, pc.view(d.out.hitDistance))

@@ -56,7 +56,7 @@ struct RtTraceInputs {
     GBufferOutputs gbuffer;          // depth, normal, roughnessMetal read (SampledRead)
     rg::Buffer rayList;              // shader::PackedRay entries (glint/ray_generation_shared.h)
     rg::Buffer rayListArgs;          // kRayListArgsWords uints, layout in ray_generation_shared.h (IndirectArgs)
-    BvhUpdateOutputs bvh;            // tlas (AccelRead), primitivePool, primitiveOffsets (StorageRead)
+    BvhUpdateOutputs bvh;            // tlas (AccelRead), primitivePool, primitiveOffsets, emission (StorageRead)
     shader::SceneLighting lighting;  // EnvironmentMap::lighting or passes::sceneLighting(scene, gbufferSettings.lighting)
     // The G-buffer's camera. Origins are reconstructed with the jittered
     // matrices it was rasterised with (passes/rt_trace.cpp says why).

@@ -291,7 +291,12 @@ PlazaMaterials plazaMaterials(Builder& b) {
     m.wood = b.material(makeMaterial("bench wood", {0.35f, 0.2f, 0.1f}, 0.0f, 0.7f));
     m.trunk = b.material(makeMaterial("palm trunk", {0.3f, 0.22f, 0.15f}, 0.0f, 0.9f));
     m.leaves = b.material(makeMaterial("palm leaves", {0.08f, 0.3f, 0.06f}, 0.0f, 0.6f));
-    m.neon = b.material(makeEmissive("neon", {1.0f, 0.15f, 0.55f}, 40.0f));
+    // Emission is in lit units at LightingSettings::emissiveScale 1, where
+    // a sunlit white wall is ~2.5 and the default exposure's tonemap (PBR
+    // Neutral) whitens a peak of 4 by a third: a neon tube (~10^4 nits,
+    // dimmer than that wall in daylight) at 2.5 stays pink; at the 40 it
+    // had before anything emitted, it rendered as a white bar.
+    m.neon = b.material(makeEmissive("neon", {1.0f, 0.15f, 0.55f}, 2.5f));
     m.carPaint = b.material(makeMaterial("car paint", {0.04f, 0.09f, 0.45f}, 0.3f, 0.12f));
     m.tyre = b.material(makeMaterial("tyre rubber", {0.03f, 0.03f, 0.03f}, 0.0f, 0.8f));
     Material flag = makeMaterial("flag cloth", {0.85f, 0.7f, 0.08f}, 0.0f, 0.8f);
@@ -303,7 +308,9 @@ PlazaMaterials plazaMaterials(Builder& b) {
     m.mirrorTower = b.material(makeMaterial("tower glass", {0.7f, 0.75f, 0.8f}, 1.0f, 0.04f));
     m.water = b.material(makeMaterial("fountain water", {0.02f, 0.03f, 0.035f}, 0.0f, 0.0f));
     m.brass = b.material(makeMaterial("brass", {0.9f, 0.72f, 0.35f}, 1.0f, 0.25f));
-    m.lampGlow = b.material(makeEmissive("lamp glow", {1.0f, 0.75f, 0.45f}, 25.0f));
+    // A bulb outshines a sunlit wall, but at 25 it burnt to pure white; 5
+    // keeps a warm glow.
+    m.lampGlow = b.material(makeEmissive("lamp glow", {1.0f, 0.75f, 0.45f}, 5.0f));
     m.skinTone = b.material(makeMaterial("skin", {0.6f, 0.42f, 0.32f}, 0.0f, 0.55f));
     return m;
 }

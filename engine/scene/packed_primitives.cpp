@@ -43,6 +43,38 @@ shader::SurfaceVertex surfaceAtVertex(const Scene& scene, const Geometry& g, uin
     return s;
 }
 
+namespace {
+
+// glTF: 8-bit emissive texels are sRGB; float images hold linear values.
+glm::vec3 emissiveTexel(const Texture& texture, glm::vec4 texel) {
+    if (texture.format != TextureFormat::Rgba8) return glm::vec3(texel);
+    return {shader::srgbToLinear(texel.r), shader::srgbToLinear(texel.g), shader::srgbToLinear(texel.b)};
+}
+
+} // namespace
+
+glm::vec3 emissionAtVertex(const Scene& scene, const Geometry& g, uint32_t vertex) {
+    const Material& m = scene.materials[g.material];
+    const glm::vec3 factor = m.emissiveFactor * m.emissiveStrength;
+    if (factor == glm::vec3(0.0f) || !m.emissiveTexture.valid()) return factor;
+    return factor * emissiveTexel(scene.textures[size_t(m.emissiveTexture.texture)],
+                                  sampleRef(scene, g, m.emissiveTexture, vertex));
+}
+
+glm::vec3 meanEmission(const Scene& scene, const Material& m) {
+    const glm::vec3 factor = m.emissiveFactor * m.emissiveStrength;
+    if (factor == glm::vec3(0.0f) || !m.emissiveTexture.valid()) return factor;
+    const Texture& texture = scene.textures[size_t(m.emissiveTexture.texture)];
+    if (texture.width == 0 || texture.height == 0) return factor;
+    glm::dvec3 sum(0.0);
+    for (uint32_t y = 0; y < texture.height; ++y) {
+        for (uint32_t x = 0; x < texture.width; ++x) {
+            sum += glm::dvec3(emissiveTexel(texture, texture.texel(x, y)));
+        }
+    }
+    return factor * glm::vec3(sum / (double(texture.width) * double(texture.height)));
+}
+
 UnwrappedGeometry unwrapGeometry(const Scene& scene, const Geometry& g, std::span<const glm::mat4> jointMatrices) {
     const bool skin = g.skinned() && !jointMatrices.empty();
     const auto skinMatrix = [&](uint32_t v) {

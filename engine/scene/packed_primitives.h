@@ -23,6 +23,18 @@ namespace glint::scene {
 // KHR_texture_transform); normal maps do not apply at vertex rate.
 shader::SurfaceVertex surfaceAtVertex(const Scene& scene, const Geometry& geometry, uint32_t vertex);
 
+// Emission in glTF units (the renderers scale it to lit units with
+// passes::LightingSettings::emissiveScale): emissiveFactor x
+// KHR_materials_emissive_strength x the emissive texture (sRGB-decoded when
+// 8-bit, linear when float) sampled bilinearly at `vertex`'s coordinates.
+glm::vec3 emissionAtVertex(const Scene& scene, const Geometry& geometry, uint32_t vertex);
+
+// A material's emission as one colour: factor x strength x the mean of its
+// emissive texture's base level (linear, i.e. after sRGB decoding; O(texels)),
+// what a ray-traced hit adds (the packed primitives have no room for it; see
+// passes/bvh_update.h). Zero for non-emissive materials.
+glm::vec3 meanEmission(const Scene& scene, const Material& material);
+
 struct UnwrappedGeometry {
     std::vector<glm::vec3> positions;                 // three per triangle, object space
     std::vector<shader::PackedPrimitive> primitives;  // one per triangle

@@ -16,12 +16,15 @@ layout(location = 4) in vec4 inClip;
 layout(location = 5) in vec4 inPreviousClip;
 layout(location = 6) in vec4 inTangent;
 layout(location = 7) in vec4 inUv;
+layout(location = 8) in vec3 inEmissive;
 
 // The draw's material textures; 1x1 fallbacks (flat normal, white) where the
-// material has none and the draw's flag is 0.
+// material has none and the draw's flag is 0 (glint/gbuffer_shared.h's
+// GBufferDraw: a flag is the texture coordinate set plus one).
 layout(set = 0, binding = 7) uniform sampler2D normalMap;     // linear, tangent space
 layout(set = 0, binding = 8) uniform sampler2D baseColorMap;  // sRGB image: texels decode to linear
 layout(set = 0, binding = 9) uniform sampler2D metalRoughMap; // linear; G = roughness, B = metallic
+layout(set = 0, binding = 10) uniform sampler2D emissiveMap;  // sRGB image: texels decode to linear
 
 layout(location = 0) out vec4 outNormal;
 layout(location = 1) out vec4 outAlbedo;
@@ -29,10 +32,10 @@ layout(location = 2) out vec4 outRoughnessMetal;
 layout(location = 3) out vec2 outMotion;
 layout(location = 4) out vec4 outLit;
 
-// A texture reference's coordinates: its set (glTF texCoord), then its
-// KHR_texture_transform.
-vec2 textureUv(uint texCoord, UvTransform transform) {
-    return applyUvTransform(transform, texCoord == 0u ? inUv.xy : inUv.zw);
+// A texture reference's coordinates: its set (the draw's flag: glTF
+// texCoord plus one), then its KHR_texture_transform.
+vec2 textureUv(uint flag, UvTransform transform) {
+    return applyUvTransform(transform, flag == 2u ? inUv.zw : inUv.xy);
 }
 
 vec2 pixelOf(vec4 clip) {
@@ -58,7 +61,7 @@ vec3 normalMapped(vec3 n, bool backFace) {
         b = -b;
         frameNormal = -n;
     }
-    vec3 m = texture(normalMap, textureUv(draw.normalTexCoord, draw.normalUvTransform)).xyz * 2.0 - 1.0;
+    vec3 m = texture(normalMap, textureUv(draw.normalMap, draw.normalUvTransform)).xyz * 2.0 - 1.0;
     m.xy *= draw.normalScale;
     const vec3 perturbed = t * m.x + b * m.y + frameNormal * m.z;
     const float lengthSq = dot(perturbed, perturbed);
@@ -79,11 +82,11 @@ void main() {
     // The flags are push constants, so the branches are uniform per draw.
     vec3 albedo = inAlbedo;
     if (draw.baseColorMap != 0u) {
-        albedo *= texture(baseColorMap, textureUv(draw.baseColorTexCoord, draw.baseColorUvTransform)).rgb;
+        albedo *= texture(baseColorMap, textureUv(draw.baseColorMap, draw.baseColorUvTransform)).rgb;
     }
     vec2 roughnessMetallic = inMaterial.xy;
     if (draw.metalRoughMap != 0u) {
-        roughnessMetallic *= texture(metalRoughMap, textureUv(draw.metalRoughTexCoord, draw.metalRoughUvTransform)).gb;
+        roughnessMetallic *= texture(metalRoughMap, textureUv(draw.metalRoughMap, draw.metalRoughUvTransform)).gb;
     }
     Surface s;
     s.position = inWorldPosition;
@@ -104,5 +107,12 @@ void main() {
     // A vertex behind last frame's camera has w <= 0: no motion is better
     // than a wild one.
     outMotion = inPreviousClip.w > 0.0 ? pixelOf(inPreviousClip) - pixelOf(inClip) : vec2(0.0);
-    outLit = vec4(shadeSurface(frame.lighting, s, toViewer, sunVisibility), 1.0);
+    // Emission: glTF factor x strength (in the vertex) x the sRGB texel, in
+    // lit units through the emissive scale; neither lit nor shadowed.
+    vec3 emission = inEmissive;
+    if (draw.emissiveMap != 0u) {
+        emission *= texture(emissiveMap, textureUv(draw.emissiveMap, draw.emissiveUvTransform)).rgb;
+    }
+    emission *= frame.lighting.sunDirection.w;
+    outLit = vec4(shadeSurface(frame.lighting, s, toViewer, sunVisibility) + emission, 1.0);
 }

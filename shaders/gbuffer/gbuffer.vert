@@ -15,6 +15,7 @@ layout(location = 4) out vec4 outClip;      // unjittered, this frame
 layout(location = 5) out vec4 outPreviousClip;
 layout(location = 6) out vec4 outTangent;  // world xyz, w = bitangent sign
 layout(location = 7) out vec4 outUv;       // uv0, uv1
+layout(location = 8) out vec3 outEmissive; // glTF units, without the per-pixel texture
 
 void main() {
     const GBufferVertex v = vertices[gl_VertexIndex];
@@ -44,6 +45,7 @@ void main() {
     outUv = vec4(v.uv0, v.uv1);
     outWorldPosition = world.xyz;
     outAlbedo = v.albedo;
+    outEmissive = v.emissive;
     outMaterial = vec3(v.roughness, v.metallic, v.reflectance);
     outClip = frame.viewProjection * world;
     outPreviousClip = frame.previousViewProjection * previousWorld;

@@ -1037,3 +1037,80 @@ TEST_CASE("an unsupported backend is refused with a clear error") {
     passes::RtTracePipelines pipelines(gpu.ctx());
     CHECK((pipelines.backend() == passes::RtBackend::Pipeline));
 }
+
+TEST_CASE("an RT hit on an emissive triangle returns its emission: factor x strength x the texture's mean, scaled") {
+    test::GpuTest gpu;
+    const auto backends = availableBackends(gpu.ctx());
+    REQUIRE_FALSE(backends.empty());
+    // The target's left half emits through a 2x2 sRGB texture (the packed
+    // primitives cannot carry it, so the hit adds the texture's mean,
+    // linear); its right half, a second geometry of the same mesh, is black
+    // and emits nothing: the table is read per (instance, geometry).
+    scene::Scene s = hitScene();
+    scene::Material black;
+    black.baseColorFactor = {0.0f, 0.0f, 0.0f, 1.0f};
+    s.materials.push_back(black);
+    s.meshes[1].lods[0].geometries = {square({-0.5f, 0, 0}, {0.5f, 0, 0}, {0, 1, 0}, 1.0f, 1),
+                                      square({0.5f, 0, 0}, {0.5f, 0, 0}, {0, 1, 0}, 1.0f, 3)};
+    scene::prepareScene(s);
+    scene::Texture texture;
+    texture.name = "emissive";
+    texture.width = texture.height = 2;
+    texture.rgba8 = {255, 0, 0, 255, 0, 128, 0, 255, 0, 0, 64, 255, 200, 200, 200, 255};
+    s.textures.push_back(texture);
+    scene::Material& target = s.materials[1];
+    target.baseColorFactor = {0.0f, 0.0f, 0.0f, 1.0f};
+    target.emissiveFactor = {1.0f, 0.5f, 0.25f};
+    target.emissiveStrength = 6.0f;
+    target.emissiveTexture.texture = 0;
+    glm::vec3 mean(0.0f);
+    for (size_t t = 0; t < 4; ++t) {
+        for (int c = 0; c < 3; ++c) {
+            mean[c] += shader::srgbToLinear(float(texture.rgba8[t * 4 + size_t(c)]) / 255.0f) / 4.0f;
+        }
+    }
+    constexpr float kEmissiveScale = 0.75f;
+    const glm::vec3 expected = target.emissiveFactor * target.emissiveStrength * mean * kEmissiveScale;
+    CHECK(near(scene::meanEmission(s, target), expected / kEmissiveScale, 1e-5f, 1e-6f));
+
+    Rig rig(gpu.ctx(), s, test::testCamera());
+    const std::vector<ListedRay> rays = hitTestRays(rig, 3);
+    const RayList list = toList(rays);
+    // No sun, a black sky: a hit's radiance is its emission alone, a miss's zero.
+    shader::SceneLighting dark{};
+    dark.sunDirection = glm::vec4(kSun, kEmissiveScale);
+    std::vector<RtFrame> frames;
+    for (const passes::RtBackend backend : backends) {
+        const std::string name = passes::rtBackendName(backend);
+        CAPTURE(name);
+        passes::RtTracePipelines pipelines(gpu.ctx(), backend);
+        frames.push_back(rig.trace(pipelines, list, dark, settingsFor(backend)));
+        const RtFrame& f = frames.back();
+        const glm::dmat4 worldToTarget = glm::inverse(glm::dmat4(rig.scene().instances[1].transform));
+        uint32_t emissiveHits = 0, darkHits = 0;
+        for (const ListedRay& r : rays) {
+            const size_t i = pixelIndex(r.pixel);
+            const glm::vec3 got(f.radiance[i]);
+            if (!r.aimedAtTarget) {
+                CHECK(got == glm::vec3(0.0f));
+                continue;
+            }
+            // Which half the ray met, from its hit distance (the origin is
+            // within millimetres of the analytic one).
+            const glm::dvec3 hit = r.origin + double(f.hitDistance[i]) * glm::dvec3(r.direction);
+            const double x = (worldToTarget * glm::dvec4(hit, 1.0)).x;
+            if (std::abs(x) < 0.05) continue;
+            const glm::vec3 want = x < 0.0 ? expected : glm::vec3(0.0f);
+            INFO("pixel " << r.pixel.x << ", " << r.pixel.y << " (x " << x << "): " << text(got) << " vs " << text(want));
+            // Half-float output: 2^-11 relative rounding.
+            CHECK(near(got, want, 1.0f / 1024.0f, 1e-6f));
+            ++(x < 0.0 ? emissiveHits : darkHits);
+        }
+        CHECK(emissiveHits > 20);
+        CHECK(darkHits > 20);
+    }
+    if (frames.size() == 2) {
+        CHECK(frames[0].radianceBits == frames[1].radianceBits);
+        CHECK(frames[0].hitDistance == frames[1].hitDistance);
+    }
+}

@@ -8,7 +8,8 @@
 //   roughnessMetal r = perceptual roughness, g = metallic, b = reflectance, a = 1
 //   motion         pixels from this frame's position back to last frame's, both
 //                  unjittered: history lookup = pixel + motion
-//   lit            radiance of the opaque scene (sun + diffuse ambient; no
+//   lit            radiance of the opaque scene (sun + diffuse ambient +
+//                  emission, which is neither lit nor shadowed; no
 //                  specular ambient: the reflection passes add that), a = 1;
 //                  the sky's radiance with a = 0 where nothing was drawn.
 //                  The sun term is shadowed by the shadow map below; the
@@ -30,7 +31,7 @@
 
 GLINT_BEGIN
 
-// One vertex of a LOD-0 geometry, uploaded once (104 bytes). The material
+// One vertex of a LOD-0 geometry, uploaded once (116 bytes). The material
 // is evaluated at the vertex on the CPU (scene::surfaceAtVertex, as the BVH
 // manager does for the packed primitives), except for the textures the
 // G-buffer samples per pixel (base colour, metallic-roughness, normal; see
@@ -49,6 +50,10 @@ struct GBufferVertex {
     vec4 tangent;   // object space xyz, w = bitangent sign (glTF: B = cross(N, T) * w)
     vec2 uv0;       // TEXCOORD_0 (zero when absent)
     vec2 uv1;       // TEXCOORD_1
+    // Emitted radiance in glTF units (emissiveFactor x strength; x the
+    // emissive texture at the vertex where it is not sampled per pixel),
+    // times SceneLighting's emissive scale in the shader.
+    vec3 emissive;
 };
 
 // One scene instance this frame and last (144 bytes).
@@ -66,7 +71,9 @@ struct GBufferInstance {
 // light reflections the same way; glint/environment.glsl looks the
 // environment up (240 bytes).
 struct SceneLighting {
-    vec4 sunDirection;   // xyz: unit, towards the sun
+    // xyz: unit, towards the sun; w: the emissive scale (glTF emissive
+    // radiance -> lit-colour units, LightingSettings::emissiveScale).
+    vec4 sunDirection;
     vec4 sunIrradiance;  // rgb: at normal incidence
     vec4 skyZenith;      // rgb radiance of the procedural sky (an image's mean, unused by the shaders)
     vec4 skyHorizon;
@@ -117,33 +124,38 @@ struct GBufferFrame {
     GBufferShadow shadow;
 };
 
-// Push constants of one draw (112 bytes, within the 128 Vulkan guarantees).
+// Push constants of one draw (124 bytes, within the 128 Vulkan guarantees).
+// Per material texture the draw samples per pixel, its flag holds the
+// texture coordinate set plus one (1: GBufferVertex::uv0, 2: uv1); 0: the
+// slot is not sampled (its 1x1 fallback stays bound, the vertex holds the
+// whole value). The branches on the flags are uniform per draw.
 struct GBufferDraw {
     uint instance;
     uint doubleSided;     // 1: back faces are lit with the flipped normal
-    uint normalMap;       // 1: perturb the normal with the normal map (binding 7)
-    uint normalTexCoord;  // 0: GBufferVertex::uv0, 1: uv1
-    UvTransform normalUvTransform;  // the normal texture's KHR_texture_transform
     float normalScale;    // glTF normalTexture.scale
-    // 1: multiply the vertex albedo (factor times COLOR_0) per pixel by the
-    // base colour texture (binding 8, sRGB-decoded by the sampler).
+    // Perturb the normal with the normal map (binding 7).
+    uint normalMap;
+    // Multiply the vertex albedo (factor times COLOR_0) by the base colour
+    // texture (binding 8, sRGB-decoded by the sampler).
     uint baseColorMap;
-    uint baseColorTexCoord;
-    UvTransform baseColorUvTransform;
-    // 1: multiply the vertex roughness and metallic (the factors) per pixel
-    // by the metallic-roughness texture's G and B (binding 9, linear).
+    // Multiply the vertex roughness and metallic (the factors) by the
+    // metallic-roughness texture's G and B (binding 9, linear).
     uint metalRoughMap;
-    uint metalRoughTexCoord;
+    // Multiply the vertex emission (factor times strength) by the emissive
+    // texture (binding 10, sRGB-decoded by the sampler).
+    uint emissiveMap;
+    UvTransform normalUvTransform;  // each texture's KHR_texture_transform
+    UvTransform baseColorUvTransform;
     UvTransform metalRoughUvTransform;
-    uint pad0;
+    UvTransform emissiveUvTransform;
 };
 
 GLINT_END
 
 #ifdef __cplusplus
-static_assert(sizeof(glint::shader::GBufferVertex) == 104);
+static_assert(sizeof(glint::shader::GBufferVertex) == 116);
 static_assert(sizeof(glint::shader::GBufferInstance) == 144);
-static_assert(sizeof(glint::shader::GBufferDraw) == 112);
+static_assert(sizeof(glint::shader::GBufferDraw) == 124);
 static_assert(sizeof(glint::shader::GBufferShadow) == 112);
 static_assert(sizeof(glint::shader::SceneLighting) == 240);
 #endif

@@ -10,7 +10,9 @@
 // ray's length shrinks with the surface's roughness; a hit's packed
 // primitive (glint/packing.h) is interpolated at the hit's barycentrics and
 // lit with the G-buffer's own lighting (glint/brdf.glsl's shadeSurface),
-// the sun's visibility from a shadow ray; a miss takes the environment.
+// the sun's visibility from a shadow ray, plus its geometry's emission (one
+// colour per geometry: the material's mean, scaled as the G-buffer scales
+// emission); a miss takes the environment.
 #ifndef GLINT_RT_TRACE_GLSL
 #define GLINT_RT_TRACE_GLSL
 
@@ -38,6 +40,9 @@ layout(set = 0, binding = 7, scalar) readonly buffer Offsets { uint primitiveOff
 layout(set = 0, binding = 8, scalar) readonly buffer Constants { RtTraceConstants rt; };
 layout(set = 0, binding = 9, rgba16f) uniform writeonly image2D radianceImage;
 layout(set = 0, binding = 10, r32f) uniform writeonly image2D hitDistanceImage;
+// Parallel to the offsets: each geometry's material emission in glTF units
+// (passes/bvh_update.h's BvhUpdateOutputs::emission).
+layout(set = 0, binding = 12, scalar) readonly buffer Emission { vec3 primitiveEmission[]; };
 
 // The backend's traversals. Both rays are opaque (the pool has no alpha)
 // and use rt.instanceMask.
@@ -159,7 +164,10 @@ void rtTraceListEntry(uint index) {
         const vec3 shadowOrigin = rtOffsetOrigin(s.position, s.normal, ray.origin, hit.t, 0.0);
         sunVisibility = rtTraceOccluded(shadowOrigin, toSun, rt.shadowDistance) ? 0.0 : 1.0;
     }
-    rtWriteResult(ray, shadeSurface(rt.lighting, s, -ray.direction, sunVisibility), hit.t);
+    // Emission, unlit and unshadowed as in the G-buffer's lit colour.
+    const vec3 emission = primitiveEmission[primitiveOffsetSlot(hit.customIndex, hit.geometry)] *
+                          rt.lighting.sunDirection.w;
+    rtWriteResult(ray, shadeSurface(rt.lighting, s, -ray.direction, sunVisibility) + emission, hit.t);
 }
 
 #endif
