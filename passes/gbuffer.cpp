@@ -506,9 +506,9 @@ std::shared_ptr<GBufferRenderer::FrameWork> GBufferRenderer::prepare(const GBuff
             gi.jointOffset = inst.jointOffset;
             gi.jointCount = uint32_t(scene_.skins.at(size_t(inst.skin)).joints.size());
         }
+        work->morphedFirstVertex.push_back(appendMorphed(inst, work->morphedVertices, gi.previousVertexDelta));
         work->instances.push_back(gi);
         work->meshes.push_back(inst.mesh);
-        work->morphedFirstVertex.push_back(appendMorphed(inst, work->morphedVertices));
     }
     work->joints = scene_.jointMatrices;
     work->previousJoints = scene_.previousJointMatrices;
@@ -518,22 +518,34 @@ std::shared_ptr<GBufferRenderer::FrameWork> GBufferRenderer::prepare(const GBuff
     return work;
 }
 
-int64_t GBufferRenderer::appendMorphed(const scene::Instance& inst, std::vector<shader::GBufferVertex>& out) const {
+int64_t GBufferRenderer::appendMorphed(const scene::Instance& inst, std::vector<shader::GBufferVertex>& out,
+                                       uint32_t& previousDelta) const {
+    previousDelta = 0;
     if (inst.mesh >= scene_.meshes.size() || inst.morphWeights.empty() || morphBaseVertices_[inst.mesh].empty()) {
         return -1;
     }
     const int64_t first = int64_t(out.size());
     const std::vector<shader::GBufferVertex>& base = morphBaseVertices_[inst.mesh];
-    size_t v = 0;
-    for (const scene::Geometry& g : scene_.meshes[inst.mesh].lods[0].geometries) {
-        const scene::Geometry morphed = scene::morphedGeometry(g, inst.morphWeights);
-        for (uint32_t k = 0; k < morphed.vertexCount(); ++k, ++v) {
-            shader::GBufferVertex vertex = base.at(v);
-            vertex.position = morphed.positions[k];
-            if (k < morphed.normals.size()) vertex.normal = morphed.normals[k];
-            if (k < morphed.tangents.size()) vertex.tangent = morphed.tangents[k];
-            out.push_back(vertex);
+    const auto append = [&](const std::vector<float>& weights) {
+        size_t v = 0;
+        for (const scene::Geometry& g : scene_.meshes[inst.mesh].lods[0].geometries) {
+            const scene::Geometry morphed = scene::morphedGeometry(g, weights);
+            for (uint32_t k = 0; k < morphed.vertexCount(); ++k, ++v) {
+                shader::GBufferVertex vertex = base.at(v);
+                vertex.position = morphed.positions[k];
+                if (k < morphed.normals.size()) vertex.normal = morphed.normals[k];
+                if (k < morphed.tangents.size()) vertex.tangent = morphed.tangents[k];
+                out.push_back(vertex);
+            }
         }
+    };
+    append(inst.morphWeights);
+    // Motion vectors of the morph itself: last frame's shape follows this
+    // one's (only positions are read from it).
+    if (inst.previousMorphWeights.size() == inst.morphWeights.size() &&
+        inst.previousMorphWeights != inst.morphWeights) {
+        previousDelta = uint32_t(int64_t(out.size()) - first);
+        append(inst.previousMorphWeights);
     }
     return first;
 }

@@ -186,7 +186,11 @@ private:
     // Appends the morphed vertices of `inst` (its mesh's LOD 0 with its
     // morph weights applied on the CPU) to `out`; their first index, or -1
     // when the instance does not morph.
-    int64_t appendMorphed(const scene::Instance& inst, std::vector<shader::GBufferVertex>& out) const;
+    // Appends the instance's morphed vertices (and, when its weights changed
+    // since last frame, last frame's copy right after them); returns the
+    // first vertex (-1: not morphing) and sets `previousDelta`.
+    int64_t appendMorphed(const scene::Instance& inst, std::vector<shader::GBufferVertex>& out,
+                          uint32_t& previousDelta) const;
     // The vertex buffer an instance's draws read and the shift of their
     // vertex offsets into it.
     std::pair<const gpu::Buffer*, int32_t> vertexSource(const FrameWork& work, size_t instance,

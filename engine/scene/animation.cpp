@@ -300,12 +300,14 @@ void prepareScene(Scene& scene, double seconds) {
     scene.previousJointMatrices = scene.jointMatrices;
     for (Instance& inst : scene.instances) {
         inst.previousTransform = inst.transform;
+        inst.previousMorphWeights = inst.morphWeights;
     }
 }
 
 void advanceScene(Scene& scene, double seconds, const Camera* camera) {
     for (Instance& inst : scene.instances) {
         inst.previousTransform = inst.transform;
+        inst.previousMorphWeights = inst.morphWeights;
     }
     scene.previousJointMatrices = scene.jointMatrices;
     evaluate(scene, seconds, camera, true);

@@ -267,6 +267,8 @@ struct Instance {
     // defaults); empty when the mesh does not morph. Changes bump
     // deformVersion (advanceScene).
     std::vector<float> morphWeights;
+    // Last frame's morphWeights (motion vectors of the morph itself).
+    std::vector<float> previousMorphWeights;
     // Bumped every time the vertices change shape (skinning, vertex
     // animation): the BVH planner rebuilds a BLAS only when it changed.
     uint64_t deformVersion = 0;

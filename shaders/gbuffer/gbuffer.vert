@@ -2,7 +2,8 @@
 // G-buffer geometry: pulls the vertex from the scene's one vertex buffer
 // (gl_VertexIndex includes the draw's vertex offset), skins it with this and
 // last frame's joint palettes, and places it with this and last frame's
-// instance transform, so motion covers camera, rigid and skinned movement.
+// instance transform, so motion covers camera, rigid, skinned and morph
+// movement (a morphing instance's last-frame copy, previousVertexDelta).
 #extension GL_GOOGLE_include_directive : require
 
 #include "gbuffer_common.glsl"
@@ -21,13 +22,16 @@ void main() {
     const GBufferVertex v = vertices[gl_VertexIndex];
     const GBufferInstance inst = instances[draw.instance];
     vec3 position = v.position;
-    vec3 previousPosition = v.position;
+    // Last frame's object-space position: a morph moves the vertex itself.
+    const vec3 previousBase =
+        inst.previousVertexDelta != 0u ? vertices[gl_VertexIndex + int(inst.previousVertexDelta)].position : v.position;
+    vec3 previousPosition = previousBase;
     vec3 normal = v.normal;
     vec3 tangent = v.tangent.xyz;
     if (inst.jointCount > 0u) {
         const mat4 skin = skinMatrix(v, inst, false);
         position = (skin * vec4(v.position, 1.0)).xyz;
-        previousPosition = (skinMatrix(v, inst, true) * vec4(v.position, 1.0)).xyz;
+        previousPosition = (skinMatrix(v, inst, true) * vec4(previousBase, 1.0)).xyz;
         // Rigs carry no non-uniform scale: the upper 3x3 transforms normals.
         normal = mat3(skin) * v.normal;
         tangent = mat3(skin) * tangent;

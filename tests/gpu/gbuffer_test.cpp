@@ -471,6 +471,40 @@ TEST_CASE("an object moving sideways gives its motion in pixels, from this frame
     CHECK(covered == 16 * 16);
 }
 
+TEST_CASE("a morph that moved the vertices since last frame gives their motion in pixels") {
+    // The sideways case above, with the move made by a morph target (+1 in
+    // x at weight 1) instead of the instance transform.
+    test::GpuTest gpu;
+    constexpr float kDistance = 4.0f;
+    scene::Geometry square1 = square({0, 0, -kDistance}, {1, 0, 0}, {0, 1, 0}, 1.0f);
+    scene::MorphTarget target;
+    target.positions.assign(square1.positions.size(), {1, 0, 0});
+    square1.morphTargets.push_back(target);
+    scene::Scene scene;
+    scene.name = "gbuffer-morph-motion-test";
+    scene.materials.emplace_back();
+    scene::Mesh mesh;
+    mesh.lods.push_back({{square1}});
+    mesh.morphWeights = {0.0f};
+    scene.meshes.push_back(std::move(mesh));
+    scene.instances.push_back({});
+    scene::prepareScene(scene);
+    REQUIRE(scene.instances[0].previousMorphWeights == std::vector<float>{0.0f});
+    scene.instances[0].morphWeights = {1.0f};
+    const GBufferImage img = render(gpu, scene, {testCamera()});
+
+    const float expected = -float(kSize) / (2.0f * kDistance);  // -8 pixels
+    uint32_t covered = 0;
+    for (size_t i = 0; i < img.depth.size(); ++i) {
+        if (img.normal[i].w == 0.0f) continue;
+        ++covered;
+        INFO("pixel " << i % kSize << ", " << i / kSize);
+        REQUIRE(std::abs(img.motion[i].x - expected) < 0.02f);
+        REQUIRE(std::abs(img.motion[i].y) < 0.02f);
+    }
+    CHECK(covered == 16 * 16);  // drawn where weight 1 puts it: x in [0, 2]
+}
+
 TEST_CASE("a camera moving sideways makes static geometry move the other way on screen") {
     test::GpuTest gpu;
     constexpr float kDistance = 5.0f;

@@ -62,7 +62,10 @@ struct GBufferInstance {
     mat4 previousTransform;
     uint jointOffset;  // first matrix in the joint palettes
     uint jointCount;   // 0: rigid
-    uint pad0;
+    // Morphing instances whose weights changed since last frame: last
+    // frame's morphed copy of a vertex lies this many vertices after this
+    // frame's (0: the vertex did not move in object space).
+    uint previousVertexDelta;
     uint pad1;
 };
 
