@@ -236,21 +236,22 @@ const BvhManager::SourceGeometry& BvhManager::sourceGeometry(uint32_t mesh, uint
     const std::vector<shader::BvhSourceVertex> vertices = sourceVertices(scene_, g);
     auto source = std::make_unique<SourceGeometry>();
     source->triangleCount = g.triangleCount();
-    // The buffers are filled by the frame's pass (FrameWork::uploads); the
+    // `target` is filled by the frame's pass (FrameWork::uploads); the
     // staging lives until that frame has finished.
-    std::vector<std::pair<std::shared_ptr<gpu::Buffer>, gpu::Buffer*>> staged;
-    const auto upload = [&](const void* data, size_t bytes, const std::string& what) {
+    const auto upload = [&](gpu::Buffer& target, const void* data, size_t bytes, const std::string& what) {
         const VkDeviceSize size = std::max<VkDeviceSize>(bytes, 4);
         auto staging = std::make_shared<gpu::Buffer>(
             ctx_, gpu::BufferDesc{size, VK_BUFFER_USAGE_TRANSFER_SRC_BIT, gpu::MemoryUsage::Upload,
                                   name + what + ".staging", true});
         std::memcpy(staging->mapped(), data, bytes);
-        staged.push_back({staging, nullptr});
-        return gpu::Buffer(ctx_, {size, VK_BUFFER_USAGE_STORAGE_BUFFER_BIT | VK_BUFFER_USAGE_TRANSFER_DST_BIT,
-                                  gpu::MemoryUsage::DeviceLocal, name + what, true});
+        target = gpu::Buffer(ctx_, {size, VK_BUFFER_USAGE_STORAGE_BUFFER_BIT | VK_BUFFER_USAGE_TRANSFER_DST_BIT,
+                                    gpu::MemoryUsage::DeviceLocal, name + what, true});
+        stats_.uploadBytes += size;
+        retired_.push_back({frame_, staging});
+        work.uploads.push_back({std::move(staging), &target});
     };
-    source->vertices = upload(vertices.data(), vertices.size() * sizeof(vertices[0]), ".vertices");
-    source->indices = upload(g.indices.data(), g.indices.size() * sizeof(uint32_t), ".indices");
+    upload(source->vertices, vertices.data(), vertices.size() * sizeof(vertices[0]), ".vertices");
+    upload(source->indices, g.indices.data(), g.indices.size() * sizeof(uint32_t), ".indices");
     stats_.geometryBytes += source->vertices.size() + source->indices.size();
     if (g.skinned()) {
         std::vector<shader::BvhSkinVertex> skin(g.vertexCount());
@@ -259,18 +260,10 @@ const BvhManager::SourceGeometry& BvhManager::sourceGeometry(uint32_t mesh, uint
             skin[v] = {glm::uvec2(uint32_t(j.x) | uint32_t(j.y) << 16, uint32_t(j.z) | uint32_t(j.w) << 16),
                        g.weights[v]};
         }
-        source->skin = upload(skin.data(), skin.size() * sizeof(skin[0]), ".skin");
+        upload(source->skin, skin.data(), skin.size() * sizeof(skin[0]), ".skin");
         stats_.geometryBytes += source->skin.size();
     }
     ++stats_.uploadedGeometries;
-    staged[0].second = &source->vertices;
-    staged[1].second = &source->indices;
-    if (source->skin) staged[2].second = &source->skin;
-    for (auto& [staging, target] : staged) {
-        stats_.uploadBytes += staging->size();
-        retired_.push_back({frame_, staging});
-        work.uploads.push_back({std::move(staging), target});
-    }
     slot = std::move(source);
     return *slot;
 }

@@ -365,42 +365,32 @@ GBufferRenderer::GBufferRenderer(gpu::Context& ctx, const scene::Scene& scene, u
             range.vertexOffset = int32_t(vertices.size());
             const scene::Material& material = scene.materials.at(g.material);
             range.doubleSided = material.doubleSided;
-            const scene::TextureRef& normalRef = material.normalTexture;
-            if (g.tangents.size() == g.vertexCount()) {
-                range.image[kNormalSlot] = textureImage(normalRef, VK_FORMAT_R8G8B8A8_UNORM, "normal_map");
-            }
-            if (range.image[kNormalSlot] != kNoImage) {
-                range.material.normalMap = normalRef.texCoord + 1;
-                range.material.normalUvTransform = normalRef.uvTransform();
-                range.material.normalScale = material.normalScale;
-                range.sampler[kNormalSlot] = samplerIndex(normalRef);
+            // A slot samples its texture when `wanted` and the texture has an
+            // image: its coordinate set (+1; 0 = not sampled), transform and
+            // sampler go to the draw.
+            const auto useSlot = [&](uint32_t slot, const scene::TextureRef& ref, VkFormat format, const char* what,
+                                     bool wanted, uint32_t& map, shader::UvTransform& transform) {
+                if (wanted) range.image[slot] = textureImage(ref, format, what);
+                if (range.image[slot] == kNoImage) return false;
+                map = ref.texCoord + 1;
+                transform = ref.uvTransform();
+                range.sampler[slot] = samplerIndex(ref);
+                return true;
+            };
+            shader::GBufferDraw& draw = range.material;
+            if (useSlot(kNormalSlot, material.normalTexture, VK_FORMAT_R8G8B8A8_UNORM, "normal_map",
+                        g.tangents.size() == g.vertexCount(), draw.normalMap, draw.normalUvTransform)) {
+                draw.normalScale = material.normalScale;
                 normalImages.insert(range.image[kNormalSlot]);
             }
-            const scene::TextureRef& baseRef = material.baseColorTexture;
-            range.image[kBaseColorSlot] = textureImage(baseRef, VK_FORMAT_R8G8B8A8_SRGB, "base_color");
-            if (range.image[kBaseColorSlot] != kNoImage) {
-                range.material.baseColorMap = baseRef.texCoord + 1;
-                range.material.baseColorUvTransform = baseRef.uvTransform();
-                range.sampler[kBaseColorSlot] = samplerIndex(baseRef);
-            }
-            const scene::TextureRef& metalRoughRef = material.metallicRoughnessTexture;
-            range.image[kMetalRoughSlot] = textureImage(metalRoughRef, VK_FORMAT_R8G8B8A8_UNORM, "metal_rough");
-            if (range.image[kMetalRoughSlot] != kNoImage) {
-                range.material.metalRoughMap = metalRoughRef.texCoord + 1;
-                range.material.metalRoughUvTransform = metalRoughRef.uvTransform();
-                range.sampler[kMetalRoughSlot] = samplerIndex(metalRoughRef);
-            }
+            useSlot(kBaseColorSlot, material.baseColorTexture, VK_FORMAT_R8G8B8A8_SRGB, "base_color", true,
+                    draw.baseColorMap, draw.baseColorUvTransform);
+            useSlot(kMetalRoughSlot, material.metallicRoughnessTexture, VK_FORMAT_R8G8B8A8_UNORM, "metal_rough", true,
+                    draw.metalRoughMap, draw.metalRoughUvTransform);
             // Only a material that emits uploads its emissive texture.
-            const scene::TextureRef& emissiveRef = material.emissiveTexture;
             const glm::vec3 emissiveFactor = material.emissiveFactor * material.emissiveStrength;
-            if (emissiveFactor != glm::vec3(0.0f)) {
-                range.image[kEmissiveSlot] = textureImage(emissiveRef, VK_FORMAT_R8G8B8A8_SRGB, "emissive");
-            }
-            if (range.image[kEmissiveSlot] != kNoImage) {
-                range.material.emissiveMap = emissiveRef.texCoord + 1;
-                range.material.emissiveUvTransform = emissiveRef.uvTransform();
-                range.sampler[kEmissiveSlot] = samplerIndex(emissiveRef);
-            }
+            useSlot(kEmissiveSlot, material.emissiveTexture, VK_FORMAT_R8G8B8A8_SRGB, "emissive",
+                    emissiveFactor != glm::vec3(0.0f), draw.emissiveMap, draw.emissiveUvTransform);
             for (uint32_t v = 0; v < g.vertexCount(); ++v) {
                 const shader::SurfaceVertex s = scene::surfaceAtVertex(scene, g, v);
                 shader::GBufferVertex out{};
