@@ -29,6 +29,7 @@
 #include <algorithm>
 #include <bit>
 #include <string>
+#include <utility>
 
 #include <spdlog/spdlog.h>
 
@@ -343,6 +344,18 @@ struct FinalImport {
     SyncScope scope;
 };
 
+// A declared use as the walk reads it, resolved once per compile: the walk
+// then touches neither the (large) declared resource nor the planned one
+// for the common use of one subresource.
+struct UseRef {
+    const UseInfo* info = nullptr;
+    uint32_t cell = 0;              // first cell of the use's range
+    VkImageAspectFlags aspect = 0;  // textures: for the barriers
+    bool texture = false;
+    bool single = false; // the range is one cell
+    bool writes = false;
+};
+
 // Where an aliased transient's bytes begin or end in its heap.
 struct Cut {
     uint64_t offset;
@@ -356,7 +369,7 @@ struct Scratch {
     std::vector<Cell> cells;
     std::vector<EndState> ends;
     std::vector<Visibility> endSeen;
-    std::vector<const UseInfo*> useInfo;
+    std::vector<UseRef> useRefs;
     std::vector<UseInfo> mergedInfo;
     std::vector<Need> needs;
     std::vector<uint32_t> useNeed;
@@ -401,7 +414,7 @@ private:
         const bool history = std::any_of(d_.resources.begin(), d_.resources.end(),
                                          [](const ir::Resource& r) { return r.partner != kNoIndex; });
         endSeen_.assign(history ? cellCount : 0, Visibility{});
-        useInfo_.resize(d_.uses.size());
+        useRefs_.resize(d_.uses.size());
         // Merged read kinds get their own entry; the reserve keeps pointers
         // into it valid.
         mergedInfo_.clear();
@@ -420,12 +433,18 @@ private:
             for (uint32_t u = pass.firstUse; u < pass.firstUse + pass.useCount; ++u) {
                 const ir::Use& use = d_.uses[u];
                 const ir::Resource& r = d_.resources[use.resource];
+                UseRef& ref = useRefs_[u];
                 if ((use.kinds & (use.kinds - 1)) == 0) {
-                    useInfo_[u] = &useInfoOf(static_cast<Access>(std::countr_zero(use.kinds)), r.kind, pass.pipeline);
+                    ref.info = &useInfoOf(static_cast<Access>(std::countr_zero(use.kinds)), r.kind, pass.pipeline);
                 } else {
                     mergedInfo_.push_back(makeUseInfo(accessScope(use.kinds, r.kind, pass.pipeline)));
-                    useInfo_[u] = &mergedInfo_.back();
+                    ref.info = &mergedInfo_.back();
                 }
+                ref.texture = r.kind == ResourceKind::Texture;
+                ref.cell = ref.texture ? ir::cellOf(r, use.range.baseMip, use.range.baseLayer) : r.cellBase;
+                ref.aspect = ref.texture ? st_.plan.resources[use.resource].aspect : 0;
+                ref.single = !ref.texture || (use.range.mipCount == 1 && use.range.layerCount == 1);
+                ref.writes = use.writes;
                 if (r.origin == ir::Origin::Imported) continue;
                 if (r.origin == ir::Origin::HistoryPrevious) {
                     deferred.push_back(u);
@@ -468,13 +487,13 @@ private:
     void applyEnd(uint32_t u, uint32_t q) {
         const ir::Use& use = d_.uses[u];
         const ir::Resource& r = d_.resources[use.resource];
-        const UseInfo& info = *useInfo_[u];
-        const bool texture = r.kind == ResourceKind::Texture;
+        const UseRef& ref = useRefs_[u];
         // Visibility carries over only for history images (imports restart
         // from their declared state, transients from discarded contents).
         const bool history = r.partner != kNoIndex;
-        forCells(r, use.range,
-                 [&](uint32_t c) { ends_[c].apply(q, info, use.writes, texture, history ? &endSeen_[c] : nullptr); });
+        forCells(ref, use, [&](uint32_t c) {
+            ends_[c].apply(q, *ref.info, use.writes, ref.texture, history ? &endSeen_[c] : nullptr);
+        });
     }
 
     // `previous` this frame is what `current` was at the end of the last one.
@@ -631,6 +650,16 @@ private:
         LastUses out;
         for (uint32_t c = res.cellBase; c < res.cellBase + res.cellCount; ++c) out.add(ends_[c]);
         return out;
+    }
+
+    // A use's cells, mip-major.
+    template <class F>
+    void forCells(const UseRef& ref, const ir::Use& use, F&& f) const {
+        if (ref.single) {
+            f(ref.cell);
+            return;
+        }
+        forCells(d_.resources[use.resource], use.range, std::forward<F>(f));
     }
 
     template <class F>
@@ -823,9 +852,8 @@ private:
 
     // Turns needs_[first, last) -- one use's cells in mip-major order -- into
     // barriers: runs of layers per mip, merged across mips when runs line up.
-    void emit(uint32_t resource, const Subresource& range, const SyncScope& s, size_t first, size_t last) {
-        const ir::Resource& r = d_.resources[resource];
-        const bool texture = r.kind == ResourceKind::Texture;
+    void emit(uint32_t resource, bool texture, VkImageAspectFlags aspect, const Subresource& range, const SyncScope& s,
+              size_t first, size_t last) {
         std::vector<Barrier>& out = st_.plan.barriers;
         const size_t firstBarrier = out.size();
         const uint32_t layers = texture ? range.layerCount : 1;
@@ -870,7 +898,7 @@ private:
             Barrier& b = out.emplace_back();
             b.resource = resource;
             b.range = {mip, 1, layer, layerCount};
-            b.aspect = texture ? st_.plan.resources[resource].aspect : 0;
+            b.aspect = aspect;
             b.srcStages = srcStages;
             b.srcAccess = srcAccess;
             b.dstStages = s.stages;
@@ -880,9 +908,11 @@ private:
             b.aliasing = aliasing;
             i = j;
         }
-        if (st_.log)
+        if (st_.log) {
+            const ir::Resource& r = d_.resources[resource];
             for (size_t k = firstBarrier; k < out.size(); ++k)
                 spdlog::debug("rg barriers: {}", describeBarrier(r.name, out[k], r.kind));
+        }
     }
 
     void walkPass(uint32_t pos) {
@@ -894,13 +924,10 @@ private:
             needs_.clear();
             useNeed_.clear();
             for (uint32_t u = pass.firstUse; u < pass.firstUse + pass.useCount; ++u) {
-                const ir::Use& use = d_.uses[u];
-                const ir::Resource& r = d_.resources[use.resource];
-                const UseInfo& info = *useInfo_[u];
-                const bool texture = r.kind == ResourceKind::Texture;
+                const UseRef& ref = useRefs_[u];
                 useNeed_.push_back(static_cast<uint32_t>(needs_.size()));
-                forCells(r, use.range,
-                         [&](uint32_t c) { analyse(needs_.emplace_back(), c, q, info, use.writes, texture); });
+                forCells(ref, d_.uses[u],
+                         [&](uint32_t c) { analyse(needs_.emplace_back(), c, q, *ref.info, ref.writes, ref.texture); });
             }
         };
         analysePass();
@@ -910,12 +937,10 @@ private:
         // second full pass would.
         if (pending_[0].active || pending_[1].active) {
             for (uint32_t i = 0; i < pass.useCount; ++i) {
-                const uint32_t u = pass.firstUse + i;
-                const ir::Use& use = d_.uses[u];
-                const bool texture = d_.resources[use.resource].kind == ResourceKind::Texture;
+                const UseRef& ref = useRefs_[pass.firstUse + i];
                 const size_t last = i + 1 < pass.useCount ? useNeed_[i + 1] : needs_.size();
                 for (size_t k = useNeed_[i]; k < last; ++k)
-                    if (needs_[k].waits) analyse(needs_[k], needs_[k].cell, q, *useInfo_[u], use.writes, texture);
+                    if (needs_[k].waits) analyse(needs_[k], needs_[k].cell, q, *ref.info, ref.writes, ref.texture);
             }
         }
         const uint32_t ordinal = batches_.placePass(static_cast<Queue>(q), pos, pending_);
@@ -923,16 +948,19 @@ private:
 
         st_.barrierFirst[pos] = static_cast<uint32_t>(st_.plan.barriers.size());
         for (uint32_t i = 0; i < pass.useCount; ++i) {
-            const ir::Use& use = d_.uses[pass.firstUse + i];
-            const UseInfo& info = *useInfo_[pass.firstUse + i];
+            const UseRef& ref = useRefs_[pass.firstUse + i];
+            const UseInfo& info = *ref.info;
             const SyncScope& s = info.scope;
             const size_t first = useNeed_[i];
             const size_t last = i + 1 < pass.useCount ? useNeed_[i + 1] : needs_.size();
             // Most uses need no barrier; emit() is not worth a call for them.
             size_t firstBarrier = first;
             while (firstBarrier < last && !needs_[firstBarrier].barrier) ++firstBarrier;
-            if (firstBarrier < last) emit(use.resource, use.range, s, first, last);
-            for (size_t k = first; k < last; ++k) update(needs_[k], q, info, use.writes, now);
+            if (firstBarrier < last) {
+                const ir::Use& use = d_.uses[pass.firstUse + i];
+                emit(use.resource, ref.texture, ref.aspect, use.range, s, first, last);
+            }
+            for (size_t k = first; k < last; ++k) update(needs_[k], q, info, ref.writes, now);
         }
         st_.barrierCount[pos] = static_cast<uint32_t>(st_.plan.barriers.size()) - st_.barrierFirst[pos];
     }
@@ -985,7 +1013,9 @@ private:
             for (size_t i = 0; i < finals_.size(); ++i) {
                 const ir::Resource& res = d_.resources[finals_[i].resource];
                 const size_t end = i + 1 < finals_.size() ? finals_[i + 1].firstNeed : needs_.size();
-                emit(finals_[i].resource, wholeOf(res), boundaryScope(res.final, res.kind), finals_[i].firstNeed, end);
+                const bool texture = res.kind == ResourceKind::Texture;
+                emit(finals_[i].resource, texture, texture ? st_.plan.resources[finals_[i].resource].aspect : 0,
+                     wholeOf(res), boundaryScope(res.final, res.kind), finals_[i].firstNeed, end);
             }
             batches_.setEndBarriers(q, firstBarrier, static_cast<uint32_t>(st_.plan.barriers.size()) - firstBarrier);
         }
@@ -1008,7 +1038,7 @@ private:
     std::vector<Cell>& cells_ = scratch_.cells;
     std::vector<EndState>& ends_ = scratch_.ends;
     std::vector<Visibility>& endSeen_ = scratch_.endSeen;     // history cells: visibility at the frame's end
-    std::vector<const UseInfo*>& useInfo_ = scratch_.useInfo; // per declared use, from the access table
+    std::vector<UseRef>& useRefs_ = scratch_.useRefs; // per declared use (scheduled ones filled in)
     std::vector<UseInfo>& mergedInfo_ = scratch_.mergedInfo;
     std::vector<Need>& needs_ = scratch_.needs;
     std::vector<uint32_t>& useNeed_ = scratch_.useNeed;

@@ -5,6 +5,11 @@
 //   compile_us_per_pass_1024=<number> alias_saving_1080p=<percent>
 // where the first number is the worse of the two 1024-pass shapes
 // (declare + compile, barriers and aliasing included, two-queue device).
+//
+//   glint-graph-bench [--runs N] [--passes P]
+// --runs N times each shape N times (default 41 at 1024 passes, 201 below);
+// --passes P times only the graphs of P passes (16, 128 or 1024). A
+// profiler wants both.
 
 #include <algorithm>
 #include <chrono>
@@ -58,14 +63,15 @@ Timing measure(const synthetic::Script& script, const QueueCaps& caps, int runs)
     return {declare[runs / 2], compile[runs / 2], barriers, batches};
 }
 
-int run() {
+int run(int runsOverride, uint32_t onlyPasses) {
     const QueueCaps caps = synthetic::twoQueueCaps();
     std::printf("glint-graph-bench: declare + compile per pass (median), two-queue device\n");
     std::printf("%-16s %6s %12s %12s %12s %9s %8s\n", "shape", "passes", "declare_us", "compile_us", "total_us",
                 "barriers", "batches");
     double worst1024 = 0;
     for (const uint32_t passes : {16u, 128u, 1024u}) {
-        const int runs = passes == 1024 ? 41 : 201;
+        if (onlyPasses != 0 && passes != onlyPasses) continue;
+        const int runs = runsOverride > 0 ? runsOverride : passes == 1024 ? 41 : 201;
         const synthetic::Script reflection = synthetic::tiledReflectionFrames(passes, 1920, 1080);
         synthetic::RandomOptions options;
         options.passes = passes;
@@ -100,9 +106,32 @@ int run() {
 
 } // namespace
 
-int main() {
+int main(int argc, char** argv) {
+    int runs = 0;
+    uint32_t passes = 0;
+    for (int i = 1; i < argc; ++i) {
+        const std::string arg = argv[i];
+        if (arg == "--runs" && i + 1 < argc) {
+            runs = std::atoi(argv[++i]);
+            if (runs <= 0) {
+                std::fprintf(stderr, "glint-graph-bench: --runs takes a positive count, not '%s'\n", argv[i]);
+                return 2;
+            }
+        } else if (arg == "--passes" && i + 1 < argc) {
+            passes = static_cast<uint32_t>(std::atoi(argv[++i]));
+            if (passes != 16 && passes != 128 && passes != 1024) {
+                std::fprintf(stderr, "glint-graph-bench: --passes takes 16, 128 or 1024, not '%s'\n", argv[i]);
+                return 2;
+            }
+        } else {
+            std::fprintf(stderr,
+                         "glint-graph-bench: unknown argument '%s' (usage: glint-graph-bench [--runs N] [--passes P])\n",
+                         arg.c_str());
+            return 2;
+        }
+    }
     try {
-        return run();
+        return run(runs, passes);
     } catch (const std::exception& e) {
         std::fprintf(stderr, "glint-graph-bench: %s\n", e.what());
         return 1;
