@@ -104,23 +104,35 @@ struct Slots {
     bool untracked = false;
 };
 
-Slots slotsOf(VkPipelineStageFlags2 s) {
-    Slots out;
-    if (s & VK_PIPELINE_STAGE_2_ALL_COMMANDS_BIT) return {uint16_t((1u << kStageSlots) - 1), true};
-    VkPipelineStageFlags2 rest = s;
-    for (uint32_t i = 0; i < kStageSlots; ++i) {
-        if (!(s & kTrackedStages[i])) continue;
-        out.mask |= uint16_t(1u << i);
-        rest &= ~kTrackedStages[i];
+// Stage bit -> slot (kStageSlots: untracked), so a mask's slots cost one
+// step per set bit rather than one per tracked stage.
+struct SlotTable {
+    VkPipelineStageFlags2 tracked = 0;
+    uint8_t slot[64] = {};
+    constexpr SlotTable() {
+        for (uint32_t b = 0; b < 64; ++b) slot[b] = kStageSlots;
+        for (uint32_t i = 0; i < kStageSlots; ++i) {
+            tracked |= kTrackedStages[i];
+            slot[std::countr_zero(kTrackedStages[i])] = static_cast<uint8_t>(i);
+        }
     }
-    out.untracked = rest != 0;
+};
+constexpr SlotTable kSlots;
+
+Slots slotsOf(VkPipelineStageFlags2 s) {
+    if (s & VK_PIPELINE_STAGE_2_ALL_COMMANDS_BIT) return {uint16_t((1u << kStageSlots) - 1), true};
+    Slots out;
+    out.untracked = (s & ~kSlots.tracked) != 0;
+    for (VkPipelineStageFlags2 rest = s & kSlots.tracked; rest; rest &= rest - 1)
+        out.mask |= uint16_t(1u << kSlots.slot[std::countr_zero(rest)]);
     return out;
 }
 
 // One declared use, looked up in the access table once per compile.
 struct UseInfo {
     SyncScope scope;
-    VkAccessFlags2 reads = 0; // the read bits of scope.access
+    VkAccessFlags2 reads = 0;       // the read bits of scope.access
+    VkAccessFlags2 writeAccess = 0; // and its write bits
     Slots slots;
     uint16_t packedAccess = 0;
     uint16_t packedReads = 0;
@@ -129,7 +141,8 @@ struct UseInfo {
 UseInfo makeUseInfo(const SyncScope& scope) {
     UseInfo info;
     info.scope = scope;
-    info.reads = scope.access & ~writeAccessBits(scope.access);
+    info.writeAccess = writeAccessBits(scope.access);
+    info.reads = scope.access & ~info.writeAccess;
     info.slots = slotsOf(scope.stages);
     info.packedAccess = pack(scope.access);
     info.packedReads = pack(info.reads);
@@ -170,21 +183,10 @@ struct Visibility {
     }
 
     // Stages outside the tracked set (raw boundary states) never count as
-    // visible: a barrier too many, never one too few.
-    bool covers(uint32_t q, VkPipelineStageFlags2 s, uint16_t a) const {
-        VkPipelineStageFlags2 untracked = s;
-        for (uint32_t i = 0; i < kStageSlots; ++i) {
-            if (!(s & kTrackedStages[i])) continue;
-            if ((a & ~access[q][i]) != 0) return false;
-            untracked &= ~kTrackedStages[i];
-        }
-        return untracked == 0;
-    }
-    void add(uint32_t q, VkPipelineStageFlags2 s, uint16_t a) {
-        const bool all = (s & VK_PIPELINE_STAGE_2_ALL_COMMANDS_BIT) != 0;
-        for (uint32_t i = 0; i < kStageSlots; ++i)
-            if (all || (s & kTrackedStages[i])) access[q][i] |= a;
-    }
+    // visible: a barrier too many, never one too few. ALL_COMMANDS adds to
+    // every slot.
+    bool covers(uint32_t q, VkPipelineStageFlags2 s, uint16_t a) const { return covers(q, slotsOf(s), a); }
+    void add(uint32_t q, VkPipelineStageFlags2 s, uint16_t a) { add(q, slotsOf(s), a); }
     void clear() { *this = Visibility{}; }
 };
 
@@ -243,7 +245,7 @@ struct EndState {
             wQueue = static_cast<int8_t>(q);
             wPending = true;
             wStages = s.stages;
-            wAccess = writeAccessBits(s.access);
+            wAccess = use.writeAccess;
             rStages[0] = rStages[1] = 0;
             if (seen) seen->clear();
         } else {
@@ -610,6 +612,24 @@ private:
                 (cuts[k].side & 1 ? last : first) = cut;
             }
             const size_t width = cut;
+            // Placement packs a heap so that a member usually spans a few
+            // pieces: then OR-ing into and out of each piece directly is far
+            // cheaper than the tree. The tree bounds the worst case.
+            size_t spanned = 0;
+            for (const auto& [first, last] : pieces) spanned += last - first;
+            if (spanned <= 8 * pieces.size()) {
+                tree.assign(width, LastUses{});
+                for (size_t i = 0; i < list.size(); ++i) {
+                    const LastUses last = summary(list[i]);
+                    for (uint32_t k = pieces[i].first; k < pieces[i].second; ++k) tree[k].merge(last);
+                }
+                for (size_t i = 0; i < list.size(); ++i) {
+                    LastUses priors;
+                    for (uint32_t k = pieces[i].first; k < pieces[i].second; ++k) priors.merge(tree[k]);
+                    addAliasedPriors(list[i], priors);
+                }
+                continue;
+            }
             // Range-OR updates, pushed down to the pieces.
             tree.assign(2 * width, LastUses{});
             for (size_t i = 0; i < list.size(); ++i) {
@@ -634,13 +654,17 @@ private:
                     if (l & 1) priors.merge(tree[l++]);
                     if (h & 1) priors.merge(tree[--h]);
                 }
-                const EndState prior = priors.endState();
-                const ir::Resource& res = d_.resources[list[i]];
-                for (uint32_t c = res.cellBase; c < res.cellBase + res.cellCount; ++c) {
-                    addPrior(cells_[c], prior);
-                    cells_[c].aliased = true;
-                }
+                addAliasedPriors(list[i], priors);
             }
+        }
+    }
+
+    void addAliasedPriors(uint32_t r, const LastUses& priors) {
+        const EndState prior = priors.endState();
+        const ir::Resource& res = d_.resources[r];
+        for (uint32_t c = res.cellBase; c < res.cellBase + res.cellCount; ++c) {
+            addPrior(cells_[c], prior);
+            cells_[c].aliased = true;
         }
     }
 
@@ -701,10 +725,10 @@ private:
         return req.stages;
     }
 
+    // `n` arrives value-initialised (a fresh need, or one reset by the caller).
     void analyse(Need& n, uint32_t c, uint32_t q, const UseInfo& use, bool writes, bool texture) {
         const Cell& cell = cells_[c];
         const SyncScope& s = use.scope;
-        n = Need{};
         n.cell = c;
         n.transition = texture && cell.layout != s.layout;
         n.oldLayout = n.transition && !cell.contents ? VK_IMAGE_LAYOUT_UNDEFINED : cell.layout;
@@ -765,9 +789,9 @@ private:
     // queue, its stages, its write access) stay as they are: whoever comes
     // next synchronises with them through `s`. Others are made to happen
     // before `s`.
+    // `n` arrives value-initialised, as in analyse().
     void analyseFinal(Need& n, uint32_t c, uint32_t q, const SyncScope& s, bool texture) {
         const Cell& cell = cells_[c];
-        n = Need{};
         n.cell = c;
         n.transition = texture && s.layout != VK_IMAGE_LAYOUT_UNDEFINED && cell.layout != s.layout;
         n.oldLayout = n.transition && !cell.contents ? VK_IMAGE_LAYOUT_UNDEFINED : cell.layout;
@@ -833,7 +857,7 @@ private:
             cell.wQueue = static_cast<int8_t>(q);
             cell.wPoint = now;
             cell.wStages = s.stages;
-            cell.wAccess = writeAccessBits(s.access);
+            cell.wAccess = use.writeAccess;
             cell.wPending = true;
             cell.rStages[0] = cell.rStages[1] = 0;
             cell.rOrdered[0] = cell.rOrdered[1] = 0;
@@ -915,6 +939,25 @@ private:
         }
     }
 
+    // emit() of a use of one cell (most uses): one barrier, nothing to merge.
+    void emitOne(uint32_t resource, const UseRef& ref, const Subresource& range, const SyncScope& s, const Need& n) {
+        Barrier& b = st_.plan.barriers.emplace_back();
+        b.resource = resource;
+        b.range = ref.texture ? Subresource{range.baseMip, 1, range.baseLayer, 1} : Subresource{0, 1, 0, 1};
+        b.aspect = ref.aspect;
+        b.srcStages = n.srcStages;
+        b.srcAccess = n.srcAccess;
+        b.dstStages = s.stages;
+        b.dstAccess = s.access;
+        b.oldLayout = ref.texture ? n.oldLayout : VK_IMAGE_LAYOUT_UNDEFINED;
+        b.newLayout = ref.texture ? s.layout : VK_IMAGE_LAYOUT_UNDEFINED;
+        b.aliasing = n.aliased;
+        if (st_.log) {
+            const ir::Resource& r = d_.resources[resource];
+            spdlog::debug("rg barriers: {}", describeBarrier(r.name, b, r.kind));
+        }
+    }
+
     void walkPass(uint32_t pos) {
         const uint32_t p = st_.order[pos];
         const ir::Pass& pass = d_.passes[p];
@@ -939,8 +982,12 @@ private:
             for (uint32_t i = 0; i < pass.useCount; ++i) {
                 const UseRef& ref = useRefs_[pass.firstUse + i];
                 const size_t last = i + 1 < pass.useCount ? useNeed_[i + 1] : needs_.size();
-                for (size_t k = useNeed_[i]; k < last; ++k)
-                    if (needs_[k].waits) analyse(needs_[k], needs_[k].cell, q, *ref.info, ref.writes, ref.texture);
+                for (size_t k = useNeed_[i]; k < last; ++k) {
+                    if (!needs_[k].waits) continue;
+                    const uint32_t cell = needs_[k].cell;
+                    needs_[k] = Need{};
+                    analyse(needs_[k], cell, q, *ref.info, ref.writes, ref.texture);
+                }
             }
         }
         const uint32_t ordinal = batches_.placePass(static_cast<Queue>(q), pos, pending_);
@@ -953,6 +1000,12 @@ private:
             const SyncScope& s = info.scope;
             const size_t first = useNeed_[i];
             const size_t last = i + 1 < pass.useCount ? useNeed_[i + 1] : needs_.size();
+            if (ref.single) {
+                const Need& n = needs_[first];
+                if (n.barrier) emitOne(d_.uses[pass.firstUse + i].resource, ref, d_.uses[pass.firstUse + i].range, s, n);
+                update(n, q, info, ref.writes, now);
+                continue;
+            }
             // Most uses need no barrier; emit() is not worth a call for them.
             size_t firstBarrier = first;
             while (firstBarrier < last && !needs_[firstBarrier].barrier) ++firstBarrier;
