@@ -335,15 +335,20 @@ struct Need {
     bool waits; // asked crossQueue(): the only part of analyse() that reads pending_
 };
 
+struct FinalImport;
+
+// An import whose final state needs barriers: its needs_[firstNeed, endNeed).
 struct Final {
-    uint32_t resource;
+    const FinalImport* target;
     uint32_t firstNeed;
+    uint32_t endNeed;
 };
 
 struct FinalImport {
     uint32_t resource;
     uint32_t queue; // boundary queue of its final state
     SyncScope scope;
+    VkAccessFlags2 reads; // the read bits of scope.access
 };
 
 // A declared use as the walk reads it, resolved once per compile: the walk
@@ -790,13 +795,12 @@ private:
     // next synchronises with them through `s`. Others are made to happen
     // before `s`.
     // `n` arrives value-initialised, as in analyse().
-    void analyseFinal(Need& n, uint32_t c, uint32_t q, const SyncScope& s, bool texture) {
+    void analyseFinal(Need& n, uint32_t c, uint32_t q, const SyncScope& s, VkAccessFlags2 reads, bool texture) {
         const Cell& cell = cells_[c];
         n.cell = c;
         n.transition = texture && s.layout != VK_IMAGE_LAYOUT_UNDEFINED && cell.layout != s.layout;
         n.oldLayout = n.transition && !cell.contents ? VK_IMAGE_LAYOUT_UNDEFINED : cell.layout;
         if (!n.transition && !s.stages) return; // handed over by a semaphore signal: nothing to order
-        const VkAccessFlags2 reads = s.access & ~writeAccessBits(s.access);
 
         auto order = [&](uint32_t from, TimelinePoint point, VkPipelineStageFlags2 stages, VkAccessFlags2 access,
                          bool makesVisible) {
@@ -806,6 +810,7 @@ private:
                 n.rawByBarrier = n.rawByBarrier || makesVisible;
                 return;
             }
+            n.waits = true;
             const VkPipelineStageFlags2 waited = crossQueue(q, from, point, s.stages);
             if (n.transition || !within(s.stages ? s.stages : VK_PIPELINE_STAGE_2_ALL_COMMANDS_BIT, waited))
                 n.srcStages |= waited;
@@ -1034,41 +1039,51 @@ private:
             target.resource = r;
             target.queue = queueIndex(st_.boundaryQueue(res.final.queue));
             target.scope = boundaryScope(res.final, res.kind);
+            target.reads = target.scope.access & ~writeAccessBits(target.scope.access);
         }
         for (uint32_t qi = 0; qi < kQueueCount; ++qi) {
             const auto q = static_cast<Queue>(qi);
             clearPending();
-            auto analyseFinals = [&] {
-                finals_.clear();
-                needs_.clear();
-                for (const FinalImport& target : targets) {
-                    if (target.queue != qi) continue;
-                    const uint32_t r = target.resource;
-                    const ir::Resource& res = d_.resources[r];
-                    const SyncScope& s = target.scope;
-                    const bool texture = res.kind == ResourceKind::Texture;
-                    const auto first = static_cast<uint32_t>(needs_.size());
-                    forCells(res, wholeOf(res),
-                             [&](uint32_t c) { analyseFinal(needs_.emplace_back(), c, qi, s, texture); });
-                    if (std::any_of(needs_.begin() + first, needs_.end(), [](const Need& n) { return n.barrier; }))
-                        finals_.push_back({r, first});
-                    else
-                        needs_.resize(first);
+            finals_.clear();
+            needs_.clear();
+            for (const FinalImport& target : targets) {
+                if (target.queue != qi) continue;
+                const ir::Resource& res = d_.resources[target.resource];
+                const bool texture = res.kind == ResourceKind::Texture;
+                const auto first = static_cast<uint32_t>(needs_.size());
+                forCells(res, wholeOf(res), [&](uint32_t c) {
+                    analyseFinal(needs_.emplace_back(), c, qi, target.scope, target.reads, texture);
+                });
+                finals_.push_back({&target, first, static_cast<uint32_t>(needs_.size())});
+            }
+            // As in walkPass(): a new wait changes only the needs that asked
+            // for one, and analysing those again in order replays the requests.
+            if (pending_[0].active || pending_[1].active) {
+                for (const Final& f : finals_) {
+                    const bool texture = d_.resources[f.target->resource].kind == ResourceKind::Texture;
+                    for (uint32_t k = f.firstNeed; k < f.endNeed; ++k) {
+                        if (!needs_[k].waits) continue;
+                        const uint32_t cell = needs_[k].cell;
+                        needs_[k] = Need{};
+                        analyseFinal(needs_[k], cell, qi, f.target->scope, f.target->reads, texture);
+                    }
                 }
-            };
-            analyseFinals();
-            if (pending_[0].active || pending_[1].active) analyseFinals();
+            }
+            std::erase_if(finals_, [&](const Final& f) {
+                return std::none_of(needs_.begin() + f.firstNeed, needs_.begin() + f.endNeed,
+                                    [](const Need& n) { return n.barrier; });
+            });
             // A final state can need only a wait: the import must be visible on
             // its final queue after the other queue's last use.
             if (finals_.empty() && !pending_[0].active && !pending_[1].active) continue;
             batches_.placeEnd(q, pending_);
             const auto firstBarrier = static_cast<uint32_t>(st_.plan.barriers.size());
-            for (size_t i = 0; i < finals_.size(); ++i) {
-                const ir::Resource& res = d_.resources[finals_[i].resource];
-                const size_t end = i + 1 < finals_.size() ? finals_[i + 1].firstNeed : needs_.size();
+            for (const Final& f : finals_) {
+                const uint32_t r = f.target->resource;
+                const ir::Resource& res = d_.resources[r];
                 const bool texture = res.kind == ResourceKind::Texture;
-                emit(finals_[i].resource, texture, texture ? st_.plan.resources[finals_[i].resource].aspect : 0,
-                     wholeOf(res), boundaryScope(res.final, res.kind), finals_[i].firstNeed, end);
+                emit(r, texture, texture ? st_.plan.resources[r].aspect : 0, wholeOf(res), f.target->scope,
+                     f.firstNeed, f.endNeed);
             }
             batches_.setEndBarriers(q, firstBarrier, static_cast<uint32_t>(st_.plan.barriers.size()) - firstBarrier);
         }
