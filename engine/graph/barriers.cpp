@@ -363,10 +363,47 @@ struct UseRef {
     bool writes = false;
 };
 
-// Where an aliased transient's bytes begin or end in its heap.
-struct Cut {
-    uint64_t offset;
-    uint32_t side; // 2 * the member's index, + 1 at its end
+// Byte offsets -> their rank among the distinct offsets inserted: an
+// open-addressing hash set, then the distinct values sorted and numbered.
+class OffsetIndex {
+public:
+    void reset(size_t values) {
+        const auto bits = static_cast<uint32_t>(std::bit_width(std::max<size_t>(2 * values, 16) - 1));
+        shift_ = 64 - bits;
+        keys_.assign(size_t{1} << bits, 0);
+        rank_.assign(size_t{1} << bits, kNoIndex);
+        distinct_.clear();
+    }
+    void insert(uint64_t offset) {
+        size_t slot = home(offset);
+        while (rank_[slot] != kNoIndex) {
+            if (keys_[slot] == offset) return;
+            slot = (slot + 1) & (keys_.size() - 1);
+        }
+        keys_[slot] = offset;
+        rank_[slot] = 0; // numbered by number()
+        distinct_.push_back(offset);
+    }
+    void number() {
+        std::sort(distinct_.begin(), distinct_.end());
+        for (uint32_t i = 0; i < distinct_.size(); ++i) rank_[slotOf(distinct_[i])] = i;
+    }
+    // An inserted offset's rank.
+    uint32_t find(uint64_t offset) const { return rank_[slotOf(offset)]; }
+    size_t count() const { return distinct_.size(); }
+
+private:
+    size_t home(uint64_t offset) const { return static_cast<size_t>((offset * 0x9E3779B97F4A7C15ull) >> shift_); }
+    size_t slotOf(uint64_t offset) const {
+        size_t slot = home(offset);
+        while (keys_[slot] != offset || rank_[slot] == kNoIndex) slot = (slot + 1) & (keys_.size() - 1);
+        return slot;
+    }
+
+    uint32_t shift_ = 60;
+    std::vector<uint64_t> keys_;
+    std::vector<uint32_t> rank_;
+    std::vector<uint64_t> distinct_;
 };
 
 // compile() runs every frame: the walk keeps its working memory per thread
@@ -384,8 +421,7 @@ struct Scratch {
     std::vector<FinalImport> finalImports;
     std::vector<uint32_t> deferred;
     std::vector<uint32_t> imports;
-    std::vector<Cut> cuts;
-    std::vector<Cut> cutsScratch;
+    OffsetIndex offsetIndex;
     std::vector<LastUses> tree;
     std::vector<std::pair<uint32_t, uint32_t>> pieces; // per aliased member: its pieces [first, second)
     std::vector<std::vector<uint32_t>> heapMembers;
@@ -596,27 +632,28 @@ private:
         for (auto& list : members) list.clear();
         for (uint32_t r = 0; r < d_.resources.size(); ++r)
             if (st_.aliased[r]) members[st_.plan.resources[r].heap].push_back(r);
-        std::vector<Cut>& cuts = scratch_.cuts;
         std::vector<LastUses>& tree = scratch_.tree;
         std::vector<std::pair<uint32_t, uint32_t>>& pieces = scratch_.pieces;
         for (const std::vector<uint32_t>& list : members) {
             if (list.empty()) continue;
-            // Both ends of every member, sorted; equal offsets are one cut.
-            cuts.clear();
+            // The distinct offsets where members begin or end, in order; a
+            // piece lies between two neighbours. Placement reuses a few
+            // offsets for many members, so the distinct ones are gathered
+            // through a hash table first and only they are sorted.
+            OffsetIndex& index = scratch_.offsetIndex;
+            index.reset(2 * list.size());
+            for (const uint32_t r : list) {
+                const PlannedResource& placed = st_.plan.resources[r];
+                index.insert(placed.offset);
+                index.insert(placed.offset + placed.size);
+            }
+            index.number();
+            pieces.resize(list.size());
             for (uint32_t i = 0; i < list.size(); ++i) {
                 const PlannedResource& placed = st_.plan.resources[list[i]];
-                cuts.push_back({placed.offset, 2 * i});
-                cuts.push_back({placed.offset + placed.size, 2 * i + 1});
+                pieces[i] = {index.find(placed.offset), index.find(placed.offset + placed.size)};
             }
-            radixSort(cuts, scratch_.cutsScratch, [](const Cut& cut) { return cut.offset; });
-            pieces.resize(list.size());
-            uint32_t cut = 0;
-            for (size_t k = 0; k < cuts.size(); ++k) {
-                if (k > 0 && cuts[k].offset != cuts[k - 1].offset) ++cut;
-                auto& [first, last] = pieces[cuts[k].side / 2];
-                (cuts[k].side & 1 ? last : first) = cut;
-            }
-            const size_t width = cut;
+            const size_t width = index.count() - 1;
             // Placement packs a heap so that a member usually spans a few
             // pieces: then OR-ing into and out of each piece directly is far
             // cheaper than the tree. The tree bounds the worst case.
