@@ -128,14 +128,34 @@ Slots slotsOf(VkPipelineStageFlags2 s) {
     return out;
 }
 
+// A set of (tracked stage slot, packed access bit) pairs: slot i's 16
+// access bits are bits [16i, 16i + 16) of a 160-bit row, so testing or
+// adding visibility is a few word operations whatever the stages.
+struct VisMask {
+    uint64_t word[3] = {0, 0, 0};
+    bool untracked = false; // names stages outside the tracked set
+};
+static_assert(kStageSlots <= 12, "a VisMask row holds 12 slots of 16 access bits");
+
+VisMask maskOf(Slots s, uint16_t a) {
+    VisMask m;
+    m.untracked = s.untracked;
+    for (uint32_t rest = s.mask; rest; rest &= rest - 1) {
+        const auto slot = static_cast<uint32_t>(std::countr_zero(rest));
+        m.word[slot / 4] |= uint64_t{a} << (16 * (slot % 4));
+    }
+    return m;
+}
+
+VisMask maskOf(VkPipelineStageFlags2 stages, uint16_t a) { return maskOf(slotsOf(stages), a); }
+
 // One declared use, looked up in the access table once per compile.
 struct UseInfo {
     SyncScope scope;
     VkAccessFlags2 reads = 0;       // the read bits of scope.access
     VkAccessFlags2 writeAccess = 0; // and its write bits
-    Slots slots;
-    uint16_t packedAccess = 0;
-    uint16_t packedReads = 0;
+    VisMask accessMask;             // its stages x its accesses
+    VisMask readMask;               // its stages x its reads
 };
 
 UseInfo makeUseInfo(const SyncScope& scope) {
@@ -143,9 +163,9 @@ UseInfo makeUseInfo(const SyncScope& scope) {
     info.scope = scope;
     info.writeAccess = writeAccessBits(scope.access);
     info.reads = scope.access & ~info.writeAccess;
-    info.slots = slotsOf(scope.stages);
-    info.packedAccess = pack(scope.access);
-    info.packedReads = pack(info.reads);
+    const Slots slots = slotsOf(scope.stages);
+    info.accessMask = maskOf(slots, pack(scope.access));
+    info.readMask = maskOf(slots, pack(info.reads));
     return info;
 }
 
@@ -169,24 +189,23 @@ const UseInfo& useInfoOf(Access a, ResourceKind k, Pipeline p) {
     return kUseInfo.info[static_cast<uint32_t>(a)][static_cast<uint32_t>(k)][static_cast<uint32_t>(p)];
 }
 
+// Per queue, the (stage, access) pairs a write is visible to.
 struct Visibility {
-    uint16_t access[kQueueCount][kStageSlots] = {};
-
-    bool covers(uint32_t q, Slots s, uint16_t a) const {
-        if (s.untracked) return false;
-        for (uint32_t rest = s.mask; rest; rest &= rest - 1)
-            if ((a & ~access[q][std::countr_zero(rest)]) != 0) return false;
-        return true;
-    }
-    void add(uint32_t q, Slots s, uint16_t a) {
-        for (uint32_t rest = s.mask; rest; rest &= rest - 1) access[q][std::countr_zero(rest)] |= a;
-    }
+    uint64_t word[kQueueCount][3] = {};
 
     // Stages outside the tracked set (raw boundary states) never count as
     // visible: a barrier too many, never one too few. ALL_COMMANDS adds to
-    // every slot.
-    bool covers(uint32_t q, VkPipelineStageFlags2 s, uint16_t a) const { return covers(q, slotsOf(s), a); }
-    void add(uint32_t q, VkPipelineStageFlags2 s, uint16_t a) { add(q, slotsOf(s), a); }
+    // every slot (slotsOf()).
+    bool covers(uint32_t q, const VisMask& m) const {
+        const uint64_t* have = word[q];
+        return !m.untracked &&
+               ((m.word[0] & ~have[0]) | (m.word[1] & ~have[1]) | (m.word[2] & ~have[2])) == 0;
+    }
+    void add(uint32_t q, const VisMask& m) {
+        word[q][0] |= m.word[0];
+        word[q][1] |= m.word[1];
+        word[q][2] |= m.word[2];
+    }
     void clear() { *this = Visibility{}; }
 };
 
@@ -206,9 +225,9 @@ struct Cell {
     // before (a barrier on that queue chained from a wait that reached them).
     VkPipelineStageFlags2 rOrdered[kQueueCount] = {0, 0};
 
-    bool visible(uint32_t q, VkPipelineStageFlags2 s, VkAccessFlags2 a) const { return vis.covers(q, s, pack(a)); }
-    void addVisible(uint32_t q, VkPipelineStageFlags2 s, VkAccessFlags2 a) { vis.add(q, s, pack(a)); }
-    void addVisibleToAll(uint32_t q, VkPipelineStageFlags2 s) { vis.add(q, s, kAnyPacked); }
+    bool visible(uint32_t q, VkPipelineStageFlags2 s, VkAccessFlags2 a) const { return vis.covers(q, maskOf(s, pack(a))); }
+    void addVisible(uint32_t q, VkPipelineStageFlags2 s, VkAccessFlags2 a) { vis.add(q, maskOf(s, pack(a))); }
+    void addVisibleToAll(uint32_t q, VkPipelineStageFlags2 s) { vis.add(q, maskOf(s, kAnyPacked)); }
     void clearVisible() { vis.clear(); }
 };
 
@@ -237,7 +256,7 @@ struct EndState {
             layout = s.layout;
             if (seen) {
                 seen->clear();
-                seen->add(q, use.slots, use.packedAccess);
+                seen->add(q, use.accessMask);
             }
         }
         touched = true;
@@ -251,7 +270,7 @@ struct EndState {
         } else {
             rStages[q] |= s.stages;
             wPending = false;
-            if (seen) seen->add(q, use.slots, use.packedAccess);
+            if (seen) seen->add(q, use.accessMask);
         }
     }
 };
@@ -790,7 +809,7 @@ private:
         };
 
         // Read after write.
-        if (use.reads && cell.wQueue >= 0 && cell.wStages && !cell.vis.covers(q, use.slots, use.packedReads)) {
+        if (use.reads && cell.wQueue >= 0 && cell.wStages && !cell.vis.covers(q, use.readMask)) {
             if (cell.wQueue == static_cast<int8_t>(q)) {
                 n.srcStages |= cell.wStages;
                 n.srcAccess |= cell.wAccess;
@@ -814,7 +833,7 @@ private:
             // synchronization validation (rightly strict about WAW) only
             // accepts a prior write the transition's barrier itself covers.
             if ((cell.wPending || n.transition) && cell.wQueue >= 0 && cell.wStages &&
-                (n.transition || !cell.vis.covers(q, use.slots, use.packedAccess))) {
+                (n.transition || !cell.vis.covers(q, use.accessMask))) {
                 if (cell.wQueue == static_cast<int8_t>(q)) {
                     n.srcStages |= cell.wStages;
                     n.srcAccess |= cell.wAccess;
@@ -889,10 +908,10 @@ private:
             cell.rStages[0] = cell.rStages[1] = 0;
             cell.rOrdered[0] = cell.rOrdered[1] = 0;
             cell.clearVisible();
-            cell.vis.add(q, use.slots, use.packedAccess);
+            cell.vis.add(q, use.accessMask);
             cell.aliased = false;
         } else if (n.rawByBarrier) {
-            cell.vis.add(q, use.slots, use.packedReads);
+            cell.vis.add(q, use.readMask);
         }
         if (n.visibleByWait) cell.addVisibleToAll(q, n.visibleByWait);
         if (writes) {
