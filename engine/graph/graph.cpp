@@ -380,8 +380,84 @@ PassId Graph::endPass(uint32_t pass) {
     return PassId{pass, d.graphId};
 }
 
-uint32_t Graph::use(uint32_t pass, ResourceKind kind, uint32_t index, uint32_t version, uint32_t graph, Access access,
-                    Subresource range, bool write) {
+// Every use of every pass comes through here, and nearly all are the plain
+// case: a valid handle of the current version, an access the resource and
+// queue allow, a legal range, contents where needed, and no other use of
+// the same subresource in the pass. That case is checked with a few
+// comparisons and recorded; anything else -- an error, a read that merges
+// with an earlier one -- goes to useGeneral(), which decides and words the
+// errors. The fast path only ever declines: it changes nothing before
+// handing over, so useGeneral() sees the same state it always did. Inline:
+// each Builder::read/write knows its kind and direction, which folds away
+// a good part of the checks.
+inline uint32_t Graph::use(uint32_t pass, ResourceKind kind, uint32_t index, uint32_t version, uint32_t graph,
+                           Access access, Subresource range, bool write) {
+    ir::Declaration& d = mutableDecl();
+    if (graph != d.graphId || index >= d.resources.size() || access >= Access::Count) [[unlikely]]
+        return useGeneral(pass, kind, index, version, graph, access, range, write);
+    const ir::Resource& r = d.resources[index];
+    const ir::Pass& p = d.passes[pass];
+    const detail::AccessRules& rules = detail::kAccessRules[static_cast<uint32_t>(access)];
+    // Bitwise, not short-circuit: every term is cheap, and one branch
+    // predicts better than eight.
+    const bool plain = (r.kind == kind) & !rules.boundaryOnly & ((rules.on >> static_cast<uint32_t>(kind)) & 1u) &
+                       (rules.writes == write) &
+                       ((p.queue == Queue::Graphics) | ((p.pipeline != Pipeline::Raster) & !rules.needsRaster)) &
+                       ((r.origin != ir::Origin::Imported) | (r.hasInitial & r.hasFinal)) & (version == r.version);
+    if (!plain) [[unlikely]]
+        return useGeneral(pass, kind, index, version, graph, access, range, write);
+
+    Subresource resolved = range;
+    uint32_t layers = 1;
+    if (kind == ResourceKind::Texture) {
+        const TextureDesc& t = r.texture;
+        layers = t.layers;
+        if (resolved.mipCount == Subresource::kAll)
+            resolved.mipCount = resolved.baseMip < t.mips ? t.mips - resolved.baseMip : 0;
+        if (resolved.layerCount == Subresource::kAll)
+            resolved.layerCount = resolved.baseLayer < t.layers ? t.layers - resolved.baseLayer : 0;
+        if (resolved.mipCount == 0 || resolved.layerCount == 0 || resolved.baseMip + resolved.mipCount > t.mips ||
+            resolved.baseLayer + resolved.layerCount > t.layers) [[unlikely]]
+            return useGeneral(pass, kind, index, version, graph, access, range, write);
+    } else {
+        if (range != Subresource{}) [[unlikely]]
+            return useGeneral(pass, kind, index, version, graph, access, range, write);
+        resolved = {0, 1, 0, 1};
+    }
+
+    if (rules.needsContents) {
+        // Cell (m, l) is cellBase + m * layers + l (ir::cellOf).
+        const uint8_t* written = d.written.data() + r.cellBase + resolved.baseLayer;
+        for (uint32_t m = resolved.baseMip; m < resolved.baseMip + resolved.mipCount; ++m)
+            for (uint32_t l = 0; l < resolved.layerCount; ++l)
+                if (!written[m * layers + l]) [[unlikely]]
+                    return useGeneral(pass, kind, index, version, graph, access, range, write);
+    }
+
+    for (uint32_t u = p.firstUse; u < p.firstUse + p.useCount; ++u) {
+        const ir::Use& other = d.uses[u];
+        if (other.resource == index && rangesOverlap(other.range, resolved)) [[unlikely]]
+            return useGeneral(pass, kind, index, version, graph, access, range, write);
+    }
+
+    const uint32_t producer = r.lastWriter;
+    // Built in place: assembling it on the stack and copying it stalls on
+    // store forwarding, and this runs for every use of every pass.
+    ir::Use& use = d.uses.emplace_back();
+    use.resource = index;
+    use.version = version;
+    use.producer = producer;
+    use.kinds = accessBit(access);
+    use.writes = write;
+    use.range = resolved;
+    ++d.passes[pass].useCount;
+    return write ? version + 1 : version;
+}
+
+// Every case use() does not take: all the checks in order, each error in
+// words, and reads that merge into an earlier use of the pass.
+uint32_t Graph::useGeneral(uint32_t pass, ResourceKind kind, uint32_t index, uint32_t version, uint32_t graph,
+                           Access access, Subresource range, bool write) {
     ir::Declaration& d = mutableDecl();
     const std::string_view passName = d.passes[pass].name;
     const ir::Resource& r = checkHandle(kind, index, graph, passName);

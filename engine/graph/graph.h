@@ -181,6 +181,8 @@ private:
     std::pair<uint32_t, uint32_t> addHistory(std::string_view name, ResourceKind kind);
     uint32_t use(uint32_t pass, ResourceKind kind, uint32_t index, uint32_t version, uint32_t graph, Access access,
                  Subresource range, bool write);
+    uint32_t useGeneral(uint32_t pass, ResourceKind kind, uint32_t index, uint32_t version, uint32_t graph,
+                        Access access, Subresource range, bool write);
     void markOutput(ResourceKind kind, uint32_t index, uint32_t version, uint32_t graph);
     const ir::Resource& checkHandle(ResourceKind kind, uint32_t index, uint32_t graph, std::string_view pass) const;
     [[noreturn]] void throwBadHandle(ResourceKind kind, uint32_t index, uint32_t graph, std::string_view pass) const;
