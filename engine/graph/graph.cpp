@@ -18,7 +18,7 @@ std::atomic<uint32_t> gNextGraphId{1};
 
 const std::string kNoPass = "(graph)";
 
-void validateTexture(std::string_view name, const TextureDesc& d) {
+[[noreturn]] void throwInvalidTexture(std::string_view name, const TextureDesc& d) {
     std::string problem;
     if (d.width == 0 || d.height == 0 || d.depth == 0 || d.layers == 0 || d.mips == 0)
         problem = "every extent, the layer count and the mip count must be at least 1";
@@ -28,7 +28,17 @@ void validateTexture(std::string_view name, const TextureDesc& d) {
         problem = "format is VK_FORMAT_UNDEFINED";
     else if (d.mips > static_cast<uint32_t>(std::bit_width(std::max({d.width, d.height, d.depth}))))
         problem = "more mips than the extent halves to 1";
-    if (!problem.empty()) throw GraphError(ErrorKind::InvalidDescription, kNoPass, std::string(name), problem);
+    throw GraphError(ErrorKind::InvalidDescription, kNoPass, std::string(name), problem);
+}
+
+// Every texture a frame declares comes through here: the test stays free of
+// the strings that describe a failure.
+void validateTexture(std::string_view name, const TextureDesc& d) {
+    const bool valid = d.width != 0 && d.height != 0 && d.depth != 0 && d.layers != 0 && d.mips != 0 &&
+                       !(d.depth > 1 && d.layers > 1) && d.format != VK_FORMAT_UNDEFINED &&
+                       d.mips <= static_cast<uint32_t>(std::bit_width(std::max({d.width, d.height, d.depth})));
+    if (!valid) [[unlikely]]
+        throwInvalidTexture(name, d);
 }
 
 void validateBuffer(std::string_view name, const BufferDesc& d) {
@@ -40,22 +50,40 @@ bool rangesOverlap(const Subresource& a, const Subresource& b) {
            a.baseLayer < b.baseLayer + b.layerCount && b.baseLayer < a.baseLayer + a.layerCount;
 }
 
+// The kinds endPass must look at closer when a pass is not raster.
+const AccessSet kNeedsRasterKinds = [] {
+    AccessSet set = 0;
+    for (uint32_t a = 0; a < kAccessCount; ++a)
+        if (accessNeedsRaster(static_cast<Access>(a))) set |= accessBit(static_cast<Access>(a));
+    return set;
+}();
+
+// New resources are copied from this rather than value-initialised: GCC
+// clears a value-initialised Resource with `rep stos`, slow to start, and
+// declaring a frame makes thousands.
+constexpr ir::Resource kFreshResource{};
+
 VkImageLayout layoutOf(AccessSet kinds) { return accessScope(kinds, ResourceKind::Texture, Pipeline::Compute).layout; }
 
 } // namespace
 
 // ---- Names -------------------------------------------------------------------
 
+void ir::NameArena::grow(size_t size) {
+    // Chunks double (4 KiB first, 64 KiB at most): a 1024-pass frame's
+    // names take a handful.
+    constexpr size_t kFirst = 4096, kLargest = 65536;
+    capacity_ = std::max(size, chunks_.empty() ? kFirst : std::min(2 * capacity_, kLargest));
+    chunks_.push_back(std::make_unique_for_overwrite<char[]>(capacity_));
+    used_ = 0;
+}
+
+// Every pass and resource name comes through here; the rare new chunk stays
+// out of line so this stays small.
 std::string_view ir::NameArena::store(std::string_view a, std::string_view b) {
     const size_t size = a.size() + b.size();
-    if (used_ + size > capacity_) {
-        // Chunks double (4 KiB first, 64 KiB at most): a 1024-pass frame's
-        // names take a handful.
-        constexpr size_t kFirst = 4096, kLargest = 65536;
-        capacity_ = std::max(size, chunks_.empty() ? kFirst : std::min(2 * capacity_, kLargest));
-        chunks_.push_back(std::make_unique_for_overwrite<char[]>(capacity_));
-        used_ = 0;
-    }
+    if (used_ + size > capacity_) [[unlikely]]
+        grow(size);
     char* out = chunks_.back().get() + used_;
     if (!a.empty()) std::memcpy(out, a.data(), a.size());
     if (!b.empty()) std::memcpy(out + a.size(), b.data(), b.size());
@@ -139,7 +167,7 @@ void Graph::unshareDecl() { decl_ = std::make_shared<ir::Declaration>(*decl_); }
 uint32_t Graph::newResource(std::string_view name, ResourceKind kind, ir::Origin origin) {
     ir::Declaration& d = mutableDecl();
     const auto index = static_cast<uint32_t>(d.resources.size());
-    ir::Resource& r = d.resources.emplace_back();
+    ir::Resource& r = d.resources.emplace_back(kFreshResource);
     r.name = d.names.store(name);
     r.kind = kind;
     r.origin = origin;
@@ -261,7 +289,7 @@ std::pair<uint32_t, uint32_t> Graph::addHistory(std::string_view name, ResourceK
     const uint32_t previous = newResource(d.names.store(name, ".previous"), kind, ir::Origin::HistoryPrevious);
     decl_->resources[previous].contentsAtStart = true;
     const uint32_t current = previous + 1;
-    decl_->resources.emplace_back();
+    decl_->resources.emplace_back(kFreshResource);
     ir::Resource& c = decl_->resources[current];
     c.name = d.names.store(name, ".current");
     c.kind = kind;
@@ -353,6 +381,7 @@ PassId Graph::endPass(uint32_t pass) {
     if (p.pipeline != Pipeline::Raster) {
         for (uint32_t u = p.firstUse; u < end; ++u) {
             const ir::Use& use = d.uses[u];
+            if (!(use.kinds & kNeedsRasterKinds)) continue;
             for (AccessSet rest = use.kinds; rest; rest &= static_cast<AccessSet>(rest - 1)) {
                 const auto a = static_cast<Access>(std::countr_zero(rest));
                 if (accessNeedsRaster(a))
@@ -373,9 +402,12 @@ PassId Graph::endPass(uint32_t pass) {
         ir::Resource& r = d.resources[use.resource];
         r.version = use.version + 1;
         r.lastWriter = pass;
+        // Cell (m, l) is cellBase + m * layers + l (ir::cellOf). Mostly one
+        // cell: a loop here beats a call to memset.
+        const uint32_t layers = r.kind == ResourceKind::Texture ? r.texture.layers : 1u;
+        uint8_t* cells = d.written.data() + r.cellBase + use.range.baseLayer;
         for (uint32_t m = use.range.baseMip; m < use.range.baseMip + use.range.mipCount; ++m)
-            for (uint32_t l = use.range.baseLayer; l < use.range.baseLayer + use.range.layerCount; ++l)
-                d.written[ir::cellOf(r, m, l)] = 1;
+            for (uint32_t l = 0; l < use.range.layerCount; ++l) cells[m * layers + l] = 1;
     }
     return PassId{pass, d.graphId};
 }

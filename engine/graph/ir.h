@@ -32,6 +32,8 @@ public:
     std::string_view store(std::string_view a, std::string_view b = {});
 
 private:
+    void grow(size_t size); // a new chunk with room for `size`
+
     std::vector<std::unique_ptr<char[]>> chunks_;
     size_t used_ = 0;
     size_t capacity_ = 0;
