@@ -36,7 +36,8 @@ const std::string kNoPass = "(graph)";
 void validateTexture(std::string_view name, const TextureDesc& d) {
     const bool valid = d.width != 0 && d.height != 0 && d.depth != 0 && d.layers != 0 && d.mips != 0 &&
                        !(d.depth > 1 && d.layers > 1) && d.format != VK_FORMAT_UNDEFINED &&
-                       d.mips <= static_cast<uint32_t>(std::bit_width(std::max({d.width, d.height, d.depth})));
+                       // bit_width of the OR is bit_width of the largest.
+                       d.mips <= static_cast<uint32_t>(std::bit_width(d.width | d.height | d.depth));
     if (!valid) [[unlikely]]
         throwInvalidTexture(name, d);
 }
@@ -55,6 +56,23 @@ const AccessSet kNeedsRasterKinds = [] {
     AccessSet set = 0;
     for (uint32_t a = 0; a < kAccessCount; ++a)
         if (accessNeedsRaster(static_cast<Access>(a))) set |= accessBit(static_cast<Access>(a));
+    return set;
+}();
+
+// The accesses a pass may declare on a resource kind, by direction (read,
+// write): not boundary-only, allowed on the kind, writing exactly when
+// declared with write(). use() checks a use against these with one bit test.
+struct DeclarableAccesses {
+    AccessSet of[3][2] = {};
+};
+const DeclarableAccesses kDeclarable = [] {
+    DeclarableAccesses set;
+    for (uint32_t i = 0; i < kAccessCount; ++i) {
+        const auto a = static_cast<Access>(i);
+        if (accessIsBoundaryOnly(a)) continue;
+        for (uint32_t k = 0; k < 3; ++k)
+            if (accessAllowedOn(a, static_cast<ResourceKind>(k))) set.of[k][accessWrites(a) ? 1 : 0] |= accessBit(a);
+    }
     return set;
 }();
 
@@ -181,7 +199,11 @@ void Graph::finishResource(uint32_t index) {
     r.cellBase = d.cellCount;
     r.cellCount = r.kind == ResourceKind::Texture ? r.texture.mips * r.texture.layers : 1u;
     d.cellCount = r.cellBase + r.cellCount;
-    d.written.resize(d.cellCount, r.contentsAtStart ? 1 : 0);
+    // Most resources have one cell; resize() would call memset for it.
+    if (r.cellCount == 1)
+        d.written.push_back(r.contentsAtStart ? 1 : 0);
+    else
+        d.written.resize(d.cellCount, r.contentsAtStart ? 1 : 0);
 }
 
 Texture Graph::createTexture(std::string_view name, const TextureDesc& desc) {
@@ -429,12 +451,12 @@ inline uint32_t Graph::use(uint32_t pass, ResourceKind kind, uint32_t index, uin
         return useGeneral(pass, kind, index, version, graph, access, range, write);
     const ir::Resource& r = d.resources[index];
     const ir::Pass& p = d.passes[pass];
-    const detail::AccessRules& rules = detail::kAccessRules[static_cast<uint32_t>(access)];
+    const AccessSet bit = accessBit(access);
     // Bitwise, not short-circuit: every term is cheap, and one branch
-    // predicts better than eight.
-    const bool plain = (r.kind == kind) & !rules.boundaryOnly & ((rules.on >> static_cast<uint32_t>(kind)) & 1u) &
-                       (rules.writes == write) &
-                       ((p.queue == Queue::Graphics) | ((p.pipeline != Pipeline::Raster) & !rules.needsRaster)) &
+    // predicts better than six.
+    const bool plain = (r.kind == kind) & ((kDeclarable.of[static_cast<uint32_t>(kind)][write] & bit) != 0) &
+                       ((p.queue == Queue::Graphics) |
+                        ((p.pipeline != Pipeline::Raster) & ((kNeedsRasterKinds & bit) == 0))) &
                        ((r.origin != ir::Origin::Imported) | (r.hasInitial & r.hasFinal)) & (version == r.version);
     if (!plain) [[unlikely]]
         return useGeneral(pass, kind, index, version, graph, access, range, write);
@@ -457,7 +479,7 @@ inline uint32_t Graph::use(uint32_t pass, ResourceKind kind, uint32_t index, uin
         resolved = {0, 1, 0, 1};
     }
 
-    if (rules.needsContents) {
+    if (accessNeedsContents(access)) {
         // Cell (m, l) is cellBase + m * layers + l (ir::cellOf).
         const uint8_t* written = d.written.data() + r.cellBase + resolved.baseLayer;
         for (uint32_t m = resolved.baseMip; m < resolved.baseMip + resolved.mipCount; ++m)
@@ -479,7 +501,7 @@ inline uint32_t Graph::use(uint32_t pass, ResourceKind kind, uint32_t index, uin
     use.resource = index;
     use.version = version;
     use.producer = producer;
-    use.kinds = accessBit(access);
+    use.kinds = bit;
     use.writes = write;
     use.range = resolved;
     ++d.passes[pass].useCount;
