@@ -394,16 +394,16 @@ void Graph::abortPass(uint32_t pass) {
     d.written.resize(passFirstCell_);
 }
 
-PassId Graph::endPass(uint32_t pass) {
-    ir::Declaration& d = mutableDecl();
-    ir::Pass& p = d.passes[pass];
+namespace {
+
+// endPass found a use that needs a raster pipeline on a pass without one, or
+// a raster pass on the async compute queue: says which, as it always has.
+[[noreturn]] void throwPassNeedsRaster(const ir::Declaration& d, uint32_t pass) {
+    const ir::Pass& p = d.passes[pass];
     const uint32_t end = p.firstUse + p.useCount;
-    // Pipeline-dependent checks wait until setup has had its chance to call
-    // setPipeline(). (A raster pass may use anything these look for.)
     if (p.pipeline != Pipeline::Raster) {
         for (uint32_t u = p.firstUse; u < end; ++u) {
             const ir::Use& use = d.uses[u];
-            if (!(use.kinds & kNeedsRasterKinds)) continue;
             for (AccessSet rest = use.kinds; rest; rest &= static_cast<AccessSet>(rest - 1)) {
                 const auto a = static_cast<Access>(std::countr_zero(rest));
                 if (accessNeedsRaster(a))
@@ -413,23 +413,40 @@ PassId Graph::endPass(uint32_t pass) {
             }
         }
     }
-    if (!queueSupports(p.queue, Access::None, p.pipeline))
-        throw GraphError(ErrorKind::QueueCannotAccess, p.name,
-                         end > p.firstUse ? d.resources[d.uses[p.firstUse].resource].name : "",
-                         "the async compute queue has no raster pipeline");
+    throw GraphError(ErrorKind::QueueCannotAccess, p.name,
+                     end > p.firstUse ? d.resources[d.uses[p.firstUse].resource].name : "",
+                     "the async compute queue has no raster pipeline");
+}
+
+} // namespace
+
+PassId Graph::endPass(uint32_t pass) {
+    ir::Declaration& d = mutableDecl();
+    const ir::Pass& p = d.passes[pass];
+    const ir::Use* const first = d.uses.data() + p.firstUse;
+    const ir::Use* const last = first + p.useCount;
+    // Pipeline-dependent checks wait until setup has had its chance to call
+    // setPipeline(). (A raster pass may use anything these look for.) The
+    // messages are built out of line, so the loops here stay in registers.
+    AccessSet kinds = 0;
+    for (const ir::Use* use = first; use != last; ++use) kinds |= use->kinds;
+    if ((p.pipeline != Pipeline::Raster && (kinds & kNeedsRasterKinds)) ||
+        !queueSupports(p.queue, Access::None, p.pipeline)) [[unlikely]]
+        throwPassNeedsRaster(d, pass);
     // Commit: every resource this pass wrote moves to its next version.
-    for (uint32_t u = p.firstUse; u < end; ++u) {
-        const ir::Use& use = d.uses[u];
-        if (!use.writes) continue;
-        ir::Resource& r = d.resources[use.resource];
-        r.version = use.version + 1;
+    for (const ir::Use* use = first; use != last; ++use) {
+        if (!use->writes) continue;
+        ir::Resource& r = d.resources[use->resource];
+        r.version = use->version + 1;
         r.lastWriter = pass;
         // Cell (m, l) is cellBase + m * layers + l (ir::cellOf). Mostly one
-        // cell: a loop here beats a call to memset.
+        // cell: a loop here beats a call to memset. The range is copied: the
+        // byte stores below could alias it, which would reload it each time.
+        const Subresource range = use->range;
         const uint32_t layers = r.kind == ResourceKind::Texture ? r.texture.layers : 1u;
-        uint8_t* cells = d.written.data() + r.cellBase + use.range.baseLayer;
-        for (uint32_t m = use.range.baseMip; m < use.range.baseMip + use.range.mipCount; ++m)
-            for (uint32_t l = 0; l < use.range.layerCount; ++l) cells[m * layers + l] = 1;
+        uint8_t* cells = d.written.data() + r.cellBase + range.baseLayer;
+        for (uint32_t m = range.baseMip; m < range.baseMip + range.mipCount; ++m)
+            for (uint32_t l = 0; l < range.layerCount; ++l) cells[m * layers + l] = 1;
     }
     return PassId{pass, d.graphId};
 }
