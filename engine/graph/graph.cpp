@@ -118,12 +118,6 @@ ir::Declaration::Declaration(const Declaration& other)
 
 // ---- Builder -----------------------------------------------------------------
 
-Texture Builder::createTexture(std::string_view name, const TextureDesc& desc) {
-    return graph_.createTexture(name, desc);
-}
-
-Buffer Builder::createBuffer(std::string_view name, const BufferDesc& desc) { return graph_.createBuffer(name, desc); }
-
 Texture Builder::read(Texture t, Access a, Subresource range) {
     graph_.use(pass_, ResourceKind::Texture, t.index, t.version, t.graph, a, range, false);
     return t;
@@ -168,8 +162,6 @@ Graph::Graph(Graph&&) noexcept = default;
 Graph& Graph::operator=(Graph&&) noexcept = default;
 Graph::~Graph() = default;
 
-uint32_t Graph::id() const { return decl_->graphId; }
-
 void Graph::reserve(uint32_t passes, uint32_t resources, uint32_t uses) {
     ir::Declaration& d = mutableDecl();
     d.passes.reserve(passes);
@@ -206,20 +198,20 @@ void Graph::finishResource(uint32_t index) {
         d.written.resize(d.cellCount, r.contentsAtStart ? 1 : 0);
 }
 
-Texture Graph::createTexture(std::string_view name, const TextureDesc& desc) {
+uint32_t Graph::declareTexture(std::string_view name, const TextureDesc& desc) {
     validateTexture(name, desc);
     const uint32_t index = newResource(name, ResourceKind::Texture, ir::Origin::Transient);
     decl_->resources[index].texture = desc;
     finishResource(index);
-    return Texture{index, 0, id()};
+    return index;
 }
 
-Buffer Graph::createBuffer(std::string_view name, const BufferDesc& desc) {
+uint32_t Graph::declareBuffer(std::string_view name, const BufferDesc& desc) {
     validateBuffer(name, desc);
     const uint32_t index = newResource(name, ResourceKind::Buffer, ir::Origin::Transient);
     decl_->resources[index].buffer = desc;
     finishResource(index);
-    return Buffer{index, 0, id()};
+    return index;
 }
 
 namespace {
@@ -263,26 +255,26 @@ uint32_t Graph::addImport(std::string_view name, ResourceKind kind, const std::o
     return index;
 }
 
-Texture Graph::importTexture(std::string_view name, const TextureImport& import) {
+uint32_t Graph::declareTextureImport(std::string_view name, const TextureImport& import) {
     validateTexture(name, import.desc);
     const uint32_t index = addImport(name, ResourceKind::Texture, import.initial, import.final);
     decl_->resources[index].texture = import.desc;
     finishResource(index);
-    return Texture{index, 0, id()};
+    return index;
 }
 
-Buffer Graph::importBuffer(std::string_view name, const BufferImport& import) {
+uint32_t Graph::declareBufferImport(std::string_view name, const BufferImport& import) {
     validateBuffer(name, import.desc);
     const uint32_t index = addImport(name, ResourceKind::Buffer, import.initial, import.final);
     decl_->resources[index].buffer = import.desc;
     finishResource(index);
-    return Buffer{index, 0, id()};
+    return index;
 }
 
-AccelStruct Graph::importAccelStruct(std::string_view name, const AccelStructImport& import) {
+uint32_t Graph::declareAccelStructImport(std::string_view name, const AccelStructImport& import) {
     const uint32_t index = addImport(name, ResourceKind::AccelStruct, import.initial, import.final);
     finishResource(index);
-    return AccelStruct{index, 0, id()};
+    return index;
 }
 
 HistoryTexture Graph::createHistoryTexture(std::string_view name, const TextureDesc& desc) {
