@@ -148,9 +148,6 @@ AccelStruct Builder::write(AccelStruct s, Access a) {
     return s;
 }
 
-void Builder::setPipeline(Pipeline pipeline) { graph_.mutableDecl().passes[pass_].pipeline = pipeline; }
-
-void Builder::markSideEffects() { graph_.mutableDecl().passes[pass_].sideEffects = true; }
 
 // ---- Graph -------------------------------------------------------------------
 
@@ -368,7 +365,9 @@ Builder Graph::beginPass(std::string_view name, Queue queue, ExecuteFn execute) 
     p.name = d.names.store(name);
     p.queue = queue;
     p.firstUse = static_cast<uint32_t>(d.uses.size());
-    p.execute = std::move(execute);
+    // Swapped rather than move-assigned: p.execute is empty, and
+    // move-assignment goes through a temporary.
+    p.execute.swap(execute);
     passFirstResource_ = static_cast<uint32_t>(d.resources.size());
     passFirstCell_ = d.cellCount;
     return Builder(*this, static_cast<uint32_t>(d.passes.size() - 1));

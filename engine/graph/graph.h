@@ -216,6 +216,11 @@ private:
     uint32_t passFirstCell_ = 0;
 };
 
+// Once per pass; inline, they are a store.
+inline void Builder::setPipeline(Pipeline pipeline) { graph_.mutableDecl().passes[pass_].pipeline = pipeline; }
+
+inline void Builder::markSideEffects() { graph_.mutableDecl().passes[pass_].sideEffects = true; }
+
 // Inline for the same reason as Graph::createTexture.
 inline Texture Builder::createTexture(std::string_view name, const TextureDesc& desc) {
     return graph_.createTexture(name, desc);
