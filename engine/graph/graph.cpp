@@ -51,7 +51,7 @@ bool rangesOverlap(const Subresource& a, const Subresource& b) {
            a.baseLayer < b.baseLayer + b.layerCount && b.baseLayer < a.baseLayer + a.layerCount;
 }
 
-// The kinds endPass must look at closer when a pass is not raster.
+// The kinds that need a raster pipeline (attachments), as one set.
 const AccessSet kNeedsRasterKinds = [] {
     AccessSet set = 0;
     for (uint32_t a = 0; a < kAccessCount; ++a)
@@ -147,7 +147,6 @@ AccelStruct Builder::write(AccelStruct s, Access a) {
     s.version = graph_.use(pass_, ResourceKind::AccelStruct, s.index, s.version, s.graph, a, {}, true);
     return s;
 }
-
 
 // ---- Graph -------------------------------------------------------------------
 
