@@ -495,12 +495,17 @@ inline uint32_t Graph::use(uint32_t pass, ResourceKind kind, uint32_t index, uin
                     return useGeneral(pass, kind, index, version, graph, access, range, write);
     }
 
-    for (uint32_t u = p.firstUse; u < p.firstUse + p.useCount; ++u) {
-        const ir::Use& other = d.uses[u];
-        if (other.resource == index && rangesOverlap(other.range, resolved)) [[unlikely]]
-            return useGeneral(pass, kind, index, version, graph, access, range, write);
+    // Most resources are used once per pass: only one this pass has used
+    // already needs its uses searched for an overlap.
+    if (r.lastUser == pass) {
+        for (uint32_t u = p.firstUse; u < p.firstUse + p.useCount; ++u) {
+            const ir::Use& other = d.uses[u];
+            if (other.resource == index && rangesOverlap(other.range, resolved)) [[unlikely]]
+                return useGeneral(pass, kind, index, version, graph, access, range, write);
+        }
     }
 
+    d.resources[index].lastUser = pass;
     const uint32_t producer = r.lastWriter;
     // Built in place: assembling it on the stack and copying it stalls on
     // store forwarding, and this runs for every use of every pass.
@@ -600,6 +605,7 @@ uint32_t Graph::useGeneral(uint32_t pass, ResourceKind kind, uint32_t index, uin
                  " and an earlier use); a pass that reads and writes one subresource declares StorageReadWrite");
     }
 
+    d.resources[index].lastUser = pass;
     const uint32_t producer = r.lastWriter;
     // Built in place: assembling it on the stack and copying it stalls on
     // store forwarding, and this runs for every use of every pass.
