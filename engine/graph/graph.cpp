@@ -180,12 +180,14 @@ uint32_t Graph::newResource(std::string_view name, ResourceKind kind, ir::Origin
     return index;
 }
 
-// Gives a resource, once described, its cells.
-void Graph::finishResource(uint32_t index) {
+// Gives a resource, once described, its cells: mips x layers of a texture,
+// one otherwise. The caller passes the count from the description it
+// holds; read back from the resource just written, it waited on the stores.
+void Graph::finishResource(uint32_t index, uint32_t cells) {
     ir::Declaration& d = *decl_;
     ir::Resource& r = d.resources[index];
     r.cellBase = d.cellCount;
-    r.cellCount = r.kind == ResourceKind::Texture ? r.texture.mips * r.texture.layers : 1u;
+    r.cellCount = cells;
     d.cellCount = r.cellBase + r.cellCount;
     // Most resources have one cell; resize() would call memset for it.
     if (r.cellCount == 1)
@@ -198,7 +200,7 @@ uint32_t Graph::declareTexture(std::string_view name, const TextureDesc& desc) {
     validateTexture(name, desc);
     const uint32_t index = newResource(name, ResourceKind::Texture, ir::Origin::Transient);
     decl_->resources[index].texture = desc;
-    finishResource(index);
+    finishResource(index, desc.mips * desc.layers);
     return index;
 }
 
@@ -206,7 +208,7 @@ uint32_t Graph::declareBuffer(std::string_view name, const BufferDesc& desc) {
     validateBuffer(name, desc);
     const uint32_t index = newResource(name, ResourceKind::Buffer, ir::Origin::Transient);
     decl_->resources[index].buffer = desc;
-    finishResource(index);
+    finishResource(index, 1);
     return index;
 }
 
@@ -255,7 +257,7 @@ uint32_t Graph::declareTextureImport(std::string_view name, const TextureImport&
     validateTexture(name, import.desc);
     const uint32_t index = addImport(name, ResourceKind::Texture, import.initial, import.final);
     decl_->resources[index].texture = import.desc;
-    finishResource(index);
+    finishResource(index, import.desc.mips * import.desc.layers);
     return index;
 }
 
@@ -263,13 +265,13 @@ uint32_t Graph::declareBufferImport(std::string_view name, const BufferImport& i
     validateBuffer(name, import.desc);
     const uint32_t index = addImport(name, ResourceKind::Buffer, import.initial, import.final);
     decl_->resources[index].buffer = import.desc;
-    finishResource(index);
+    finishResource(index, 1);
     return index;
 }
 
 uint32_t Graph::declareAccelStructImport(std::string_view name, const AccelStructImport& import) {
     const uint32_t index = addImport(name, ResourceKind::AccelStruct, import.initial, import.final);
-    finishResource(index);
+    finishResource(index, 1);
     return index;
 }
 
@@ -278,7 +280,7 @@ HistoryTexture Graph::createHistoryTexture(std::string_view name, const TextureD
     const auto [previous, current] = addHistory(name, ResourceKind::Texture);
     for (uint32_t r : {previous, current}) {
         decl_->resources[r].texture = desc;
-        finishResource(r);
+        finishResource(r, desc.mips * desc.layers);
     }
     return {Texture{previous, 0, id()}, Texture{current, 0, id()}};
 }
@@ -288,7 +290,7 @@ HistoryBuffer Graph::createHistoryBuffer(std::string_view name, const BufferDesc
     const auto [previous, current] = addHistory(name, ResourceKind::Buffer);
     for (uint32_t r : {previous, current}) {
         decl_->resources[r].buffer = desc;
-        finishResource(r);
+        finishResource(r, 1);
     }
     return {Buffer{previous, 0, id()}, Buffer{current, 0, id()}};
 }

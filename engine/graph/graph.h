@@ -195,7 +195,7 @@ private:
     uint32_t declareBufferImport(std::string_view name, const BufferImport& import);
     uint32_t declareAccelStructImport(std::string_view name, const AccelStructImport& import);
     uint32_t newResource(std::string_view name, ResourceKind kind, ir::Origin origin);
-    void finishResource(uint32_t index);
+    void finishResource(uint32_t index, uint32_t cells);
     uint32_t addImport(std::string_view name, ResourceKind kind, const std::optional<BoundaryState>& initial,
                        const std::optional<BoundaryState>& final);
     std::pair<uint32_t, uint32_t> addHistory(std::string_view name, ResourceKind kind);
