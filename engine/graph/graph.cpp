@@ -18,7 +18,7 @@ std::atomic<uint32_t> gNextGraphId{1};
 
 const std::string kNoPass = "(graph)";
 
-void validateTexture(std::string_view name, const TextureDesc& d) {
+[[noreturn]] void throwInvalidTexture(std::string_view name, const TextureDesc& d) {
     std::string problem;
     if (d.width == 0 || d.height == 0 || d.depth == 0 || d.layers == 0 || d.mips == 0)
         problem = "every extent, the layer count and the mip count must be at least 1";
@@ -28,7 +28,18 @@ void validateTexture(std::string_view name, const TextureDesc& d) {
         problem = "format is VK_FORMAT_UNDEFINED";
     else if (d.mips > static_cast<uint32_t>(std::bit_width(std::max({d.width, d.height, d.depth}))))
         problem = "more mips than the extent halves to 1";
-    if (!problem.empty()) throw GraphError(ErrorKind::InvalidDescription, kNoPass, std::string(name), problem);
+    throw GraphError(ErrorKind::InvalidDescription, kNoPass, std::string(name), problem);
+}
+
+// Every texture a frame declares comes through here: the test stays free of
+// the strings that describe a failure.
+void validateTexture(std::string_view name, const TextureDesc& d) {
+    const bool valid = d.width != 0 && d.height != 0 && d.depth != 0 && d.layers != 0 && d.mips != 0 &&
+                       !(d.depth > 1 && d.layers > 1) && d.format != VK_FORMAT_UNDEFINED &&
+                       // bit_width of the OR is bit_width of the largest.
+                       d.mips <= static_cast<uint32_t>(std::bit_width(d.width | d.height | d.depth));
+    if (!valid) [[unlikely]]
+        throwInvalidTexture(name, d);
 }
 
 void validateBuffer(std::string_view name, const BufferDesc& d) {
@@ -40,22 +51,57 @@ bool rangesOverlap(const Subresource& a, const Subresource& b) {
            a.baseLayer < b.baseLayer + b.layerCount && b.baseLayer < a.baseLayer + a.layerCount;
 }
 
+// The kinds that need a raster pipeline (attachments), as one set.
+const AccessSet kNeedsRasterKinds = [] {
+    AccessSet set = 0;
+    for (uint32_t a = 0; a < kAccessCount; ++a)
+        if (accessNeedsRaster(static_cast<Access>(a))) set |= accessBit(static_cast<Access>(a));
+    return set;
+}();
+
+// The accesses a pass may declare on a resource kind, by direction (read,
+// write): not boundary-only, allowed on the kind, writing exactly when
+// declared with write(). use() checks a use against these with one bit test.
+struct DeclarableAccesses {
+    AccessSet of[3][2] = {};
+};
+const DeclarableAccesses kDeclarable = [] {
+    DeclarableAccesses set;
+    for (uint32_t i = 0; i < kAccessCount; ++i) {
+        const auto a = static_cast<Access>(i);
+        if (accessIsBoundaryOnly(a)) continue;
+        for (uint32_t k = 0; k < 3; ++k)
+            if (accessAllowedOn(a, static_cast<ResourceKind>(k))) set.of[k][accessWrites(a) ? 1 : 0] |= accessBit(a);
+    }
+    return set;
+}();
+
+// New resources are copied from this rather than value-initialised: GCC
+// clears a value-initialised Resource with `rep stos`, slow to start, and
+// declaring a frame makes thousands.
+constexpr ir::Resource kFreshResource{};
+
 VkImageLayout layoutOf(AccessSet kinds) { return accessScope(kinds, ResourceKind::Texture, Pipeline::Compute).layout; }
 
 } // namespace
 
 // ---- Names -------------------------------------------------------------------
 
+void ir::NameArena::grow(size_t size) {
+    // Chunks double (4 KiB first, 64 KiB at most): a 1024-pass frame's
+    // names take a handful.
+    constexpr size_t kFirst = 4096, kLargest = 65536;
+    capacity_ = std::max(size, chunks_.empty() ? kFirst : std::min(2 * capacity_, kLargest));
+    chunks_.push_back(std::make_unique_for_overwrite<char[]>(capacity_));
+    used_ = 0;
+}
+
+// Every pass and resource name comes through here; the rare new chunk stays
+// out of line so this stays small.
 std::string_view ir::NameArena::store(std::string_view a, std::string_view b) {
     const size_t size = a.size() + b.size();
-    if (used_ + size > capacity_) {
-        // Chunks double (4 KiB first, 64 KiB at most): a 1024-pass frame's
-        // names take a handful.
-        constexpr size_t kFirst = 4096, kLargest = 65536;
-        capacity_ = std::max(size, chunks_.empty() ? kFirst : std::min(2 * capacity_, kLargest));
-        chunks_.push_back(std::make_unique_for_overwrite<char[]>(capacity_));
-        used_ = 0;
-    }
+    if (used_ + size > capacity_) [[unlikely]]
+        grow(size);
     char* out = chunks_.back().get() + used_;
     if (!a.empty()) std::memcpy(out, a.data(), a.size());
     if (!b.empty()) std::memcpy(out + a.size(), b.data(), b.size());
@@ -71,12 +117,6 @@ ir::Declaration::Declaration(const Declaration& other)
 }
 
 // ---- Builder -----------------------------------------------------------------
-
-Texture Builder::createTexture(std::string_view name, const TextureDesc& desc) {
-    return graph_.createTexture(name, desc);
-}
-
-Buffer Builder::createBuffer(std::string_view name, const BufferDesc& desc) { return graph_.createBuffer(name, desc); }
 
 Texture Builder::read(Texture t, Access a, Subresource range) {
     graph_.use(pass_, ResourceKind::Texture, t.index, t.version, t.graph, a, range, false);
@@ -108,10 +148,6 @@ AccelStruct Builder::write(AccelStruct s, Access a) {
     return s;
 }
 
-void Builder::setPipeline(Pipeline pipeline) { graph_.mutableDecl().passes[pass_].pipeline = pipeline; }
-
-void Builder::markSideEffects() { graph_.mutableDecl().passes[pass_].sideEffects = true; }
-
 // ---- Graph -------------------------------------------------------------------
 
 Graph::Graph(const QueueCaps& caps) : caps_(caps), decl_(std::make_shared<ir::Declaration>()) {
@@ -121,8 +157,6 @@ Graph::Graph(const QueueCaps& caps) : caps_(caps), decl_(std::make_shared<ir::De
 Graph::Graph(Graph&&) noexcept = default;
 Graph& Graph::operator=(Graph&&) noexcept = default;
 Graph::~Graph() = default;
-
-uint32_t Graph::id() const { return decl_->graphId; }
 
 void Graph::reserve(uint32_t passes, uint32_t resources, uint32_t uses) {
     ir::Declaration& d = mutableDecl();
@@ -139,37 +173,43 @@ void Graph::unshareDecl() { decl_ = std::make_shared<ir::Declaration>(*decl_); }
 uint32_t Graph::newResource(std::string_view name, ResourceKind kind, ir::Origin origin) {
     ir::Declaration& d = mutableDecl();
     const auto index = static_cast<uint32_t>(d.resources.size());
-    ir::Resource& r = d.resources.emplace_back();
+    ir::Resource& r = d.resources.emplace_back(kFreshResource);
     r.name = d.names.store(name);
     r.kind = kind;
     r.origin = origin;
     return index;
 }
 
-// Gives a resource, once described, its cells.
-void Graph::finishResource(uint32_t index) {
+// Gives a resource, once described, its cells: mips x layers of a texture,
+// one otherwise. The caller passes the count from the description it
+// holds; read back from the resource just written, it waited on the stores.
+void Graph::finishResource(uint32_t index, uint32_t cells) {
     ir::Declaration& d = *decl_;
     ir::Resource& r = d.resources[index];
     r.cellBase = d.cellCount;
-    r.cellCount = r.kind == ResourceKind::Texture ? r.texture.mips * r.texture.layers : 1u;
+    r.cellCount = cells;
     d.cellCount = r.cellBase + r.cellCount;
-    d.written.resize(d.cellCount, r.contentsAtStart ? 1 : 0);
+    // Most resources have one cell; resize() would call memset for it.
+    if (r.cellCount == 1)
+        d.written.push_back(r.contentsAtStart ? 1 : 0);
+    else
+        d.written.resize(d.cellCount, r.contentsAtStart ? 1 : 0);
 }
 
-Texture Graph::createTexture(std::string_view name, const TextureDesc& desc) {
+uint32_t Graph::declareTexture(std::string_view name, const TextureDesc& desc) {
     validateTexture(name, desc);
     const uint32_t index = newResource(name, ResourceKind::Texture, ir::Origin::Transient);
     decl_->resources[index].texture = desc;
-    finishResource(index);
-    return Texture{index, 0, id()};
+    finishResource(index, desc.mips * desc.layers);
+    return index;
 }
 
-Buffer Graph::createBuffer(std::string_view name, const BufferDesc& desc) {
+uint32_t Graph::declareBuffer(std::string_view name, const BufferDesc& desc) {
     validateBuffer(name, desc);
     const uint32_t index = newResource(name, ResourceKind::Buffer, ir::Origin::Transient);
     decl_->resources[index].buffer = desc;
-    finishResource(index);
-    return Buffer{index, 0, id()};
+    finishResource(index, 1);
+    return index;
 }
 
 namespace {
@@ -213,26 +253,26 @@ uint32_t Graph::addImport(std::string_view name, ResourceKind kind, const std::o
     return index;
 }
 
-Texture Graph::importTexture(std::string_view name, const TextureImport& import) {
+uint32_t Graph::declareTextureImport(std::string_view name, const TextureImport& import) {
     validateTexture(name, import.desc);
     const uint32_t index = addImport(name, ResourceKind::Texture, import.initial, import.final);
     decl_->resources[index].texture = import.desc;
-    finishResource(index);
-    return Texture{index, 0, id()};
+    finishResource(index, import.desc.mips * import.desc.layers);
+    return index;
 }
 
-Buffer Graph::importBuffer(std::string_view name, const BufferImport& import) {
+uint32_t Graph::declareBufferImport(std::string_view name, const BufferImport& import) {
     validateBuffer(name, import.desc);
     const uint32_t index = addImport(name, ResourceKind::Buffer, import.initial, import.final);
     decl_->resources[index].buffer = import.desc;
-    finishResource(index);
-    return Buffer{index, 0, id()};
+    finishResource(index, 1);
+    return index;
 }
 
-AccelStruct Graph::importAccelStruct(std::string_view name, const AccelStructImport& import) {
+uint32_t Graph::declareAccelStructImport(std::string_view name, const AccelStructImport& import) {
     const uint32_t index = addImport(name, ResourceKind::AccelStruct, import.initial, import.final);
-    finishResource(index);
-    return AccelStruct{index, 0, id()};
+    finishResource(index, 1);
+    return index;
 }
 
 HistoryTexture Graph::createHistoryTexture(std::string_view name, const TextureDesc& desc) {
@@ -240,7 +280,7 @@ HistoryTexture Graph::createHistoryTexture(std::string_view name, const TextureD
     const auto [previous, current] = addHistory(name, ResourceKind::Texture);
     for (uint32_t r : {previous, current}) {
         decl_->resources[r].texture = desc;
-        finishResource(r);
+        finishResource(r, desc.mips * desc.layers);
     }
     return {Texture{previous, 0, id()}, Texture{current, 0, id()}};
 }
@@ -250,7 +290,7 @@ HistoryBuffer Graph::createHistoryBuffer(std::string_view name, const BufferDesc
     const auto [previous, current] = addHistory(name, ResourceKind::Buffer);
     for (uint32_t r : {previous, current}) {
         decl_->resources[r].buffer = desc;
-        finishResource(r);
+        finishResource(r, 1);
     }
     return {Buffer{previous, 0, id()}, Buffer{current, 0, id()}};
 }
@@ -261,7 +301,7 @@ std::pair<uint32_t, uint32_t> Graph::addHistory(std::string_view name, ResourceK
     const uint32_t previous = newResource(d.names.store(name, ".previous"), kind, ir::Origin::HistoryPrevious);
     decl_->resources[previous].contentsAtStart = true;
     const uint32_t current = previous + 1;
-    decl_->resources.emplace_back();
+    decl_->resources.emplace_back(kFreshResource);
     ir::Resource& c = decl_->resources[current];
     c.name = d.names.store(name, ".current");
     c.kind = kind;
@@ -326,7 +366,9 @@ Builder Graph::beginPass(std::string_view name, Queue queue, ExecuteFn execute) 
     p.name = d.names.store(name);
     p.queue = queue;
     p.firstUse = static_cast<uint32_t>(d.uses.size());
-    p.execute = std::move(execute);
+    // Swapped rather than move-assigned: p.execute is empty, and
+    // move-assignment goes through a temporary.
+    p.execute.swap(execute);
     passFirstResource_ = static_cast<uint32_t>(d.resources.size());
     passFirstCell_ = d.cellCount;
     return Builder(*this, static_cast<uint32_t>(d.passes.size() - 1));
@@ -344,12 +386,13 @@ void Graph::abortPass(uint32_t pass) {
     d.written.resize(passFirstCell_);
 }
 
-PassId Graph::endPass(uint32_t pass) {
-    ir::Declaration& d = mutableDecl();
-    ir::Pass& p = d.passes[pass];
+namespace {
+
+// endPass found a use that needs a raster pipeline on a pass without one, or
+// a raster pass on the async compute queue: says which, as it always has.
+[[noreturn]] void throwPassNeedsRaster(const ir::Declaration& d, uint32_t pass) {
+    const ir::Pass& p = d.passes[pass];
     const uint32_t end = p.firstUse + p.useCount;
-    // Pipeline-dependent checks wait until setup has had its chance to call
-    // setPipeline(). (A raster pass may use anything these look for.)
     if (p.pipeline != Pipeline::Raster) {
         for (uint32_t u = p.firstUse; u < end; ++u) {
             const ir::Use& use = d.uses[u];
@@ -362,26 +405,127 @@ PassId Graph::endPass(uint32_t pass) {
             }
         }
     }
-    if (!queueSupports(p.queue, Access::None, p.pipeline))
-        throw GraphError(ErrorKind::QueueCannotAccess, p.name,
-                         end > p.firstUse ? d.resources[d.uses[p.firstUse].resource].name : "",
-                         "the async compute queue has no raster pipeline");
+    throw GraphError(ErrorKind::QueueCannotAccess, p.name,
+                     end > p.firstUse ? d.resources[d.uses[p.firstUse].resource].name : "",
+                     "the async compute queue has no raster pipeline");
+}
+
+} // namespace
+
+PassId Graph::endPass(uint32_t pass) {
+    ir::Declaration& d = mutableDecl();
+    const ir::Pass& p = d.passes[pass];
+    const ir::Use* const first = d.uses.data() + p.firstUse;
+    const ir::Use* const last = first + p.useCount;
+    // Pipeline-dependent checks wait until setup has had its chance to call
+    // setPipeline(). (A raster pass may use anything these look for.) The
+    // messages are built out of line, so the loops here stay in registers.
+    AccessSet kinds = 0;
+    for (const ir::Use* use = first; use != last; ++use) kinds |= use->kinds;
+    if ((p.pipeline != Pipeline::Raster && (kinds & kNeedsRasterKinds)) ||
+        !queueSupports(p.queue, Access::None, p.pipeline)) [[unlikely]]
+        throwPassNeedsRaster(d, pass);
     // Commit: every resource this pass wrote moves to its next version.
-    for (uint32_t u = p.firstUse; u < end; ++u) {
-        const ir::Use& use = d.uses[u];
-        if (!use.writes) continue;
-        ir::Resource& r = d.resources[use.resource];
-        r.version = use.version + 1;
+    for (const ir::Use* use = first; use != last; ++use) {
+        if (!use->writes) continue;
+        ir::Resource& r = d.resources[use->resource];
+        r.version = use->version + 1;
         r.lastWriter = pass;
-        for (uint32_t m = use.range.baseMip; m < use.range.baseMip + use.range.mipCount; ++m)
-            for (uint32_t l = use.range.baseLayer; l < use.range.baseLayer + use.range.layerCount; ++l)
-                d.written[ir::cellOf(r, m, l)] = 1;
+        // Cell (m, l) is cellBase + m * layers + l (ir::cellOf). Mostly one
+        // cell: a loop here beats a call to memset. The range is copied: the
+        // byte stores below could alias it, which would reload it each time.
+        const Subresource range = use->range;
+        const uint32_t layers = r.kind == ResourceKind::Texture ? r.texture.layers : 1u;
+        uint8_t* cells = d.written.data() + r.cellBase + range.baseLayer;
+        for (uint32_t m = range.baseMip; m < range.baseMip + range.mipCount; ++m)
+            for (uint32_t l = 0; l < range.layerCount; ++l) cells[m * layers + l] = 1;
     }
     return PassId{pass, d.graphId};
 }
 
-uint32_t Graph::use(uint32_t pass, ResourceKind kind, uint32_t index, uint32_t version, uint32_t graph, Access access,
-                    Subresource range, bool write) {
+// Every use of every pass comes through here, and nearly all are the plain
+// case: a valid handle of the current version, an access the resource and
+// queue allow, a legal range, contents where needed, and no other use of
+// the same subresource in the pass. That case is checked with a few
+// comparisons and recorded; anything else -- an error, a read that merges
+// with an earlier one -- goes to useGeneral(), which decides and words the
+// errors. The fast path only ever declines: it changes nothing before
+// handing over, so useGeneral() sees the same state it always did. Inline:
+// each Builder::read/write knows its kind and direction, which folds away
+// a good part of the checks.
+inline uint32_t Graph::use(uint32_t pass, ResourceKind kind, uint32_t index, uint32_t version, uint32_t graph,
+                           Access access, Subresource range, bool write) {
+    ir::Declaration& d = mutableDecl();
+    if (graph != d.graphId || index >= d.resources.size() || access >= Access::Count) [[unlikely]]
+        return useGeneral(pass, kind, index, version, graph, access, range, write);
+    const ir::Resource& r = d.resources[index];
+    const ir::Pass& p = d.passes[pass];
+    const AccessSet bit = accessBit(access);
+    // Bitwise, not short-circuit: every term is cheap, and one branch
+    // predicts better than six.
+    const bool plain = (r.kind == kind) & ((kDeclarable.of[static_cast<uint32_t>(kind)][write] & bit) != 0) &
+                       ((p.queue == Queue::Graphics) |
+                        ((p.pipeline != Pipeline::Raster) & ((kNeedsRasterKinds & bit) == 0))) &
+                       ((r.origin != ir::Origin::Imported) | (r.hasInitial & r.hasFinal)) & (version == r.version);
+    if (!plain) [[unlikely]]
+        return useGeneral(pass, kind, index, version, graph, access, range, write);
+
+    Subresource resolved = range;
+    uint32_t layers = 1;
+    if (kind == ResourceKind::Texture) {
+        const TextureDesc& t = r.texture;
+        layers = t.layers;
+        if (resolved.mipCount == Subresource::kAll)
+            resolved.mipCount = resolved.baseMip < t.mips ? t.mips - resolved.baseMip : 0;
+        if (resolved.layerCount == Subresource::kAll)
+            resolved.layerCount = resolved.baseLayer < t.layers ? t.layers - resolved.baseLayer : 0;
+        if (resolved.mipCount == 0 || resolved.layerCount == 0 || resolved.baseMip + resolved.mipCount > t.mips ||
+            resolved.baseLayer + resolved.layerCount > t.layers) [[unlikely]]
+            return useGeneral(pass, kind, index, version, graph, access, range, write);
+    } else {
+        if (range != Subresource{}) [[unlikely]]
+            return useGeneral(pass, kind, index, version, graph, access, range, write);
+        resolved = {0, 1, 0, 1};
+    }
+
+    if (accessNeedsContents(access)) {
+        // Cell (m, l) is cellBase + m * layers + l (ir::cellOf).
+        const uint8_t* written = d.written.data() + r.cellBase + resolved.baseLayer;
+        for (uint32_t m = resolved.baseMip; m < resolved.baseMip + resolved.mipCount; ++m)
+            for (uint32_t l = 0; l < resolved.layerCount; ++l)
+                if (!written[m * layers + l]) [[unlikely]]
+                    return useGeneral(pass, kind, index, version, graph, access, range, write);
+    }
+
+    // Most resources are used once per pass: only one this pass has used
+    // already needs its uses searched for an overlap.
+    if (r.lastUser == pass) {
+        for (uint32_t u = p.firstUse; u < p.firstUse + p.useCount; ++u) {
+            const ir::Use& other = d.uses[u];
+            if (other.resource == index && rangesOverlap(other.range, resolved)) [[unlikely]]
+                return useGeneral(pass, kind, index, version, graph, access, range, write);
+        }
+    }
+
+    d.resources[index].lastUser = pass;
+    const uint32_t producer = r.lastWriter;
+    // Built in place: assembling it on the stack and copying it stalls on
+    // store forwarding, and this runs for every use of every pass.
+    ir::Use& use = d.uses.emplace_back();
+    use.resource = index;
+    use.version = version;
+    use.producer = producer;
+    use.kinds = bit;
+    use.writes = write;
+    use.range = resolved;
+    ++d.passes[pass].useCount;
+    return write ? version + 1 : version;
+}
+
+// Every case use() does not take: all the checks in order, each error in
+// words, and reads that merge into an earlier use of the pass.
+uint32_t Graph::useGeneral(uint32_t pass, ResourceKind kind, uint32_t index, uint32_t version, uint32_t graph,
+                           Access access, Subresource range, bool write) {
     ir::Declaration& d = mutableDecl();
     const std::string_view passName = d.passes[pass].name;
     const ir::Resource& r = checkHandle(kind, index, graph, passName);
@@ -463,6 +607,7 @@ uint32_t Graph::use(uint32_t pass, ResourceKind kind, uint32_t index, uint32_t v
                  " and an earlier use); a pass that reads and writes one subresource declares StorageReadWrite");
     }
 
+    d.resources[index].lastUser = pass;
     const uint32_t producer = r.lastWriter;
     // Built in place: assembling it on the stack and copying it stalls on
     // store forwarding, and this runs for every use of every pass.

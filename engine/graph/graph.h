@@ -126,11 +126,25 @@ public:
         return *data;
     }
 
-    Texture createTexture(std::string_view name, const TextureDesc& desc);
-    Buffer createBuffer(std::string_view name, const BufferDesc& desc);
-    Texture importTexture(std::string_view name, const TextureImport& import);
-    Buffer importBuffer(std::string_view name, const BufferImport& import);
-    AccelStruct importAccelStruct(std::string_view name, const AccelStructImport& import);
+    // These make the handle inline, in the caller: returned from a call,
+    // GCC assembles a 12-byte handle on the stack and reloads it as one
+    // word, a store-forwarding stall that was a third of declaring a
+    // resource.
+    Texture createTexture(std::string_view name, const TextureDesc& desc) {
+        return Texture{declareTexture(name, desc), 0, id()};
+    }
+    Buffer createBuffer(std::string_view name, const BufferDesc& desc) {
+        return Buffer{declareBuffer(name, desc), 0, id()};
+    }
+    Texture importTexture(std::string_view name, const TextureImport& import) {
+        return Texture{declareTextureImport(name, import), 0, id()};
+    }
+    Buffer importBuffer(std::string_view name, const BufferImport& import) {
+        return Buffer{declareBufferImport(name, import), 0, id()};
+    }
+    AccelStruct importAccelStruct(std::string_view name, const AccelStructImport& import) {
+        return AccelStruct{declareAccelStructImport(name, import), 0, id()};
+    }
     // A ping-pong pair, identified across frames by `name` (the executor keeps
     // its two images under that name and swaps them every frame).
     HistoryTexture createHistoryTexture(std::string_view name, const TextureDesc& desc);
@@ -154,7 +168,7 @@ public:
     Plan compile() const;
 
     const QueueCaps& caps() const { return caps_; }
-    uint32_t id() const;
+    uint32_t id() const { return decl_->graphId; }
     const ir::Declaration& declaration() const { return *decl_; }
     // Lets a caller that builds big graphs every frame keep the vectors warm.
     void reserve(uint32_t passes, uint32_t resources, uint32_t uses);
@@ -174,13 +188,21 @@ private:
         return *decl_;
     }
     void unshareDecl();
+    // The resource-making halves of createTexture() and the like: the index.
+    uint32_t declareTexture(std::string_view name, const TextureDesc& desc);
+    uint32_t declareBuffer(std::string_view name, const BufferDesc& desc);
+    uint32_t declareTextureImport(std::string_view name, const TextureImport& import);
+    uint32_t declareBufferImport(std::string_view name, const BufferImport& import);
+    uint32_t declareAccelStructImport(std::string_view name, const AccelStructImport& import);
     uint32_t newResource(std::string_view name, ResourceKind kind, ir::Origin origin);
-    void finishResource(uint32_t index);
+    void finishResource(uint32_t index, uint32_t cells);
     uint32_t addImport(std::string_view name, ResourceKind kind, const std::optional<BoundaryState>& initial,
                        const std::optional<BoundaryState>& final);
     std::pair<uint32_t, uint32_t> addHistory(std::string_view name, ResourceKind kind);
     uint32_t use(uint32_t pass, ResourceKind kind, uint32_t index, uint32_t version, uint32_t graph, Access access,
                  Subresource range, bool write);
+    uint32_t useGeneral(uint32_t pass, ResourceKind kind, uint32_t index, uint32_t version, uint32_t graph,
+                        Access access, Subresource range, bool write);
     void markOutput(ResourceKind kind, uint32_t index, uint32_t version, uint32_t graph);
     const ir::Resource& checkHandle(ResourceKind kind, uint32_t index, uint32_t graph, std::string_view pass) const;
     [[noreturn]] void throwBadHandle(ResourceKind kind, uint32_t index, uint32_t graph, std::string_view pass) const;
@@ -193,5 +215,19 @@ private:
     uint32_t passFirstResource_ = 0;
     uint32_t passFirstCell_ = 0;
 };
+
+// Once per pass; inline, they are a store.
+inline void Builder::setPipeline(Pipeline pipeline) { graph_.mutableDecl().passes[pass_].pipeline = pipeline; }
+
+inline void Builder::markSideEffects() { graph_.mutableDecl().passes[pass_].sideEffects = true; }
+
+// Inline for the same reason as Graph::createTexture.
+inline Texture Builder::createTexture(std::string_view name, const TextureDesc& desc) {
+    return graph_.createTexture(name, desc);
+}
+
+inline Buffer Builder::createBuffer(std::string_view name, const BufferDesc& desc) {
+    return graph_.createBuffer(name, desc);
+}
 
 } // namespace glint::rg

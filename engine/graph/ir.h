@@ -32,6 +32,8 @@ public:
     std::string_view store(std::string_view a, std::string_view b = {});
 
 private:
+    void grow(size_t size); // a new chunk with room for `size`
+
     std::vector<std::unique_ptr<char[]>> chunks_;
     size_t used_ = 0;
     size_t capacity_ = 0;
@@ -57,6 +59,10 @@ struct Resource {
     uint32_t version = 0;
     uint32_t lastWriter = kNoIndex;
     bool contentsAtStart = false; // imports with a defined initial state, history previous
+    // Declaration bookkeeping: the last pass that declared a use of it (or
+    // one that was declared and dropped). Only a pass whose index matches
+    // can have used it already, so only then does a use look for overlaps.
+    uint32_t lastUser = kNoIndex;
 };
 
 struct Use {
