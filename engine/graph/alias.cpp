@@ -35,6 +35,7 @@ struct Item {
     uint32_t resource;
     uint32_t first;
     uint32_t last;
+    uint32_t heap;
     uint64_t size;
     uint64_t alignment;
 };
@@ -57,11 +58,9 @@ uint64_t alignUp(uint64_t v, uint64_t a) {
 struct Scratch {
     std::vector<HeapKey> keys;
     std::vector<Item> all;          // used transients in resource order
-    std::vector<uint32_t> heapOf;   // per entry of `all`
     std::vector<Item> items;        // grouped by heap, each sorted for placement
     std::vector<uint32_t> heapBegin; // per heap: its span of `items`, then the end
     std::vector<uint32_t> count;    // counting-sort buckets
-    std::vector<uint32_t> sorted;   // indices into `all` by first use
     std::vector<uint64_t> offsets;
     std::vector<Block> free;
     std::vector<uint32_t> releaseAt, next; // per position / item: items by last use
@@ -183,8 +182,6 @@ void aliasMemory(CompileState& st) {
     std::vector<HeapKey>& keys = s.keys;
     keys.clear();
     s.all.clear();
-    s.heapOf.clear();
-    s.count.assign(positions + 1, 0);
 
     TransientDescription desc;
     for (uint32_t r = 0; r < d.resources.size(); ++r) {
@@ -212,29 +209,25 @@ void aliasMemory(CompileState& st) {
         }
         const auto h = static_cast<uint32_t>(it - keys.begin());
         out.heap = h;
-        s.all.push_back({r, life.first, life.last, alignUp(out.size, granularity), std::max(alignment, granularity)});
-        s.heapOf.push_back(h);
-        ++s.count[life.first + 1];
+        s.all.push_back({r, life.first, life.last, h, alignUp(out.size, granularity), std::max(alignment, granularity)});
     }
 
     // Placement order: by first use, larger first on ties (big resources
-    // get the low bytes), then by resource. A counting sort by first use
-    // (stable, so resource order survives within a position) and a
-    // counting sort by heap give each heap its items in first-use order;
-    // the runs sharing a first use are short and get an insertion sort.
+    // get the low bytes), then by resource. One counting sort by (heap,
+    // first use) gives each heap its items in first-use order, in resource
+    // order within a position (it is stable); the runs sharing a first use
+    // are short and get an insertion sort by size.
     const auto n = static_cast<uint32_t>(s.all.size());
-    for (uint32_t p = 0; p < positions; ++p) s.count[p + 1] += s.count[p];
-    s.sorted.resize(n);
-    for (uint32_t i = 0; i < n; ++i) s.sorted[s.count[s.all[i].first]++] = i;
     const auto heaps = static_cast<uint32_t>(keys.size());
-    s.heapBegin.assign(heaps + 1, 0);
-    for (uint32_t i = 0; i < n; ++i) ++s.heapBegin[s.heapOf[i] + 1];
-    for (uint32_t h = 0; h < heaps; ++h) s.heapBegin[h + 1] += s.heapBegin[h];
+    const uint32_t buckets = heaps * positions;
+    std::vector<uint32_t>& count = s.count;
+    count.assign(buckets + 1, 0);
+    for (const Item& item : s.all) ++count[item.heap * positions + item.first + 1];
+    for (uint32_t b = 0; b < buckets; ++b) count[b + 1] += count[b];
+    s.heapBegin.resize(heaps + 1);
+    for (uint32_t h = 0; h <= heaps; ++h) s.heapBegin[h] = count[h * positions];
     s.items.resize(n);
-    {
-        s.count.assign(s.heapBegin.begin(), s.heapBegin.end() - 1);
-        for (const uint32_t i : s.sorted) s.items[s.count[s.heapOf[i]]++] = s.all[i];
-    }
+    for (const Item& item : s.all) s.items[count[item.heap * positions + item.first]++] = item;
     for (uint32_t h = 0; h < heaps; ++h) {
         Item* const items = s.items.data() + s.heapBegin[h];
         const uint32_t size = s.heapBegin[h + 1] - s.heapBegin[h];
