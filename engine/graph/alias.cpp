@@ -35,7 +35,7 @@ struct Item {
     uint32_t resource;
     uint32_t first;
     uint32_t last;
-    uint32_t heap;
+    uint32_t heap; // index into the heap keys (fills what was padding)
     uint64_t size;
     uint64_t alignment;
 };
@@ -57,10 +57,10 @@ uint64_t alignUp(uint64_t v, uint64_t a) {
 // compile to the next (as barriers.cpp's scratch does).
 struct Scratch {
     std::vector<HeapKey> keys;
-    std::vector<Item> all;          // used transients in resource order
-    std::vector<Item> items;        // grouped by heap, each sorted for placement
+    std::vector<Item> all;           // used transients in resource order
+    std::vector<Item> items;         // grouped by heap, each sorted for placement
     std::vector<uint32_t> heapBegin; // per heap: its span of `items`, then the end
-    std::vector<uint32_t> count;    // counting-sort buckets
+    std::vector<uint32_t> count;     // counting-sort buckets
     std::vector<uint64_t> offsets;
     std::vector<Block> free;
     std::vector<uint32_t> releaseAt, next; // per position / item: items by last use
