@@ -17,7 +17,6 @@
 // for the last users of those bytes, and an alias starts from UNDEFINED.
 
 #include <algorithm>
-#include <queue>
 
 #include <spdlog/spdlog.h>
 
@@ -36,6 +35,7 @@ struct Item {
     uint32_t resource;
     uint32_t first;
     uint32_t last;
+    uint32_t heap; // index into the heap keys (fills what was padding)
     uint64_t size;
     uint64_t alignment;
 };
@@ -53,35 +53,68 @@ uint64_t alignUp(uint64_t v, uint64_t a) {
     return (v + a - 1) / a * a;
 }
 
+// compile() runs every frame: the vectors keep their storage from one
+// compile to the next (as barriers.cpp's scratch does).
+struct Scratch {
+    std::vector<HeapKey> keys;
+    std::vector<Item> all;           // used transients in resource order
+    std::vector<Item> items;         // grouped by heap, each sorted for placement
+    std::vector<uint32_t> heapBegin; // per heap: its span of `items`, then the end
+    std::vector<uint32_t> count;     // counting-sort buckets
+    std::vector<uint64_t> offsets;
+    std::vector<Block> free;
+    std::vector<uint32_t> releaseAt, next; // per position / item: items by last use
+    std::vector<uint32_t> byOffset, sortScratch;
+};
+
+Scratch& scratch() {
+    thread_local Scratch s;
+    return s;
+}
+
 // Places items (sorted by first use) into one heap; returns its size.
-uint64_t place(std::vector<Item>& items, std::vector<uint64_t>& offsets, bool alias) {
-    std::vector<Block> free; // sorted by offset, coalesced
+// `positions` bounds every first and last use.
+uint64_t place(const Item* items, uint32_t n, uint64_t* offsets, bool alias, uint32_t positions, Scratch& s) {
+    std::vector<Block>& free = s.free; // sorted by offset, coalesced
+    free.clear();
     uint64_t top = 0;
-    auto byLast = [&](uint32_t a, uint32_t b) { return items[a].last > items[b].last; };
-    std::priority_queue<uint32_t, std::vector<uint32_t>, decltype(byLast)> live(byLast);
+    // Items to release, listed by last use: after placing item i, it joins
+    // the list of its last position, and each first use releases the lists
+    // of the positions before it. Release order among them does not matter:
+    // the free list stays coalesced, so it depends only on which bytes are
+    // free.
+    if (alias) {
+        s.releaseAt.assign(positions, kNoIndex);
+        s.next.resize(n);
+    }
+    uint32_t released = 0; // positions before this one have been released
 
     auto release = [&](uint32_t i) {
-        Block b{offsets[i], items[i].size};
+        const Block b{offsets[i], items[i].size};
         auto it = std::lower_bound(free.begin(), free.end(), b.offset,
                                    [](const Block& x, uint64_t off) { return x.offset < off; });
-        it = free.insert(it, b);
-        if (it + 1 != free.end() && it->offset + it->size == (it + 1)->offset) {
-            it->size += (it + 1)->size;
-            free.erase(it + 1);
-        }
-        if (it != free.begin() && (it - 1)->offset + (it - 1)->size == it->offset) {
-            (it - 1)->size += it->size;
+        const bool joinsPrev = it != free.begin() && (it - 1)->offset + (it - 1)->size == b.offset;
+        const bool joinsNext = it != free.end() && b.offset + b.size == it->offset;
+        // Grow a neighbour in place where one touches: an insert shifts the
+        // vector's tail.
+        if (joinsPrev && joinsNext) {
+            (it - 1)->size += b.size + it->size;
             free.erase(it);
+        } else if (joinsPrev) {
+            (it - 1)->size += b.size;
+        } else if (joinsNext) {
+            it->offset = b.offset;
+            it->size += b.size;
+        } else {
+            free.insert(it, b);
         }
     };
 
-    for (uint32_t i = 0; i < items.size(); ++i) {
+    for (uint32_t i = 0; i < n; ++i) {
         const Item& item = items[i];
         if (alias) {
-            while (!live.empty() && items[live.top()].last < item.first) {
-                release(live.top());
-                live.pop();
-            }
+            for (; released < item.first; ++released)
+                for (uint32_t r = s.releaseAt[released]; r != kNoIndex; r = s.next[r]) release(r);
         }
         // Best fit: the free block that leaves the least over.
         size_t best = free.size();
@@ -99,13 +132,20 @@ uint64_t place(std::vector<Item>& items, std::vector<uint64_t>& offsets, bool al
         }
         uint64_t offset;
         if (best != free.size()) {
-            Block block = free[best];
+            const Block block = free[best];
             offset = alignUp(block.offset, item.alignment);
-            free.erase(free.begin() + static_cast<ptrdiff_t>(best));
+            // What is left of the block: the alignment gap below the item
+            // and the tail above it, each in the block's place in order.
             const uint64_t tail = block.offset + block.size - (offset + item.size);
-            if (tail) free.insert(free.begin() + static_cast<ptrdiff_t>(best), Block{offset + item.size, tail});
-            if (offset > block.offset)
-                free.insert(free.begin() + static_cast<ptrdiff_t>(best), Block{block.offset, offset - block.offset});
+            const auto at = free.begin() + static_cast<ptrdiff_t>(best);
+            if (offset > block.offset) {
+                *at = Block{block.offset, offset - block.offset};
+                if (tail) free.insert(at + 1, Block{offset + item.size, tail});
+            } else if (tail) {
+                *at = Block{offset + item.size, tail};
+            } else {
+                free.erase(at);
+            }
         } else if (!free.empty() && free.back().offset + free.back().size == top &&
                    alignUp(free.back().offset, item.alignment) + item.size > top) {
             // Grow the heap from the free block at its top instead of past it.
@@ -120,7 +160,10 @@ uint64_t place(std::vector<Item>& items, std::vector<uint64_t>& offsets, bool al
             top = offset + item.size;
         }
         offsets[i] = offset;
-        live.push(i);
+        if (alias) {
+            s.next[i] = s.releaseAt[item.last];
+            s.releaseAt[item.last] = i;
+        }
     }
     return top;
 }
@@ -131,17 +174,21 @@ void aliasMemory(CompileState& st) {
     const ir::Declaration& d = st.decl;
     Plan& plan = st.plan;
     const MemoryRequirementsFn& requirementsOf = st.options.memoryRequirements;
+    Scratch& s = scratch();
+    const uint64_t granularity = std::max<uint64_t>(st.caps.bufferImageGranularity, 1);
+    const auto positions = static_cast<uint32_t>(st.order.size());
 
     st.aliased.assign(d.resources.size(), 0);
-    std::vector<HeapKey> keys;
-    std::vector<std::vector<Item>> heapItems;
+    std::vector<HeapKey>& keys = s.keys;
+    keys.clear();
+    s.all.clear();
 
+    TransientDescription desc;
     for (uint32_t r = 0; r < d.resources.size(); ++r) {
         const ir::Resource& res = d.resources[r];
         const Lifetime& life = st.lifetimes[r];
         if (res.origin != ir::Origin::Transient || !life.used()) continue;
         PlannedResource& out = plan.resources[r];
-        TransientDescription desc;
         desc.name = res.name;
         desc.kind = res.kind;
         desc.texture = res.texture;
@@ -158,39 +205,63 @@ void aliasMemory(CompileState& st) {
         auto it = std::find(keys.begin(), keys.end(), key);
         if (it == keys.end()) {
             keys.push_back(key);
-            heapItems.emplace_back();
             it = keys.end() - 1;
         }
         const auto h = static_cast<uint32_t>(it - keys.begin());
         out.heap = h;
-        const uint64_t granularity = std::max<uint64_t>(st.caps.bufferImageGranularity, 1);
-        heapItems[h].push_back(
-            {r, life.first, life.last, alignUp(out.size, granularity), std::max(alignment, granularity)});
+        s.all.push_back({r, life.first, life.last, h, alignUp(out.size, granularity), std::max(alignment, granularity)});
     }
 
-    std::vector<uint64_t> offsets;
-    std::vector<uint32_t> byOffset, sortScratch;
-    for (uint32_t h = 0; h < keys.size(); ++h) {
-        std::vector<Item>& items = heapItems[h];
-        // Ties on first use: larger first, so big resources get the low bytes.
-        std::sort(items.begin(), items.end(), [](const Item& a, const Item& b) {
-            return a.first != b.first ? a.first < b.first
-                                      : (a.size != b.size ? a.size > b.size : a.resource < b.resource);
-        });
-        offsets.assign(items.size(), 0);
+    // Placement order: by first use, larger first on ties (big resources
+    // get the low bytes), then by resource. One counting sort by (heap,
+    // first use) gives each heap its items in first-use order, in resource
+    // order within a position (it is stable); the runs sharing a first use
+    // are short and get an insertion sort by size.
+    const auto n = static_cast<uint32_t>(s.all.size());
+    const auto heaps = static_cast<uint32_t>(keys.size());
+    const uint32_t buckets = heaps * positions;
+    std::vector<uint32_t>& count = s.count;
+    count.assign(buckets + 1, 0);
+    for (const Item& item : s.all) ++count[item.heap * positions + item.first + 1];
+    for (uint32_t b = 0; b < buckets; ++b) count[b + 1] += count[b];
+    s.heapBegin.resize(heaps + 1);
+    for (uint32_t h = 0; h <= heaps; ++h) s.heapBegin[h] = count[h * positions];
+    s.items.resize(n);
+    for (const Item& item : s.all) s.items[count[item.heap * positions + item.first]++] = item;
+    for (uint32_t h = 0; h < heaps; ++h) {
+        Item* const items = s.items.data() + s.heapBegin[h];
+        const uint32_t size = s.heapBegin[h + 1] - s.heapBegin[h];
+        for (uint32_t i = 1; i < size; ++i) {
+            if (items[i].first != items[i - 1].first || items[i].size <= items[i - 1].size) continue;
+            // Stable: equal sizes stay in resource order.
+            const Item moving = items[i];
+            uint32_t j = i;
+            for (; j > 0 && items[j - 1].first == moving.first && items[j - 1].size < moving.size; --j)
+                items[j] = items[j - 1];
+            items[j] = moving;
+        }
+    }
+
+    std::vector<uint64_t>& offsets = s.offsets;
+    std::vector<uint32_t>& byOffset = s.byOffset;
+    for (uint32_t h = 0; h < heaps; ++h) {
+        const Item* const items = s.items.data() + s.heapBegin[h];
+        const uint32_t size = s.heapBegin[h + 1] - s.heapBegin[h];
+        offsets.resize(size);
         const bool alias = st.options.aliasing && keys[h].queueOrShared != 2;
         MemoryHeap heap;
         heap.queue = keys[h].queueOrShared == 1 ? Queue::AsyncCompute : Queue::Graphics;
         heap.crossQueue = keys[h].queueOrShared == 2;
         heap.memoryTypeBits = keys[h].memoryTypeBits;
-        heap.size = place(items, offsets, alias);
-        for (const Item& item : items) {
+        heap.size = place(items, size, offsets.data(), alias, positions, s);
+        for (uint32_t i = 0; i < size; ++i) {
+            const Item& item = items[i];
             heap.alignment = std::max(heap.alignment, item.alignment);
             const bool image = d.resources[item.resource].kind == ResourceKind::Texture;
             heap.images = heap.images || image;
             heap.buffers = heap.buffers || !image;
+            plan.resources[item.resource].offset = offsets[i];
         }
-        for (uint32_t i = 0; i < items.size(); ++i) plan.resources[items[i].resource].offset = offsets[i];
         plan.heaps.push_back(heap);
         plan.stats.aliasedTransientBytes += heap.size;
 
@@ -199,9 +270,9 @@ void aliasMemory(CompileState& st) {
         // of an earlier one or the next one starts below its end.
         // (Which of several resources at one offset comes first does not
         // change the outcome: each is aliased by the other.)
-        byOffset.resize(items.size());
-        for (uint32_t i = 0; i < items.size(); ++i) byOffset[i] = i;
-        radixSort(byOffset, sortScratch, [&](uint32_t i) { return offsets[i]; });
+        byOffset.resize(size);
+        for (uint32_t i = 0; i < size; ++i) byOffset[i] = i;
+        radixSort(byOffset, s.sortScratch, [&](uint32_t i) { return offsets[i]; });
         uint64_t reach = 0;
         for (uint32_t i = 0; i < byOffset.size(); ++i) {
             const uint32_t a = byOffset[i];
@@ -211,7 +282,7 @@ void aliasMemory(CompileState& st) {
             reach = std::max(reach, end);
         }
         if (st.log)
-            for (uint32_t i = 0; i < items.size(); ++i)
+            for (uint32_t i = 0; i < size; ++i)
                 spdlog::debug("rg alias: '{}' heap {} [{}, +{}) passes {}..{}{}", d.resources[items[i].resource].name,
                               h, offsets[i], items[i].size, items[i].first, items[i].last,
                               st.aliased[items[i].resource] ? ", shares bytes" : "");

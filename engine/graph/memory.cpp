@@ -143,9 +143,19 @@ MemoryRequirements estimateMemoryRequirements(const TransientDescription& d) {
                                     std::to_string(static_cast<int>(t.format)) + " of '" + std::string(d.name) +
                                     "'; pass a MemoryRequirementsFn");
     uint64_t bytes = 0;
-    for (uint32_t m = 0; m < t.mips; ++m) {
-        const uint64_t w = std::max(1u, t.width >> m), h = std::max(1u, t.height >> m), z = std::max(1u, t.depth >> m);
-        bytes += (w + block.width - 1) / block.width * ((h + block.height - 1) / block.height) * z * block.bytes;
+    if (block.width == 1 && block.height == 1) {
+        // Uncompressed formats (nearly every transient): texels are blocks,
+        // no rounding to block extents. compile() sizes every transient
+        // every frame.
+        uint64_t texels = 0;
+        for (uint32_t m = 0; m < t.mips; ++m)
+            texels += uint64_t{std::max(1u, t.width >> m)} * std::max(1u, t.height >> m) * std::max(1u, t.depth >> m);
+        bytes = texels * block.bytes;
+    } else {
+        for (uint32_t m = 0; m < t.mips; ++m) {
+            const uint64_t w = std::max(1u, t.width >> m), h = std::max(1u, t.height >> m), z = std::max(1u, t.depth >> m);
+            bytes += (w + block.width - 1) / block.width * ((h + block.height - 1) / block.height) * z * block.bytes;
+        }
     }
     return {alignUp(bytes * t.layers, kImageAlignment), kImageAlignment, ~0u};
 }
