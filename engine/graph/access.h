@@ -162,8 +162,23 @@ inline const SyncScope& scopeOf(Access a, ResourceKind k, Pipeline p) {
 // A boundary state in masks (raw states pass through).
 SyncScope boundaryScope(const BoundaryState&, ResourceKind);
 
-VkImageUsageFlags imageUsageFor(AccessSet);
-VkBufferUsageFlags bufferUsageFor(AccessSet);
+namespace detail {
+// Usage flags of every access set, computed from the table at compile time
+// and split by byte (an AccessSet is 16 bits): the union of a set is two
+// lookups. compile() asks for every resource, so the lookup stays inline.
+struct UsageLut {
+    VkImageUsageFlags image[2][256];
+    VkBufferUsageFlags buffer[2][256];
+};
+extern const UsageLut kUsageLut;
+} // namespace detail
+
+inline VkImageUsageFlags imageUsageFor(AccessSet set) {
+    return detail::kUsageLut.image[0][set & 0xffu] | detail::kUsageLut.image[1][set >> 8];
+}
+inline VkBufferUsageFlags bufferUsageFor(AccessSet set) {
+    return detail::kUsageLut.buffer[0][set & 0xffu] | detail::kUsageLut.buffer[1][set >> 8];
+}
 
 // Write bits of an access mask (the part a later access must wait to see).
 VkAccessFlags2 writeAccessBits(VkAccessFlags2);

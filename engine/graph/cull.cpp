@@ -12,12 +12,23 @@
 #include "graph/compile_state.h"
 
 namespace glint::rg::detail {
+namespace {
+
+// The work list, kept between compiles on this thread so a frame loop does
+// not allocate it every frame.
+std::vector<uint32_t>& stackScratch() {
+    thread_local std::vector<uint32_t> stack;
+    return stack;
+}
+
+} // namespace
 
 void cull(CompileState& st) {
     const ir::Declaration& d = st.decl;
     const auto passCount = static_cast<uint32_t>(d.passes.size());
     st.alive.assign(passCount, 0);
-    std::vector<uint32_t> stack;
+    std::vector<uint32_t>& stack = stackScratch();
+    stack.clear();
     stack.reserve(passCount);
 
     auto keep = [&](uint32_t pass) {
@@ -37,7 +48,8 @@ void cull(CompileState& st) {
         const uint32_t p = stack.back();
         stack.pop_back();
         const ir::Pass& pass = d.passes[p];
-        for (uint32_t u = pass.firstUse; u < pass.firstUse + pass.useCount; ++u) keep(d.uses[u].producer);
+        const ir::Use* uses = d.uses.data() + pass.firstUse;
+        for (uint32_t u = 0; u < pass.useCount; ++u) keep(uses[u].producer);
     }
 
     for (uint32_t p = 0; p < passCount; ++p) {

@@ -14,10 +14,26 @@
 #include "graph/memory.h"
 
 namespace glint::rg::detail {
+namespace {
+
+[[noreturn]] void rayQueryUnsupported(const CompileState& st, const ir::Pass& pass) {
+    const ir::Declaration& d = st.decl;
+    const ir::Use* uses = d.uses.data() + pass.firstUse;
+    uint32_t u = 0;
+    while (!(uses[u].kinds & accessBit(Access::AccelRead))) ++u;
+    throw GraphError(ErrorKind::UnsupportedFeature, pass.name, d.resources[uses[u].resource].name,
+                     "reads an acceleration structure with a ray query, which the device does not support");
+}
+
+} // namespace
 
 void computeLifetimes(CompileState& st) {
     const ir::Declaration& d = st.decl;
     st.lifetimes.assign(d.resources.size(), Lifetime{});
+    // Reading a structure outside a ray tracing pipeline is a ray query.
+    // Checked once per pass on the union of its uses' kinds, not per use:
+    // the error names the first offending use either way.
+    const AccessSet rayQueryRead = st.caps.rayQuery ? AccessSet{0} : accessBit(Access::AccelRead);
 
     for (uint32_t pos = 0; pos < st.order.size(); ++pos) {
         const uint32_t p = st.order[pos];
@@ -27,18 +43,18 @@ void computeLifetimes(CompileState& st) {
             throw GraphError(ErrorKind::UnsupportedFeature, pass.name,
                              pass.useCount ? d.resources[d.uses[pass.firstUse].resource].name : std::string(),
                              "uses a ray tracing pipeline, which the device does not support");
-        for (uint32_t u = pass.firstUse; u < pass.firstUse + pass.useCount; ++u) {
-            const ir::Use& use = d.uses[u];
-            if ((use.kinds & accessBit(Access::AccelRead)) && pass.pipeline != Pipeline::RayTracing &&
-                !st.caps.rayQuery)
-                throw GraphError(ErrorKind::UnsupportedFeature, pass.name, d.resources[use.resource].name,
-                                 "reads an acceleration structure with a ray query, which the device does not support");
+        const ir::Use* uses = d.uses.data() + pass.firstUse;
+        AccessSet passKinds = 0;
+        for (uint32_t u = 0; u < pass.useCount; ++u) {
+            const ir::Use& use = uses[u];
             Lifetime& life = st.lifetimes[use.resource];
             if (life.first == kNoIndex) life.first = pos;
             life.last = pos;
             life.queues |= queueBit;
             life.kinds |= use.kinds;
+            passKinds |= use.kinds;
         }
+        if ((passKinds & rayQueryRead) && pass.pipeline != Pipeline::RayTracing) rayQueryUnsupported(st, pass);
     }
 
     st.plan.resources.assign(d.resources.size(), PlannedResource{});
