@@ -432,11 +432,16 @@ PassId Graph::endPass(uint32_t pass) {
         r.version = use->version + 1;
         r.lastWriter = pass;
         // Cell (m, l) is cellBase + m * layers + l (ir::cellOf). Mostly one
-        // cell: a loop here beats a call to memset. The range is copied: the
+        // cell, stored without the loops' setup; otherwise a loop still
+        // beats a call to memset. The range is copied: the
         // byte stores below could alias it, which would reload it each time.
         const Subresource range = use->range;
         const uint32_t layers = r.kind == ResourceKind::Texture ? r.texture.layers : 1u;
         uint8_t* cells = d.written.data() + r.cellBase + range.baseLayer;
+        if (range.mipCount == 1 && range.layerCount == 1) {
+            cells[range.baseMip * layers] = 1;
+            continue;
+        }
         for (uint32_t m = range.baseMip; m < range.baseMip + range.mipCount; ++m)
             for (uint32_t l = 0; l < range.layerCount; ++l) cells[m * layers + l] = 1;
     }
@@ -491,10 +496,16 @@ inline uint32_t Graph::use(uint32_t pass, ResourceKind kind, uint32_t index, uin
     if (accessNeedsContents(access)) {
         // Cell (m, l) is cellBase + m * layers + l (ir::cellOf).
         const uint8_t* written = d.written.data() + r.cellBase + resolved.baseLayer;
-        for (uint32_t m = resolved.baseMip; m < resolved.baseMip + resolved.mipCount; ++m)
-            for (uint32_t l = 0; l < resolved.layerCount; ++l)
-                if (!written[m * layers + l]) [[unlikely]]
-                    return useGeneral(pass, kind, index, version, graph, access, range, write);
+        // Most uses name one cell; the loops' setup costs more than the check.
+        if (resolved.mipCount == 1 && resolved.layerCount == 1) {
+            if (!written[resolved.baseMip * layers]) [[unlikely]]
+                return useGeneral(pass, kind, index, version, graph, access, range, write);
+        } else {
+            for (uint32_t m = resolved.baseMip; m < resolved.baseMip + resolved.mipCount; ++m)
+                for (uint32_t l = 0; l < resolved.layerCount; ++l)
+                    if (!written[m * layers + l]) [[unlikely]]
+                        return useGeneral(pass, kind, index, version, graph, access, range, write);
+        }
     }
 
     // Most resources are used once per pass: only one this pass has used
