@@ -83,11 +83,14 @@ Plan compile(const Graph& graph, const QueueCaps& caps, const CompileOptions& op
     detail::placeBarriersAndBatches(state);
 
     // Lifetimes in planned-pass indices, now that the passes have them.
-    for (uint32_t r = 0; r < plan.resources.size(); ++r) {
-        const detail::Lifetime& life = state.lifetimes[r];
+    const detail::Lifetime* const lifetimes = state.lifetimes.data();
+    const uint32_t* const plannedIndex = state.plannedIndex.data();
+    const auto resourceCount = static_cast<uint32_t>(plan.resources.size());
+    for (uint32_t r = 0; r < resourceCount; ++r) {
+        const detail::Lifetime& life = lifetimes[r];
         if (!life.used()) continue;
-        plan.resources[r].firstPass = state.plannedIndex[life.first];
-        plan.resources[r].lastPass = state.plannedIndex[life.last];
+        plan.resources[r].firstPass = plannedIndex[life.first];
+        plan.resources[r].lastPass = plannedIndex[life.last];
     }
     plan.stats.culledPasses = static_cast<uint32_t>(plan.culled.size());
 

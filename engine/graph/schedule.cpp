@@ -139,16 +139,24 @@ void schedule(CompileState& st) {
 
 void assignQueues(CompileState& st) {
     const ir::Declaration& d = st.decl;
-    st.queueOf.resize(d.passes.size());
-    for (uint32_t p = 0; p < d.passes.size(); ++p) {
-        const Queue declared = d.passes[p].queue;
-        const Queue q =
-            declared == Queue::AsyncCompute && st.caps.separateComputeFamily ? Queue::AsyncCompute : Queue::Graphics;
-        st.queueOf[p] = q;
-        if (st.alive[p]) st.queueActive[queueIndex(q)] = true;
-        if (st.log && st.alive[p] && declared != q)
-            spdlog::debug("rg queues: '{}' runs on graphics (no separate compute family)", d.passes[p].name);
+    const auto n = static_cast<uint32_t>(d.passes.size());
+    st.queueOf.resize(n);
+    // Local pointers and flags: the byte-sized stores would otherwise make
+    // the compiler reload every vector after each one.
+    Queue* const queueOf = st.queueOf.data();
+    const uint8_t* const alive = st.alive.data();
+    const bool separate = st.caps.separateComputeFamily;
+    bool active[kQueueCount] = {false, false};
+    for (uint32_t p = 0; p < n; ++p) {
+        const Queue q = d.passes[p].queue == Queue::AsyncCompute && separate ? Queue::AsyncCompute : Queue::Graphics;
+        queueOf[p] = q;
+        active[queueIndex(q)] = active[queueIndex(q)] || alive[p];
     }
+    for (uint32_t q = 0; q < kQueueCount; ++q) st.queueActive[q] = st.queueActive[q] || active[q];
+    if (!st.log) return;
+    for (uint32_t p = 0; p < n; ++p)
+        if (alive[p] && d.passes[p].queue != queueOf[p])
+            spdlog::debug("rg queues: '{}' runs on graphics (no separate compute family)", d.passes[p].name);
 }
 
 } // namespace glint::rg::detail
