@@ -35,9 +35,10 @@ void cull(CompileState& st) {
     // work list needed.
     for (uint32_t p = passCount; p-- > 0;) {
         if (!alive[p]) continue;
-        const ir::Pass& pass = d.passes[p];
-        const ir::Use* uses = d.uses.data() + pass.firstUse;
-        for (uint32_t u = 0; u < pass.useCount; ++u) alive[std::min(uses[u].producer, passCount)] = 1;
+        // The count is read once: the byte stores could alias it.
+        const ir::Use* const uses = d.uses.data() + d.passes[p].firstUse;
+        const uint32_t useCount = d.passes[p].useCount;
+        for (uint32_t u = 0; u < useCount; ++u) alive[std::min(uses[u].producer, passCount)] = 1;
     }
     st.alive.pop_back();
 
