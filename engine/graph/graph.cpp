@@ -419,10 +419,8 @@ PassId Graph::endPass(uint32_t pass) {
     const ir::Use* const last = first + p.useCount;
     // Pipeline-dependent checks wait until setup has had its chance to call
     // setPipeline(). (A raster pass may use anything these look for.) The
-    // messages are built out of line, so the loops here stay in registers.
-    AccessSet kinds = 0;
-    for (const ir::Use* use = first; use != last; ++use) kinds |= use->kinds;
-    if ((p.pipeline != Pipeline::Raster && (kinds & kNeedsRasterKinds)) ||
+    // messages are built out of line, so the loop here stays in registers.
+    if ((p.pipeline != Pipeline::Raster && (p.kinds & kNeedsRasterKinds)) ||
         !queueSupports(p.queue, Access::None, p.pipeline)) [[unlikely]]
         throwPassNeedsRaster(d, pass);
     // Commit: every resource this pass wrote moves to its next version.
@@ -529,7 +527,9 @@ inline uint32_t Graph::use(uint32_t pass, ResourceKind kind, uint32_t index, uin
     use.kinds = bit;
     use.writes = write;
     use.range = resolved;
-    ++d.passes[pass].useCount;
+    ir::Pass& owner = d.passes[pass];
+    ++owner.useCount;
+    owner.kinds |= bit;
     return write ? version + 1 : version;
 }
 
@@ -611,6 +611,7 @@ uint32_t Graph::useGeneral(uint32_t pass, ResourceKind kind, uint32_t index, uin
         const bool sameLayout = kind != ResourceKind::Texture || layoutOf(other.kinds) == layoutOf(bit);
         if (!write && !other.writes && other.range == range && sameLayout) {
             other.kinds |= bit;
+            d.passes[pass].kinds |= bit;
             return version;
         }
         fail(ErrorKind::ConflictingAccess,
@@ -629,7 +630,9 @@ uint32_t Graph::useGeneral(uint32_t pass, ResourceKind kind, uint32_t index, uin
     use.kinds = bit;
     use.writes = write;
     use.range = range;
-    ++d.passes[pass].useCount;
+    ir::Pass& owner = d.passes[pass];
+    ++owner.useCount;
+    owner.kinds |= bit;
     return write ? version + 1 : version;
 }
 
