@@ -69,6 +69,7 @@ Plan compile(const Graph& graph, const QueueCaps& caps, const CompileOptions& op
     plan.stats = {};
     plan.caps = caps;
     plan.declaration = graph.decl_;
+    graph.mayBeShared_.store(true, std::memory_order_relaxed);
     plan.stats.declaredPasses = static_cast<uint32_t>(graph.decl_->passes.size());
 
     detail::CompileState state{*graph.decl_, caps, options, plan};

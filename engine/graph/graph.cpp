@@ -154,8 +154,18 @@ Graph::Graph(const QueueCaps& caps) : caps_(caps), decl_(std::make_shared<ir::De
     decl_->graphId = gNextGraphId.fetch_add(1, std::memory_order_relaxed);
 }
 
-Graph::Graph(Graph&&) noexcept = default;
-Graph& Graph::operator=(Graph&&) noexcept = default;
+Graph::Graph(Graph&& other) noexcept
+    : caps_(other.caps_), decl_(std::move(other.decl_)), passFirstResource_(other.passFirstResource_),
+      passFirstCell_(other.passFirstCell_), mayBeShared_(other.mayBeShared_.load(std::memory_order_relaxed)) {}
+
+Graph& Graph::operator=(Graph&& other) noexcept {
+    caps_ = other.caps_;
+    decl_ = std::move(other.decl_);
+    passFirstResource_ = other.passFirstResource_;
+    passFirstCell_ = other.passFirstCell_;
+    mayBeShared_.store(other.mayBeShared_.load(std::memory_order_relaxed), std::memory_order_relaxed);
+    return *this;
+}
 Graph::~Graph() = default;
 
 void Graph::reserve(uint32_t passes, uint32_t resources, uint32_t uses) {
@@ -166,7 +176,10 @@ void Graph::reserve(uint32_t passes, uint32_t resources, uint32_t uses) {
     d.written.reserve(resources);
 }
 
-void Graph::unshareDecl() { decl_ = std::make_shared<ir::Declaration>(*decl_); }
+void Graph::unshareDecl() {
+    if (decl_.use_count() > 1) decl_ = std::make_shared<ir::Declaration>(*decl_);
+    mayBeShared_.store(false, std::memory_order_relaxed);
+}
 
 // Resources are built in place: moving a Resource into the vector costs
 // more than everything else declaring it does.
