@@ -285,8 +285,6 @@ constexpr ScopeLut kScopeLut = makeScopeLut();
 constexpr UsageLut kUsageLut = makeUsageLut();
 } // namespace detail
 
-SyncScope accessScope(Access a, ResourceKind k, Pipeline p) { return scopeOf(a, k, p); }
-
 SyncScope accessScope(AccessSet set, ResourceKind k, Pipeline p) {
     SyncScope merged;
     for (AccessSet rest = set; rest; rest &= static_cast<AccessSet>(rest - 1)) {
@@ -296,15 +294,6 @@ SyncScope accessScope(AccessSet set, ResourceKind k, Pipeline p) {
         merged.layout = one.layout;
     }
     return merged;
-}
-
-SyncScope boundaryScope(const BoundaryState& b, ResourceKind k) {
-    if (b.isRaw) {
-        SyncScope s = b.rawScope;
-        if (k != ResourceKind::Texture) s.layout = VK_IMAGE_LAYOUT_UNDEFINED;
-        return s;
-    }
-    return accessScope(b.access, k, b.pipeline);
 }
 
 VkAccessFlags2 writeAccessBits(VkAccessFlags2 access) { return access & kWriteBits; }

@@ -140,9 +140,6 @@ inline bool queueSupports(Queue q, Access a, Pipeline p) {
     return q == Queue::Graphics || (p != Pipeline::Raster && !accessNeedsRaster(a));
 }
 
-// Stage/access/layout of one kind used on one resource kind from one
-// pipeline. Layout is VK_IMAGE_LAYOUT_UNDEFINED for buffers and structures.
-SyncScope accessScope(Access, ResourceKind, Pipeline);
 // Union over a set of kinds (they share one layout; Builder guarantees it).
 SyncScope accessScope(AccessSet, ResourceKind, Pipeline);
 
@@ -159,8 +156,20 @@ extern const ScopeLut kScopeLut;
 inline const SyncScope& scopeOf(Access a, ResourceKind k, Pipeline p) {
     return detail::kScopeLut.scope[static_cast<uint32_t>(a)][static_cast<uint32_t>(k)][static_cast<uint32_t>(p)];
 }
-// A boundary state in masks (raw states pass through).
-SyncScope boundaryScope(const BoundaryState&, ResourceKind);
+// Stage/access/layout of one kind used on one resource kind from one
+// pipeline. Layout is VK_IMAGE_LAYOUT_UNDEFINED for buffers and structures.
+inline SyncScope accessScope(Access a, ResourceKind k, Pipeline p) { return scopeOf(a, k, p); }
+
+// A boundary state in masks (raw states pass through). Inline: declaring
+// an import and finishing the frame ask for every import's states.
+inline SyncScope boundaryScope(const BoundaryState& b, ResourceKind k) {
+    if (b.isRaw) {
+        SyncScope s = b.rawScope;
+        if (k != ResourceKind::Texture) s.layout = VK_IMAGE_LAYOUT_UNDEFINED;
+        return s;
+    }
+    return scopeOf(b.access, k, b.pipeline);
+}
 
 namespace detail {
 // Usage flags of every access set, computed from the table at compile time
