@@ -196,7 +196,8 @@ uint32_t Graph::newResource(std::string_view name, ResourceKind kind, ir::Origin
 // Gives a resource, once described, its cells: mips x layers of a texture,
 // one otherwise. The caller passes the count from the description it
 // holds; read back from the resource just written, it waited on the stores.
-void Graph::finishResource(uint32_t index, uint32_t cells) {
+// Inline (only this file calls it): a call cost about as much as its work.
+inline void Graph::finishResource(uint32_t index, uint32_t cells) {
     ir::Declaration& d = *decl_;
     ir::Resource& r = d.resources[index];
     r.cellBase = d.cellCount;
