@@ -214,6 +214,19 @@ constexpr detail::ScopeLut makeScopeLut() {
     return lut;
 }
 
+constexpr detail::UsageLut makeUsageLut() {
+    detail::UsageLut lut{};
+    for (uint32_t half = 0; half < 2; ++half)
+        for (uint32_t bits = 0; bits < 256; ++bits)
+            for (uint32_t b = 0; b < 8; ++b) {
+                const uint32_t a = half * 8 + b;
+                if (!(bits & (1u << b)) || a >= kAccessCount) continue;
+                lut.image[half][bits] |= kTable[a].imageUsage;
+                lut.buffer[half][bits] |= kTable[a].bufferUsage;
+            }
+    return lut;
+}
+
 static_assert(row(Access::StorageReadWrite).name == "StorageReadWrite" && row(Access::AccelRead).name == "AccelRead" &&
                   row(Access::Present).name == "Present",
               "table rows follow the Access enum");
@@ -269,9 +282,8 @@ constexpr AccessRules kAccessRules[kAccessCount] = {
 static_assert(kAccessCount == 15, "kAccessRules lists every row");
 
 constexpr ScopeLut kScopeLut = makeScopeLut();
+constexpr UsageLut kUsageLut = makeUsageLut();
 } // namespace detail
-
-SyncScope accessScope(Access a, ResourceKind k, Pipeline p) { return scopeOf(a, k, p); }
 
 SyncScope accessScope(AccessSet set, ResourceKind k, Pipeline p) {
     SyncScope merged;
@@ -282,29 +294,6 @@ SyncScope accessScope(AccessSet set, ResourceKind k, Pipeline p) {
         merged.layout = one.layout;
     }
     return merged;
-}
-
-SyncScope boundaryScope(const BoundaryState& b, ResourceKind k) {
-    if (b.isRaw) {
-        SyncScope s = b.rawScope;
-        if (k != ResourceKind::Texture) s.layout = VK_IMAGE_LAYOUT_UNDEFINED;
-        return s;
-    }
-    return accessScope(b.access, k, b.pipeline);
-}
-
-VkImageUsageFlags imageUsageFor(AccessSet set) {
-    VkImageUsageFlags usage = 0;
-    for (AccessSet rest = set; rest; rest &= static_cast<AccessSet>(rest - 1))
-        usage |= kTable[std::countr_zero(rest)].imageUsage;
-    return usage;
-}
-
-VkBufferUsageFlags bufferUsageFor(AccessSet set) {
-    VkBufferUsageFlags usage = 0;
-    for (AccessSet rest = set; rest; rest &= static_cast<AccessSet>(rest - 1))
-        usage |= kTable[std::countr_zero(rest)].bufferUsage;
-    return usage;
 }
 
 VkAccessFlags2 writeAccessBits(VkAccessFlags2 access) { return access & kWriteBits; }

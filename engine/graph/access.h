@@ -140,9 +140,6 @@ inline bool queueSupports(Queue q, Access a, Pipeline p) {
     return q == Queue::Graphics || (p != Pipeline::Raster && !accessNeedsRaster(a));
 }
 
-// Stage/access/layout of one kind used on one resource kind from one
-// pipeline. Layout is VK_IMAGE_LAYOUT_UNDEFINED for buffers and structures.
-SyncScope accessScope(Access, ResourceKind, Pipeline);
 // Union over a set of kinds (they share one layout; Builder guarantees it).
 SyncScope accessScope(AccessSet, ResourceKind, Pipeline);
 
@@ -159,11 +156,38 @@ extern const ScopeLut kScopeLut;
 inline const SyncScope& scopeOf(Access a, ResourceKind k, Pipeline p) {
     return detail::kScopeLut.scope[static_cast<uint32_t>(a)][static_cast<uint32_t>(k)][static_cast<uint32_t>(p)];
 }
-// A boundary state in masks (raw states pass through).
-SyncScope boundaryScope(const BoundaryState&, ResourceKind);
+// Stage/access/layout of one kind used on one resource kind from one
+// pipeline. Layout is VK_IMAGE_LAYOUT_UNDEFINED for buffers and structures.
+inline SyncScope accessScope(Access a, ResourceKind k, Pipeline p) { return scopeOf(a, k, p); }
 
-VkImageUsageFlags imageUsageFor(AccessSet);
-VkBufferUsageFlags bufferUsageFor(AccessSet);
+// A boundary state in masks (raw states pass through). Inline: declaring
+// an import and finishing the frame ask for every import's states.
+inline SyncScope boundaryScope(const BoundaryState& b, ResourceKind k) {
+    if (b.isRaw) {
+        SyncScope s = b.rawScope;
+        if (k != ResourceKind::Texture) s.layout = VK_IMAGE_LAYOUT_UNDEFINED;
+        return s;
+    }
+    return scopeOf(b.access, k, b.pipeline);
+}
+
+namespace detail {
+// Usage flags of every access set, computed from the table at compile time
+// and split by byte (an AccessSet is 16 bits): the union of a set is two
+// lookups. compile() asks for every resource, so the lookup stays inline.
+struct UsageLut {
+    VkImageUsageFlags image[2][256];
+    VkBufferUsageFlags buffer[2][256];
+};
+extern const UsageLut kUsageLut;
+} // namespace detail
+
+inline VkImageUsageFlags imageUsageFor(AccessSet set) {
+    return detail::kUsageLut.image[0][set & 0xffu] | detail::kUsageLut.image[1][set >> 8];
+}
+inline VkBufferUsageFlags bufferUsageFor(AccessSet set) {
+    return detail::kUsageLut.buffer[0][set & 0xffu] | detail::kUsageLut.buffer[1][set >> 8];
+}
 
 // Write bits of an access mask (the part a later access must wait to see).
 VkAccessFlags2 writeAccessBits(VkAccessFlags2);

@@ -6,6 +6,55 @@
 #include "graph/graph.h"
 
 namespace glint::rg {
+namespace {
+
+// The phases' per-pass and per-resource vectors, kept from one compile to
+// the next on this thread: a frame loop compiles every frame, and
+// allocating them afresh each time cost more than most phases' work. Every
+// phase sizes what it uses with assign()/clear(), so nothing stale leaks
+// from the previous compile.
+struct Scratch {
+    std::vector<uint8_t> alive;
+    std::vector<uint32_t> order;
+    std::vector<uint32_t> position;
+    std::vector<Queue> queueOf;
+    std::vector<detail::Lifetime> lifetimes;
+    std::vector<uint8_t> aliased;
+    std::vector<uint32_t> barrierFirst;
+    std::vector<uint32_t> barrierCount;
+    std::vector<uint32_t> plannedIndex;
+};
+
+void swapVectors(Scratch& s, detail::CompileState& st) {
+    s.alive.swap(st.alive);
+    s.order.swap(st.order);
+    s.position.swap(st.position);
+    s.queueOf.swap(st.queueOf);
+    s.lifetimes.swap(st.lifetimes);
+    s.aliased.swap(st.aliased);
+    s.barrierFirst.swap(st.barrierFirst);
+    s.barrierCount.swap(st.barrierCount);
+    s.plannedIndex.swap(st.plannedIndex);
+}
+
+// Lends the scratch vectors to a CompileState for one compile and takes
+// them back afterwards, also when a phase throws.
+class LentScratch {
+public:
+    explicit LentScratch(detail::CompileState& st) : st_(st) { swapVectors(scratch(), st_); }
+    ~LentScratch() { swapVectors(scratch(), st_); }
+    LentScratch(const LentScratch&) = delete;
+    LentScratch& operator=(const LentScratch&) = delete;
+
+private:
+    static Scratch& scratch() {
+        thread_local Scratch s;
+        return s;
+    }
+    detail::CompileState& st_;
+};
+
+} // namespace
 
 Plan compile(const Graph& graph, const QueueCaps& caps, const CompileOptions& options, Plan&& recycled) {
     Plan plan = std::move(recycled);
@@ -20,10 +69,12 @@ Plan compile(const Graph& graph, const QueueCaps& caps, const CompileOptions& op
     plan.stats = {};
     plan.caps = caps;
     plan.declaration = graph.decl_;
+    graph.mayBeShared_.store(true, std::memory_order_relaxed);
     plan.stats.declaredPasses = static_cast<uint32_t>(graph.decl_->passes.size());
 
     detail::CompileState state{*graph.decl_, caps, options, plan};
     state.log = spdlog::should_log(spdlog::level::debug);
+    const LentScratch lent(state);
 
     detail::cull(state);
     detail::schedule(state);
@@ -33,11 +84,14 @@ Plan compile(const Graph& graph, const QueueCaps& caps, const CompileOptions& op
     detail::placeBarriersAndBatches(state);
 
     // Lifetimes in planned-pass indices, now that the passes have them.
-    for (uint32_t r = 0; r < plan.resources.size(); ++r) {
-        const detail::Lifetime& life = state.lifetimes[r];
+    const detail::Lifetime* const lifetimes = state.lifetimes.data();
+    const uint32_t* const plannedIndex = state.plannedIndex.data();
+    const auto resourceCount = static_cast<uint32_t>(plan.resources.size());
+    for (uint32_t r = 0; r < resourceCount; ++r) {
+        const detail::Lifetime& life = lifetimes[r];
         if (!life.used()) continue;
-        plan.resources[r].firstPass = state.plannedIndex[life.first];
-        plan.resources[r].lastPass = state.plannedIndex[life.last];
+        plan.resources[r].firstPass = plannedIndex[life.first];
+        plan.resources[r].lastPass = plannedIndex[life.last];
     }
     plan.stats.culledPasses = static_cast<uint32_t>(plan.culled.size());
 

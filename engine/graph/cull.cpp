@@ -7,6 +7,8 @@
 // overwrites: storage writes and attachment loads keep whatever they do not
 // touch, so the earlier writer stays.
 
+#include <algorithm>
+
 #include <spdlog/spdlog.h>
 
 #include "graph/compile_state.h"
@@ -16,32 +18,32 @@ namespace glint::rg::detail {
 void cull(CompileState& st) {
     const ir::Declaration& d = st.decl;
     const auto passCount = static_cast<uint32_t>(d.passes.size());
-    st.alive.assign(passCount, 0);
-    std::vector<uint32_t> stack;
-    stack.reserve(passCount);
+    // One slot past the passes absorbs "no producer" (kNoIndex), so marking
+    // a producer needs no branch: std::min sends kNoIndex there.
+    st.alive.assign(passCount + 1, 0);
+    uint8_t* const alive = st.alive.data();
 
-    auto keep = [&](uint32_t pass) {
-        if (pass != kNoIndex && !st.alive[pass]) {
-            st.alive[pass] = 1;
-            stack.push_back(pass);
-        }
-    };
-
-    for (uint32_t p = 0; p < passCount; ++p)
-        if (d.passes[p].sideEffects) keep(p);
-    for (const ir::Output& o : d.outputs) keep(o.producer);
+    for (uint32_t p = 0; p < passCount; ++p) alive[p] = d.passes[p].sideEffects ? 1 : 0;
+    for (const ir::Output& o : d.outputs) alive[std::min(o.producer, passCount)] = 1;
     for (const ir::Resource& r : d.resources)
-        if (r.origin == ir::Origin::Imported || r.origin == ir::Origin::HistoryCurrent) keep(r.lastWriter);
+        if (r.origin == ir::Origin::Imported || r.origin == ir::Origin::HistoryCurrent)
+            alive[std::min(r.lastWriter, passCount)] = 1;
 
-    while (!stack.empty()) {
-        const uint32_t p = stack.back();
-        stack.pop_back();
-        const ir::Pass& pass = d.passes[p];
-        for (uint32_t u = pass.firstUse; u < pass.firstUse + pass.useCount; ++u) keep(d.uses[u].producer);
+    // A use's producer was declared before the pass using it (a version
+    // exists only once its writer's setup has ended), so one sweep from the
+    // last pass back reaches every pass after everything that uses it: no
+    // work list needed.
+    for (uint32_t p = passCount; p-- > 0;) {
+        if (!alive[p]) continue;
+        // The count is read once: the byte stores could alias it.
+        const ir::Use* const uses = d.uses.data() + d.passes[p].firstUse;
+        const uint32_t useCount = d.passes[p].useCount;
+        for (uint32_t u = 0; u < useCount; ++u) alive[std::min(uses[u].producer, passCount)] = 1;
     }
+    st.alive.pop_back();
 
     for (uint32_t p = 0; p < passCount; ++p) {
-        if (st.alive[p]) continue;
+        if (alive[p]) continue;
         st.plan.culled.push_back(p);
         if (st.log) spdlog::debug("rg cull: '{}' (nothing observable depends on it)", d.passes[p].name);
     }

@@ -154,8 +154,18 @@ Graph::Graph(const QueueCaps& caps) : caps_(caps), decl_(std::make_shared<ir::De
     decl_->graphId = gNextGraphId.fetch_add(1, std::memory_order_relaxed);
 }
 
-Graph::Graph(Graph&&) noexcept = default;
-Graph& Graph::operator=(Graph&&) noexcept = default;
+Graph::Graph(Graph&& other) noexcept
+    : caps_(other.caps_), decl_(std::move(other.decl_)), passFirstResource_(other.passFirstResource_),
+      passFirstCell_(other.passFirstCell_), mayBeShared_(other.mayBeShared_.load(std::memory_order_relaxed)) {}
+
+Graph& Graph::operator=(Graph&& other) noexcept {
+    caps_ = other.caps_;
+    decl_ = std::move(other.decl_);
+    passFirstResource_ = other.passFirstResource_;
+    passFirstCell_ = other.passFirstCell_;
+    mayBeShared_.store(other.mayBeShared_.load(std::memory_order_relaxed), std::memory_order_relaxed);
+    return *this;
+}
 Graph::~Graph() = default;
 
 void Graph::reserve(uint32_t passes, uint32_t resources, uint32_t uses) {
@@ -166,7 +176,10 @@ void Graph::reserve(uint32_t passes, uint32_t resources, uint32_t uses) {
     d.written.reserve(resources);
 }
 
-void Graph::unshareDecl() { decl_ = std::make_shared<ir::Declaration>(*decl_); }
+void Graph::unshareDecl() {
+    if (decl_.use_count() > 1) decl_ = std::make_shared<ir::Declaration>(*decl_);
+    mayBeShared_.store(false, std::memory_order_relaxed);
+}
 
 // Resources are built in place: moving a Resource into the vector costs
 // more than everything else declaring it does.
@@ -183,7 +196,8 @@ uint32_t Graph::newResource(std::string_view name, ResourceKind kind, ir::Origin
 // Gives a resource, once described, its cells: mips x layers of a texture,
 // one otherwise. The caller passes the count from the description it
 // holds; read back from the resource just written, it waited on the stores.
-void Graph::finishResource(uint32_t index, uint32_t cells) {
+// Inline (only this file calls it): a call cost about as much as its work.
+inline void Graph::finishResource(uint32_t index, uint32_t cells) {
     ir::Declaration& d = *decl_;
     ir::Resource& r = d.resources[index];
     r.cellBase = d.cellCount;
@@ -419,10 +433,8 @@ PassId Graph::endPass(uint32_t pass) {
     const ir::Use* const last = first + p.useCount;
     // Pipeline-dependent checks wait until setup has had its chance to call
     // setPipeline(). (A raster pass may use anything these look for.) The
-    // messages are built out of line, so the loops here stay in registers.
-    AccessSet kinds = 0;
-    for (const ir::Use* use = first; use != last; ++use) kinds |= use->kinds;
-    if ((p.pipeline != Pipeline::Raster && (kinds & kNeedsRasterKinds)) ||
+    // messages are built out of line, so the loop here stays in registers.
+    if ((p.pipeline != Pipeline::Raster && (p.kinds & kNeedsRasterKinds)) ||
         !queueSupports(p.queue, Access::None, p.pipeline)) [[unlikely]]
         throwPassNeedsRaster(d, pass);
     // Commit: every resource this pass wrote moves to its next version.
@@ -432,11 +444,16 @@ PassId Graph::endPass(uint32_t pass) {
         r.version = use->version + 1;
         r.lastWriter = pass;
         // Cell (m, l) is cellBase + m * layers + l (ir::cellOf). Mostly one
-        // cell: a loop here beats a call to memset. The range is copied: the
+        // cell, stored without the loops' setup; otherwise a loop still
+        // beats a call to memset. The range is copied: the
         // byte stores below could alias it, which would reload it each time.
         const Subresource range = use->range;
         const uint32_t layers = r.kind == ResourceKind::Texture ? r.texture.layers : 1u;
         uint8_t* cells = d.written.data() + r.cellBase + range.baseLayer;
+        if (range.mipCount == 1 && range.layerCount == 1) {
+            cells[range.baseMip * layers] = 1;
+            continue;
+        }
         for (uint32_t m = range.baseMip; m < range.baseMip + range.mipCount; ++m)
             for (uint32_t l = 0; l < range.layerCount; ++l) cells[m * layers + l] = 1;
     }
@@ -491,10 +508,16 @@ inline uint32_t Graph::use(uint32_t pass, ResourceKind kind, uint32_t index, uin
     if (accessNeedsContents(access)) {
         // Cell (m, l) is cellBase + m * layers + l (ir::cellOf).
         const uint8_t* written = d.written.data() + r.cellBase + resolved.baseLayer;
-        for (uint32_t m = resolved.baseMip; m < resolved.baseMip + resolved.mipCount; ++m)
-            for (uint32_t l = 0; l < resolved.layerCount; ++l)
-                if (!written[m * layers + l]) [[unlikely]]
-                    return useGeneral(pass, kind, index, version, graph, access, range, write);
+        // Most uses name one cell; the loops' setup costs more than the check.
+        if (resolved.mipCount == 1 && resolved.layerCount == 1) {
+            if (!written[resolved.baseMip * layers]) [[unlikely]]
+                return useGeneral(pass, kind, index, version, graph, access, range, write);
+        } else {
+            for (uint32_t m = resolved.baseMip; m < resolved.baseMip + resolved.mipCount; ++m)
+                for (uint32_t l = 0; l < resolved.layerCount; ++l)
+                    if (!written[m * layers + l]) [[unlikely]]
+                        return useGeneral(pass, kind, index, version, graph, access, range, write);
+        }
     }
 
     // Most resources are used once per pass: only one this pass has used
@@ -518,7 +541,9 @@ inline uint32_t Graph::use(uint32_t pass, ResourceKind kind, uint32_t index, uin
     use.kinds = bit;
     use.writes = write;
     use.range = resolved;
-    ++d.passes[pass].useCount;
+    ir::Pass& owner = d.passes[pass];
+    ++owner.useCount;
+    owner.kinds |= bit;
     return write ? version + 1 : version;
 }
 
@@ -600,6 +625,7 @@ uint32_t Graph::useGeneral(uint32_t pass, ResourceKind kind, uint32_t index, uin
         const bool sameLayout = kind != ResourceKind::Texture || layoutOf(other.kinds) == layoutOf(bit);
         if (!write && !other.writes && other.range == range && sameLayout) {
             other.kinds |= bit;
+            d.passes[pass].kinds |= bit;
             return version;
         }
         fail(ErrorKind::ConflictingAccess,
@@ -618,7 +644,9 @@ uint32_t Graph::useGeneral(uint32_t pass, ResourceKind kind, uint32_t index, uin
     use.kinds = bit;
     use.writes = write;
     use.range = range;
-    ++d.passes[pass].useCount;
+    ir::Pass& owner = d.passes[pass];
+    ++owner.useCount;
+    owner.kinds |= bit;
     return write ? version + 1 : version;
 }
 

@@ -27,6 +27,7 @@
 // ownership-transfer barrier pairs are needed. Imports used on both queues
 // must have been created that way by their owner.
 
+#include <atomic>
 #include <cstdint>
 #include <memory>
 #include <optional>
@@ -182,9 +183,12 @@ private:
     PassId endPass(uint32_t pass);
 
     // A compiled Plan shares the declaration; the first change after a
-    // compile copies it so the plan's view stays frozen.
+    // compile copies it so the plan's view stays frozen. Only compile()
+    // shares it, and it raises mayBeShared_: every use declared asks, and
+    // one flag is cheaper to read than the shared count.
     ir::Declaration& mutableDecl() {
-        if (decl_.use_count() > 1) unshareDecl();
+        if (mayBeShared_.load(std::memory_order_relaxed)) [[unlikely]]
+            unshareDecl();
         return *decl_;
     }
     void unshareDecl();
@@ -214,6 +218,9 @@ private:
     // Resources created by the pass being declared, for rollback.
     uint32_t passFirstResource_ = 0;
     uint32_t passFirstCell_ = 0;
+    // Set by compile() (a const operation, hence atomic), cleared by
+    // unshareDecl(): whether a Plan may share decl_.
+    mutable std::atomic<bool> mayBeShared_{false};
 };
 
 // Once per pass; inline, they are a store.

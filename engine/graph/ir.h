@@ -79,6 +79,9 @@ struct Pass {
     Queue queue = Queue::Graphics; // as declared; compile() maps it to a family
     Pipeline pipeline = Pipeline::Compute;
     bool sideEffects = false;
+    // Declaration bookkeeping: every access kind its uses take, so endPass
+    // checks the pipeline without walking the uses again.
+    AccessSet kinds = 0;
     uint32_t firstUse = 0;
     uint32_t useCount = 0;
     ExecuteFn execute;

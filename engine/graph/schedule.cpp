@@ -66,81 +66,97 @@ struct Edge {
 void schedule(CompileState& st) {
     const ir::Declaration& d = st.decl;
     const auto n = static_cast<uint32_t>(d.passes.size());
-    st.order.clear();
-    st.order.reserve(n);
-    st.position.assign(n, kNoIndex);
-
     bool backwards = false;
     for (const ir::Ordering& o : d.orderings)
         if (st.alive[o.before] && st.alive[o.after] && o.before >= o.after) backwards = true;
 
     if (!backwards) {
-        for (uint32_t p = 0; p < n; ++p)
-            if (st.alive[p]) st.order.push_back(p);
-    } else {
-        std::vector<Edge> edges;
-        // Readers of each resource's current version, for write-after-read edges.
-        std::vector<std::vector<uint32_t>> readers(d.resources.size());
+        // Declaration order: one pass writes both the order and the
+        // positions, without a branch per pass (culling is data-dependent).
+        st.order.resize(n);
+        st.position.resize(n);
+        uint32_t count = 0;
         for (uint32_t p = 0; p < n; ++p) {
-            if (!st.alive[p]) continue;
-            const ir::Pass& pass = d.passes[p];
-            for (uint32_t u = pass.firstUse; u < pass.firstUse + pass.useCount; ++u) {
-                const ir::Use& use = d.uses[u];
-                if (use.producer != kNoIndex) edges.push_back({use.producer, p, use.resource});
-                if (use.writes) {
-                    for (uint32_t reader : readers[use.resource])
-                        if (reader != p) edges.push_back({reader, p, use.resource});
-                }
-            }
-            // Readers are recorded after the pass's own writes so a pass that
-            // reads one mip and writes another is not its own predecessor.
-            for (uint32_t u = pass.firstUse; u < pass.firstUse + pass.useCount; ++u) {
-                const ir::Use& use = d.uses[u];
-                if (use.writes)
-                    readers[use.resource].clear();
-                else
-                    readers[use.resource].push_back(p);
-            }
+            st.order[count] = p;
+            st.position[p] = st.alive[p] ? count : kNoIndex;
+            count += st.alive[p];
         }
-        for (const ir::Ordering& o : d.orderings)
-            if (st.alive[o.before] && st.alive[o.after]) edges.push_back({o.before, o.after, kNoIndex});
-
-        std::vector<uint32_t> indegree(n, 0);
-        std::vector<std::vector<uint32_t>> successors(n);
-        for (const Edge& e : edges) {
-            ++indegree[e.to];
-            successors[e.from].push_back(e.to);
-        }
-        std::priority_queue<uint32_t, std::vector<uint32_t>, std::greater<>> ready;
-        for (uint32_t p = 0; p < n; ++p)
-            if (st.alive[p] && indegree[p] == 0) ready.push(p);
-        while (!ready.empty()) {
-            const uint32_t p = ready.top();
-            ready.pop();
-            st.order.push_back(p);
-            for (uint32_t s : successors[p])
-                if (--indegree[s] == 0) ready.push(s);
-        }
-        uint32_t aliveCount = 0;
-        for (uint32_t p = 0; p < n; ++p) aliveCount += st.alive[p];
-        if (st.order.size() != aliveCount) reportCycle(st, edges, indegree);
-        if (st.log) spdlog::debug("rg schedule: explicit orderings moved passes out of declaration order");
+        st.order.resize(count);
+        return;
     }
+    st.order.clear();
+    st.order.reserve(n);
+    st.position.assign(n, kNoIndex);
+    std::vector<Edge> edges;
+    // Readers of each resource's current version, for write-after-read edges.
+    std::vector<std::vector<uint32_t>> readers(d.resources.size());
+    for (uint32_t p = 0; p < n; ++p) {
+        if (!st.alive[p]) continue;
+        const ir::Pass& pass = d.passes[p];
+        for (uint32_t u = pass.firstUse; u < pass.firstUse + pass.useCount; ++u) {
+            const ir::Use& use = d.uses[u];
+            if (use.producer != kNoIndex) edges.push_back({use.producer, p, use.resource});
+            if (use.writes) {
+                for (uint32_t reader : readers[use.resource])
+                    if (reader != p) edges.push_back({reader, p, use.resource});
+            }
+        }
+        // Readers are recorded after the pass's own writes so a pass that
+        // reads one mip and writes another is not its own predecessor.
+        for (uint32_t u = pass.firstUse; u < pass.firstUse + pass.useCount; ++u) {
+            const ir::Use& use = d.uses[u];
+            if (use.writes)
+                readers[use.resource].clear();
+            else
+                readers[use.resource].push_back(p);
+        }
+    }
+    for (const ir::Ordering& o : d.orderings)
+        if (st.alive[o.before] && st.alive[o.after]) edges.push_back({o.before, o.after, kNoIndex});
+
+    std::vector<uint32_t> indegree(n, 0);
+    std::vector<std::vector<uint32_t>> successors(n);
+    for (const Edge& e : edges) {
+        ++indegree[e.to];
+        successors[e.from].push_back(e.to);
+    }
+    std::priority_queue<uint32_t, std::vector<uint32_t>, std::greater<>> ready;
+    for (uint32_t p = 0; p < n; ++p)
+        if (st.alive[p] && indegree[p] == 0) ready.push(p);
+    while (!ready.empty()) {
+        const uint32_t p = ready.top();
+        ready.pop();
+        st.order.push_back(p);
+        for (uint32_t s : successors[p])
+            if (--indegree[s] == 0) ready.push(s);
+    }
+    uint32_t aliveCount = 0;
+    for (uint32_t p = 0; p < n; ++p) aliveCount += st.alive[p];
+    if (st.order.size() != aliveCount) reportCycle(st, edges, indegree);
+    if (st.log) spdlog::debug("rg schedule: explicit orderings moved passes out of declaration order");
     for (uint32_t i = 0; i < st.order.size(); ++i) st.position[st.order[i]] = i;
 }
 
 void assignQueues(CompileState& st) {
     const ir::Declaration& d = st.decl;
-    st.queueOf.resize(d.passes.size());
-    for (uint32_t p = 0; p < d.passes.size(); ++p) {
-        const Queue declared = d.passes[p].queue;
-        const Queue q =
-            declared == Queue::AsyncCompute && st.caps.separateComputeFamily ? Queue::AsyncCompute : Queue::Graphics;
-        st.queueOf[p] = q;
-        if (st.alive[p]) st.queueActive[queueIndex(q)] = true;
-        if (st.log && st.alive[p] && declared != q)
-            spdlog::debug("rg queues: '{}' runs on graphics (no separate compute family)", d.passes[p].name);
+    const auto n = static_cast<uint32_t>(d.passes.size());
+    st.queueOf.resize(n);
+    // Local pointers and flags: the byte-sized stores would otherwise make
+    // the compiler reload every vector after each one.
+    Queue* const queueOf = st.queueOf.data();
+    const uint8_t* const alive = st.alive.data();
+    const bool separate = st.caps.separateComputeFamily;
+    bool active[kQueueCount] = {false, false};
+    for (uint32_t p = 0; p < n; ++p) {
+        const Queue q = d.passes[p].queue == Queue::AsyncCompute && separate ? Queue::AsyncCompute : Queue::Graphics;
+        queueOf[p] = q;
+        active[queueIndex(q)] = active[queueIndex(q)] || alive[p];
     }
+    for (uint32_t q = 0; q < kQueueCount; ++q) st.queueActive[q] = st.queueActive[q] || active[q];
+    if (!st.log) return;
+    for (uint32_t p = 0; p < n; ++p)
+        if (alive[p] && d.passes[p].queue != queueOf[p])
+            spdlog::debug("rg queues: '{}' runs on graphics (no separate compute family)", d.passes[p].name);
 }
 
 } // namespace glint::rg::detail
