@@ -83,6 +83,26 @@ constexpr ir::Resource kFreshResource{};
 
 VkImageLayout layoutOf(AccessSet kinds) { return accessScope(kinds, ResourceKind::Texture, Pipeline::Compute).layout; }
 
+// Records a checked use; returns the version the handle has after it.
+inline uint32_t appendUse(ir::Declaration& d, uint32_t pass, uint32_t index, uint32_t version, AccessSet bit,
+                          bool write, const Subresource& range) {
+    ir::Resource& r = d.resources[index];
+    r.lastUser = pass;
+    // Built in place: assembling it on the stack and copying it stalls on
+    // store forwarding, and this runs for every use of every pass.
+    ir::Use& use = d.uses.emplace_back();
+    use.resource = index;
+    use.version = version;
+    use.producer = r.lastWriter;
+    use.kinds = bit;
+    use.writes = write;
+    use.range = range;
+    ir::Pass& owner = d.passes[pass];
+    ++owner.useCount;
+    owner.kinds |= bit;
+    return write ? version + 1 : version;
+}
+
 } // namespace
 
 // ---- Names -------------------------------------------------------------------
@@ -530,21 +550,7 @@ inline uint32_t Graph::use(uint32_t pass, ResourceKind kind, uint32_t index, uin
         }
     }
 
-    d.resources[index].lastUser = pass;
-    const uint32_t producer = r.lastWriter;
-    // Built in place: assembling it on the stack and copying it stalls on
-    // store forwarding, and this runs for every use of every pass.
-    ir::Use& use = d.uses.emplace_back();
-    use.resource = index;
-    use.version = version;
-    use.producer = producer;
-    use.kinds = bit;
-    use.writes = write;
-    use.range = resolved;
-    ir::Pass& owner = d.passes[pass];
-    ++owner.useCount;
-    owner.kinds |= bit;
-    return write ? version + 1 : version;
+    return appendUse(d, pass, index, version, bit, write, resolved);
 }
 
 // Every case use() does not take: all the checks in order, each error in
@@ -633,21 +639,7 @@ uint32_t Graph::useGeneral(uint32_t pass, ResourceKind kind, uint32_t index, uin
                  " and an earlier use); a pass that reads and writes one subresource declares StorageReadWrite");
     }
 
-    d.resources[index].lastUser = pass;
-    const uint32_t producer = r.lastWriter;
-    // Built in place: assembling it on the stack and copying it stalls on
-    // store forwarding, and this runs for every use of every pass.
-    ir::Use& use = d.uses.emplace_back();
-    use.resource = index;
-    use.version = version;
-    use.producer = producer;
-    use.kinds = bit;
-    use.writes = write;
-    use.range = range;
-    ir::Pass& owner = d.passes[pass];
-    ++owner.useCount;
-    owner.kinds |= bit;
-    return write ? version + 1 : version;
+    return appendUse(d, pass, index, version, bit, write, range);
 }
 
 Plan Graph::compile(const CompileOptions& options, Plan&& recycled) const {
