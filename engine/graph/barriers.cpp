@@ -642,9 +642,10 @@ private:
     // on any of its bytes, itself included (one queue per heap, so stages
     // are all that matter). Per heap: cut the bytes at every placement
     // boundary, OR each resource's last uses into the pieces it covers, then
-    // OR back over each resource's pieces -- a segment tree over the pieces
-    // (bottom-up, 2 x pieces nodes: OR is commutative, so any size works),
-    // O(n log n) however many placements overlap.
+    // OR back over each resource's pieces: piece by piece when members span
+    // a few pieces each (the usual packing), else through a segment tree
+    // over the pieces (bottom-up, 2 x pieces nodes: OR is commutative, so
+    // any size works), O(n log n) however many placements overlap.
     void startAliased() {
         std::vector<std::vector<uint32_t>>& members = scratch_.heapMembers;
         members.resize(st_.plan.heaps.size());
