@@ -28,6 +28,7 @@
 
 #include <algorithm>
 #include <bit>
+#include <stdexcept>
 #include <string>
 #include <utility>
 
@@ -213,6 +214,11 @@ struct Cell {
     VkImageLayout layout = VK_IMAGE_LAYOUT_UNDEFINED;
     bool contents = false;
     bool aliased = false;  // prior accesses include another resource on these bytes
+    // A transient used on one queue, not used yet this frame: its prior
+    // accesses (the previous frame's last uses of its bytes) are not known
+    // until the walk has seen those, so the first use's barrier is placed
+    // with the priors left out and completed by resolveFirstUses().
+    bool priorLater = false;
     bool wPending = false; // a later write must still be ordered after the write (no read came between)
     int8_t wQueue = -1;    // -1: no write to synchronise with
     TimelinePoint wPoint;
@@ -351,7 +357,18 @@ struct Need {
     bool barrier;
     bool rawByBarrier;
     bool aliased;
-    bool waits; // asked crossQueue(): the only part of analyse() that reads pending_
+    bool waits;    // asked crossQueue(): the only part of analyse() that reads pending_
+    bool firstUse; // of a priorLater cell: the barrier's priors come later
+};
+
+// A barrier that holds a priorLater cell's first use: resolveFirstUses()
+// analyses that use again against the frame-start priors and ORs what they
+// add into it.
+struct FirstUse {
+    uint32_t barrier; // index into Plan::barriers
+    uint32_t cell;
+    uint32_t use; // declared use index
+    uint32_t queue;
 };
 
 struct FinalImport;
@@ -440,6 +457,7 @@ struct Scratch {
     std::vector<FinalImport> finalImports;
     std::vector<uint32_t> deferred;
     std::vector<uint32_t> imports;
+    std::vector<FirstUse> firstUses;
     OffsetIndex offsetIndex;
     std::vector<LastUses> tree;
     std::vector<std::pair<uint32_t, uint32_t>> pieces; // per aliased member: its pieces [first, second)
@@ -462,6 +480,7 @@ public:
         st_.barrierCount.assign(st_.order.size(), 0);
         needs_.reserve(64);
         for (uint32_t pos = 0; pos < st_.order.size(); ++pos) walkPass(pos);
+        resolveFirstUses();
         finalStates();
         batches_.finish();
     }
@@ -508,6 +527,9 @@ private:
                 ref.single = !ref.texture || (use.range.mipCount == 1 && use.range.layerCount == 1);
                 ref.writes = use.writes;
                 if (r.origin == ir::Origin::Imported) continue;
+                // A transient on one queue starts from its own end (or its
+                // aliases'), which the walk itself arrives at.
+                if (r.origin == ir::Origin::Transient && !st_.lifetimes[use.resource].crossQueue()) continue;
                 if (r.origin == ir::Origin::HistoryPrevious) {
                     deferred.push_back(u);
                     deferred.push_back(pos);
@@ -532,18 +554,107 @@ private:
                 case ir::Origin::HistoryCurrent:
                     startHistory(r);
                     break;
-                case ir::Origin::Transient:
-                    // Its own bytes: last used by itself in the previous frame.
-                    // Shared bytes: see startAliased.
-                    if (st_.lifetimes[r].used() && !st_.aliased[r]) {
-                        const ir::Resource& res = d_.resources[r];
-                        for (uint32_t c = res.cellBase; c < res.cellBase + res.cellCount; ++c)
+                case ir::Origin::Transient: {
+                    // Its own bytes: last used by itself in the previous
+                    // frame; shared bytes: by any resource on them (see
+                    // startAliased). Both queues: known now (its bytes are
+                    // its own). One queue: known once the walk is over.
+                    if (!st_.lifetimes[r].used()) break;
+                    const ir::Resource& res = d_.resources[r];
+                    const bool both = st_.lifetimes[r].crossQueue();
+                    for (uint32_t c = res.cellBase; c < res.cellBase + res.cellCount; ++c) {
+                        if (both) {
                             addPrior(cells_[c], ends_[c]);
+                            continue;
+                        }
+                        cells_[c].priorLater = true;
+                        cells_[c].aliased = st_.aliased[r] != 0;
                     }
                     break;
+                }
             }
         }
+    }
+
+    [[noreturn]] void priorsElsewhere(uint32_t r) const {
+        throw std::logic_error("rg barriers: the frame-start priors of '" + std::string(d_.resources[r].name) +
+                               "' are on the other queue");
+    }
+
+    // What the walk left in a cell, as the next frame's prior accesses (the
+    // bookkeeping EndState::apply() follows, which the walk's agrees with
+    // once the cell's first use has written it).
+    static EndState endOf(const Cell& c) {
+        EndState e;
+        e.touched = c.wQueue >= 0 || c.rStages[0] || c.rStages[1];
+        e.layout = c.layout;
+        e.wQueue = c.wQueue;
+        e.wPending = c.wPending;
+        e.wStages = c.wStages;
+        e.wAccess = c.wAccess;
+        e.rStages[0] = c.rStages[0];
+        e.rStages[1] = c.rStages[1];
+        return e;
+    }
+
+    // Completes the first-use barriers of the transients on one queue: now
+    // that the walk has seen the frame's last uses, each such use is
+    // analysed again from its true frame-start state (its own last uses, or
+    // those of every resource on its bytes), and what that adds is ORed into
+    // the barrier the walk placed. The priors are on the use's own queue (a
+    // one-queue resource; an aliasing heap holds one queue's resources), so
+    // they add stages and accesses, never a wait.
+    void resolveFirstUses() {
+        if (firstUses_.empty()) return;
         startAliased();
+        std::vector<Barrier>& barriers = st_.plan.barriers;
+        for (const FirstUse& f : firstUses_) {
+            const ir::Use& use = d_.uses[f.use];
+            const UseRef& ref = useRefs_[f.use];
+            const EndState prior = st_.aliased[use.resource] ? ends_[f.cell] : endOf(cells_[f.cell]);
+            const UseInfo& info = *ref.info;
+            const bool transition = ref.texture; // from UNDEFINED
+            VkPipelineStageFlags2 srcStages = 0;
+            VkAccessFlags2 srcAccess = 0;
+            // analyse() of a use after `prior` alone: nothing is visible yet,
+            // the use writes (or transitions), every prior is on its queue.
+            const bool write = prior.wQueue >= 0 && prior.wStages;
+            if (prior.wQueue != static_cast<int8_t>(f.queue) && write) [[unlikely]]
+                priorsElsewhere(use.resource);
+            // Read after write.
+            if (info.reads && write && !Visibility{}.covers(f.queue, info.readMask)) {
+                srcStages |= prior.wStages;
+                srcAccess |= prior.wAccess;
+            }
+            // Write after read.
+            for (uint32_t rq = 0; rq < kQueueCount; ++rq) {
+                if (!prior.rStages[rq]) continue;
+                if (rq != f.queue) [[unlikely]]
+                    priorsElsewhere(use.resource);
+                srcStages |= prior.rStages[rq];
+            }
+            // Write after write.
+            if ((prior.wPending || transition) && write &&
+                (transition || !Visibility{}.covers(f.queue, info.accessMask))) {
+                srcStages |= prior.wStages;
+                srcAccess |= prior.wAccess;
+            }
+            if (!transition && !srcStages) [[unlikely]]
+                throw std::logic_error("rg barriers: '" + std::string(d_.resources[use.resource].name) +
+                                       "' starts the frame with no prior use");
+            Barrier& b = barriers[f.barrier];
+            b.srcStages |= srcStages;
+            b.srcAccess |= srcAccess;
+        }
+        if (st_.log) {
+            for (size_t i = 0; i < firstUses_.size(); ++i) {
+                const uint32_t k = firstUses_[i].barrier;
+                if (i > 0 && firstUses_[i - 1].barrier == k) continue;
+                const ir::Resource& r = d_.resources[barriers[k].resource];
+                spdlog::debug("rg barriers: {} (first use)", describeBarrier(r.name, barriers[k], r.kind));
+            }
+        }
+        firstUses_.clear();
     }
 
     void applyEnd(uint32_t u, uint32_t q) {
@@ -721,20 +832,19 @@ private:
         }
     }
 
+    // Keeps an aliased transient's priors in ends_ (which transients do not
+    // otherwise use) for resolveFirstUses().
     void addAliasedPriors(uint32_t r, const LastUses& priors) {
         const EndState prior = priors.endState();
         const ir::Resource& res = d_.resources[r];
-        for (uint32_t c = res.cellBase; c < res.cellBase + res.cellCount; ++c) {
-            addPrior(cells_[c], prior);
-            cells_[c].aliased = true;
-        }
+        for (uint32_t c = res.cellBase; c < res.cellBase + res.cellCount; ++c) ends_[c] = prior;
     }
 
-    // The last uses of any subresource of `r`.
+    // The last uses of any subresource of `r`: where the walk left its cells.
     LastUses summary(uint32_t r) const {
         const ir::Resource& res = d_.resources[r];
         LastUses out;
-        for (uint32_t c = res.cellBase; c < res.cellBase + res.cellCount; ++c) out.add(ends_[c]);
+        for (uint32_t c = res.cellBase; c < res.cellBase + res.cellCount; ++c) out.add(endOf(cells_[c]));
         return out;
     }
 
@@ -791,6 +901,19 @@ private:
     void analyse(Need& n, uint32_t c, uint32_t q, const UseInfo& use, bool writes, bool texture) {
         const Cell& cell = cells_[c];
         const SyncScope& s = use.scope;
+        if (cell.priorLater) {
+            // Nothing this frame came before it, and what the previous one
+            // left comes later: a barrier either way (a texture transitions
+            // from UNDEFINED; a buffer's last frame always left a use behind),
+            // which resolveFirstUses() completes.
+            n.cell = c;
+            n.transition = texture && cell.layout != s.layout;
+            n.oldLayout = VK_IMAGE_LAYOUT_UNDEFINED;
+            n.aliased = cell.aliased;
+            n.barrier = true;
+            n.firstUse = true;
+            return;
+        }
         n.cell = c;
         n.transition = texture && cell.layout != s.layout;
         n.oldLayout = n.transition && !cell.contents ? VK_IMAGE_LAYOUT_UNDEFINED : cell.layout;
@@ -892,6 +1015,16 @@ private:
     void update(const Need& n, uint32_t q, const UseInfo& use, bool writes, TimelinePoint now) {
         Cell& cell = cells_[n.cell];
         const SyncScope& s = use.scope;
+        if (n.firstUse) [[unlikely]] {
+            // What follows a write (or a layout transition) does not depend
+            // on what came before it, so the walk can go on without the
+            // priors. A transient's first use of a subresource writes it
+            // (reads need contents), so this holds by construction.
+            if (!writes && !n.transition)
+                throw std::logic_error("rg barriers: the first use of a transient subresource in '" +
+                                       std::string(d_.passes[st_.order[pos_]].name) + "' reads it");
+            cell.priorLater = false;
+        }
         // A barrier chained from a wait orders every read of the other queue
         // that wait reached, not only the hazard it was placed for.
         const uint32_t other = queueIndex(otherQueue(static_cast<Queue>(q)));
@@ -938,8 +1071,9 @@ private:
 
     // Turns needs_[first, last) -- one use's cells in mip-major order -- into
     // barriers: runs of layers per mip, merged across mips when runs line up.
+    // `use` is the declared use on queue q (kNoIndex for frame-end states).
     void emit(uint32_t resource, bool texture, VkImageAspectFlags aspect, const Subresource& range, const SyncScope& s,
-              size_t first, size_t last) {
+              size_t first, size_t last, uint32_t use, uint32_t q) {
         std::vector<Barrier>& out = st_.plan.barriers;
         const size_t firstBarrier = out.size();
         const uint32_t layers = texture ? range.layerCount : 1;
@@ -977,10 +1111,12 @@ private:
                     prev.srcStages |= srcStages;
                     prev.srcAccess |= srcAccess;
                     prev.aliasing = prev.aliasing || aliasing;
+                    noteFirstUses(out.size() - 1, use, q, i, j);
                     i = j;
                     continue;
                 }
             }
+            noteFirstUses(out.size(), use, q, i, j);
             Barrier& b = out.emplace_back();
             b.resource = resource;
             b.range = {mip, 1, layer, layerCount};
@@ -997,12 +1133,28 @@ private:
         if (st_.log) {
             const ir::Resource& r = d_.resources[resource];
             for (size_t k = firstBarrier; k < out.size(); ++k)
-                spdlog::debug("rg barriers: {}", describeBarrier(r.name, out[k], r.kind));
+                if (!holdsFirstUse(k)) spdlog::debug("rg barriers: {}", describeBarrier(r.name, out[k], r.kind));
         }
     }
 
+    // Records the first uses among needs_[first, last) of declared use
+    // `use` on queue q, merged into barrier `barrier`.
+    void noteFirstUses(size_t barrier, uint32_t use, uint32_t q, size_t first, size_t last) {
+        for (size_t k = first; k < last; ++k)
+            if (needs_[k].firstUse) [[unlikely]]
+                firstUses_.push_back({static_cast<uint32_t>(barrier), needs_[k].cell, use, q});
+    }
+
+    // Whether barrier k waits for resolveFirstUses() (debug logging only).
+    bool holdsFirstUse(size_t k) const {
+        return std::any_of(firstUses_.begin(), firstUses_.end(), [&](const FirstUse& f) { return f.barrier == k; });
+    }
+
     // emit() of a use of one cell (most uses): one barrier, nothing to merge.
-    void emitOne(uint32_t resource, const UseRef& ref, const Subresource& range, const SyncScope& s, const Need& n) {
+    void emitOne(uint32_t resource, const UseRef& ref, const Subresource& range, const SyncScope& s, const Need& n,
+                 uint32_t use, uint32_t q) {
+        if (n.firstUse) [[unlikely]]
+            firstUses_.push_back({static_cast<uint32_t>(st_.plan.barriers.size()), n.cell, use, q});
         Barrier& b = st_.plan.barriers.emplace_back();
         b.resource = resource;
         b.range = ref.texture ? Subresource{range.baseMip, 1, range.baseLayer, 1} : Subresource{0, 1, 0, 1};
@@ -1014,13 +1166,14 @@ private:
         b.oldLayout = ref.texture ? n.oldLayout : VK_IMAGE_LAYOUT_UNDEFINED;
         b.newLayout = ref.texture ? s.layout : VK_IMAGE_LAYOUT_UNDEFINED;
         b.aliasing = n.aliased;
-        if (st_.log) {
+        if (st_.log && !n.firstUse) {
             const ir::Resource& r = d_.resources[resource];
             spdlog::debug("rg barriers: {}", describeBarrier(r.name, b, r.kind));
         }
     }
 
     void walkPass(uint32_t pos) {
+        pos_ = pos;
         const uint32_t p = st_.order[pos];
         const ir::Pass& pass = d_.passes[p];
         const uint32_t q = queueIndex(st_.queueOf[p]);
@@ -1064,7 +1217,9 @@ private:
             const size_t last = i + 1 < pass.useCount ? useNeed_[i + 1] : needs_.size();
             if (ref.single) {
                 const Need& n = needs_[first];
-                if (n.barrier) emitOne(d_.uses[pass.firstUse + i].resource, ref, d_.uses[pass.firstUse + i].range, s, n);
+                if (n.barrier)
+                    emitOne(d_.uses[pass.firstUse + i].resource, ref, d_.uses[pass.firstUse + i].range, s, n,
+                            pass.firstUse + i, q);
                 update(n, q, info, ref.writes, now);
                 continue;
             }
@@ -1073,7 +1228,7 @@ private:
             while (firstBarrier < last && !needs_[firstBarrier].barrier) ++firstBarrier;
             if (firstBarrier < last) {
                 const ir::Use& use = d_.uses[pass.firstUse + i];
-                emit(use.resource, ref.texture, ref.aspect, use.range, s, first, last);
+                emit(use.resource, ref.texture, ref.aspect, use.range, s, first, last, pass.firstUse + i, q);
             }
             for (size_t k = first; k < last; ++k) update(needs_[k], q, info, ref.writes, now);
         }
@@ -1140,7 +1295,7 @@ private:
                 const ir::Resource& res = d_.resources[r];
                 const bool texture = res.kind == ResourceKind::Texture;
                 emit(r, texture, texture ? st_.plan.resources[r].aspect : 0, wholeOf(res), f.target->scope,
-                     f.firstNeed, f.endNeed);
+                     f.firstNeed, f.endNeed, kNoIndex, qi);
             }
             batches_.setEndBarriers(q, firstBarrier, static_cast<uint32_t>(st_.plan.barriers.size()) - firstBarrier);
         }
@@ -1169,7 +1324,9 @@ private:
     std::vector<uint32_t>& useNeed_ = scratch_.useNeed;
     std::vector<Final>& finals_ = scratch_.finals;
     std::vector<uint32_t>& imports_ = scratch_.imports;
+    std::vector<FirstUse>& firstUses_ = scratch_.firstUses;
     WaitRequest pending_[kQueueCount];
+    uint32_t pos_ = 0; // schedule position of the pass being walked
 };
 
 } // namespace
