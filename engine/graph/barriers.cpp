@@ -297,52 +297,23 @@ void addPrior(Cell& c, const EndState& e) {
     }
 }
 
-// The last uses on some bytes of a heap, merged over the resources on them:
-// EndState less the layout, in 40 bytes, for startAliased's tree. Writes
-// already made available still matter to the next layout transition on
-// these bytes (see analyse(): write after write), so they are carried too;
-// only pending ones set `pending`. One queue per heap: the write's queue is
-// the same for all.
+// The last uses of a transient on one queue, or of some bytes of a heap
+// merged over the resources on them: what its first uses in the next frame
+// synchronise with. One queue per heap, and reads and the write on it, so
+// three masks and a flag, merged by OR. Writes already made available still
+// matter to the next layout transition on these bytes (see analyse(): write
+// after write), so they are carried too; only pending ones set `pending`.
 struct LastUses {
-    VkPipelineStageFlags2 rStages[kQueueCount] = {0, 0};
-    VkPipelineStageFlags2 wStages = 0;
+    VkPipelineStageFlags2 rStages = 0;
+    VkPipelineStageFlags2 wStages = 0; // 0: no write
     VkAccessFlags2 wAccess = 0;
-    int8_t wQueue = -1;
-    bool touched = false;
     bool pending = false;
 
-    void add(const EndState& e) {
-        if (!e.touched) return;
-        touched = true;
-        for (uint32_t q = 0; q < kQueueCount; ++q) rStages[q] |= e.rStages[q];
-        if (e.wQueue >= 0 && e.wStages) {
-            if (wQueue < 0 || e.wPending) wQueue = e.wQueue;
-            pending = pending || e.wPending;
-            wStages |= e.wStages;
-            wAccess |= e.wAccess;
-        }
-    }
-    void merge(const LastUses& from) {
-        if (!from.touched) return;
-        touched = true;
-        for (uint32_t q = 0; q < kQueueCount; ++q) rStages[q] |= from.rStages[q];
-        if (from.wQueue >= 0 && from.wStages) {
-            if (wQueue < 0 || from.pending) wQueue = from.wQueue;
-            pending = pending || from.pending;
-            wStages |= from.wStages;
-            wAccess |= from.wAccess;
-        }
-    }
-    EndState endState() const {
-        EndState e;
-        e.touched = touched;
-        e.wQueue = wQueue;
-        e.wPending = pending;
-        e.wStages = wStages;
-        e.wAccess = wAccess;
-        e.rStages[0] = rStages[0];
-        e.rStages[1] = rStages[1];
-        return e;
+    void merge(const LastUses& o) {
+        rStages |= o.rStages;
+        wStages |= o.wStages;
+        wAccess |= o.wAccess;
+        pending = pending || o.pending;
     }
 };
 
@@ -369,6 +340,7 @@ struct FirstUse {
     uint32_t cell;
     uint32_t use; // declared use index
     uint32_t queue;
+    const UseInfo* info;
 };
 
 struct FinalImport;
@@ -382,9 +354,8 @@ struct Final {
 
 struct FinalImport {
     uint32_t resource;
-    uint32_t queue; // boundary queue of its final state
-    SyncScope scope;
-    VkAccessFlags2 reads; // the read bits of scope.access
+    uint32_t queue;        // boundary queue of its final state
+    const UseInfo* state;  // the final state as a use: in the table, or in rawFinals
 };
 
 // A declared use as the walk reads it, resolved once per compile: the walk
@@ -401,44 +372,66 @@ struct UseRef {
 
 // Byte offsets -> their rank among the distinct offsets inserted: an
 // open-addressing hash set, then the distinct values sorted and numbered.
+// Placement reuses a few offsets for many resources, so the table is sized
+// by the distinct ones (it grows when they fill half of it), and a stamp per
+// slot tells this compile's entries from older ones: nothing is cleared.
 class OffsetIndex {
 public:
-    void reset(size_t values) {
-        const auto bits = static_cast<uint32_t>(std::bit_width(std::max<size_t>(2 * values, 16) - 1));
-        shift_ = 64 - bits;
-        keys_.assign(size_t{1} << bits, 0);
-        rank_.assign(size_t{1} << bits, kNoIndex);
+    void reset() {
         distinct_.clear();
+        if (slots_.empty()) rehash(64);
+        if (++stamp_ == 0) { // wrapped: forget every stamp
+            for (Slot& slot : slots_) slot.stamp = 0;
+            stamp_ = 1;
+        }
     }
     void insert(uint64_t offset) {
-        size_t slot = home(offset);
-        while (rank_[slot] != kNoIndex) {
-            if (keys_[slot] == offset) return;
-            slot = (slot + 1) & (keys_.size() - 1);
+        size_t i = home(offset);
+        while (slots_[i].stamp == stamp_) {
+            if (slots_[i].key == offset) return;
+            i = (i + 1) & mask_;
         }
-        keys_[slot] = offset;
-        rank_[slot] = 0; // numbered by number()
+        slots_[i] = {offset, stamp_, 0};
         distinct_.push_back(offset);
+        if (2 * distinct_.size() > slots_.size()) rehash(2 * slots_.size());
     }
     void number() {
         std::sort(distinct_.begin(), distinct_.end());
-        for (uint32_t i = 0; i < distinct_.size(); ++i) rank_[slotOf(distinct_[i])] = i;
+        for (uint32_t i = 0; i < distinct_.size(); ++i) slots_[slotOf(distinct_[i])].rank = i;
     }
     // An inserted offset's rank.
-    uint32_t find(uint64_t offset) const { return rank_[slotOf(offset)]; }
+    uint32_t find(uint64_t offset) const { return slots_[slotOf(offset)].rank; }
     size_t count() const { return distinct_.size(); }
 
 private:
+    struct Slot {
+        uint64_t key = 0;
+        uint32_t stamp = 0; // holds this compile's offset when it equals stamp_
+        uint32_t rank = 0;
+    };
+
+    void rehash(size_t size) {
+        slots_.assign(size, Slot{});
+        mask_ = size - 1;
+        shift_ = 64 - static_cast<uint32_t>(std::countr_zero(size));
+        stamp_ = std::max(stamp_, 1u);
+        for (const uint64_t offset : distinct_) {
+            size_t i = home(offset);
+            while (slots_[i].stamp == stamp_) i = (i + 1) & mask_;
+            slots_[i] = {offset, stamp_, 0};
+        }
+    }
     size_t home(uint64_t offset) const { return static_cast<size_t>((offset * 0x9E3779B97F4A7C15ull) >> shift_); }
     size_t slotOf(uint64_t offset) const {
-        size_t slot = home(offset);
-        while (keys_[slot] != offset || rank_[slot] == kNoIndex) slot = (slot + 1) & (keys_.size() - 1);
-        return slot;
+        size_t i = home(offset);
+        while (slots_[i].key != offset || slots_[i].stamp != stamp_) i = (i + 1) & mask_;
+        return i;
     }
 
-    uint32_t shift_ = 60;
-    std::vector<uint64_t> keys_;
-    std::vector<uint32_t> rank_;
+    std::vector<Slot> slots_;
+    size_t mask_ = 0;
+    uint32_t shift_ = 64;
+    uint32_t stamp_ = 0;
     std::vector<uint64_t> distinct_;
 };
 
@@ -449,17 +442,21 @@ struct Scratch {
     std::vector<Cell> cells;
     std::vector<EndState> ends;
     std::vector<Visibility> endSeen;
-    std::vector<UseRef> useRefs;
     std::vector<UseInfo> mergedInfo;
     std::vector<Need> needs;
     std::vector<uint32_t> useNeed;
     std::vector<Final> finals;
     std::vector<FinalImport> finalImports;
+    std::vector<UseInfo> rawFinals; // final states given as raw masks
     std::vector<uint32_t> deferred;
+    std::vector<uint32_t> historyCurrents;
+    std::vector<uint8_t> early; // per resource: starts from its own end, known before the walk
+    std::vector<UseRef> passRefs; // the walked pass's uses
     std::vector<uint32_t> imports;
     std::vector<FirstUse> firstUses;
     OffsetIndex offsetIndex;
     std::vector<LastUses> tree;
+    std::vector<LastUses> aliasedPriors; // per resource; aliased transients' entries are set
     std::vector<std::pair<uint32_t, uint32_t>> pieces; // per aliased member: its pieces [first, second)
     std::vector<std::vector<uint32_t>> heapMembers;
 };
@@ -488,60 +485,84 @@ public:
 private:
     // ---- Frame start ----------------------------------------------------------
 
+    // A declared use as the walk reads it (merged read kinds get an entry
+    // of their own in mergedInfo_).
+    UseRef useRefOf(const ir::Pass& pass, uint32_t u) {
+        const ir::Use& use = d_.uses[u];
+        const ir::Resource& r = d_.resources[use.resource];
+        UseRef ref;
+        if ((use.kinds & (use.kinds - 1)) == 0) {
+            ref.info = &useInfoOf(static_cast<Access>(std::countr_zero(use.kinds)), r.kind, pass.pipeline);
+        } else {
+            mergedInfo_.push_back(makeUseInfo(accessScope(use.kinds, r.kind, pass.pipeline)));
+            ref.info = &mergedInfo_.back();
+        }
+        ref.texture = r.kind == ResourceKind::Texture;
+        ref.cell = ref.texture ? ir::cellOf(r, use.range.baseMip, use.range.baseLayer) : r.cellBase;
+        ref.aspect = ref.texture ? st_.plan.resources[use.resource].aspect : 0;
+        ref.single = !ref.texture || (use.range.mipCount == 1 && use.range.layerCount == 1);
+        ref.writes = use.writes;
+        return ref;
+    }
+
     void initialiseCells() {
         const uint32_t cellCount = d_.cellCount;
         cells_.assign(cellCount, Cell{});
-        ends_.assign(cellCount, EndState{});
-        const bool history = std::any_of(d_.resources.begin(), d_.resources.end(),
-                                         [](const ir::Resource& r) { return r.partner != kNoIndex; });
-        endSeen_.assign(history ? cellCount : 0, Visibility{});
-        useRefs_.resize(d_.uses.size());
-        // Merged read kinds get their own entry; the reserve keeps pointers
-        // into it valid.
+        // A UseRef is made per use in the walk and once more for a use of a
+        // resource that starts from its own end: at most two merged entries
+        // per use, and the reserve keeps pointers into them valid.
         mergedInfo_.clear();
-        mergedInfo_.reserve(d_.uses.size());
+        mergedInfo_.reserve(2 * d_.uses.size());
 
-        // What the frame leaves behind, use by use. Imports restart from their
-        // declared state, so only transients and history halves need it; a
-        // `previous` half starts from what its partner ended in, so it goes
-        // second.
-        std::vector<uint32_t>& deferred = scratch_.deferred;
-        deferred.clear();
-        for (uint32_t pos = 0; pos < st_.order.size(); ++pos) {
-            const uint32_t p = st_.order[pos];
-            const ir::Pass& pass = d_.passes[p];
-            const uint32_t q = queueIndex(st_.queueOf[p]);
-            for (uint32_t u = pass.firstUse; u < pass.firstUse + pass.useCount; ++u) {
-                const ir::Use& use = d_.uses[u];
-                const ir::Resource& r = d_.resources[use.resource];
-                UseRef& ref = useRefs_[u];
-                if ((use.kinds & (use.kinds - 1)) == 0) {
-                    ref.info = &useInfoOf(static_cast<Access>(std::countr_zero(use.kinds)), r.kind, pass.pipeline);
-                } else {
-                    mergedInfo_.push_back(makeUseInfo(accessScope(use.kinds, r.kind, pass.pipeline)));
-                    ref.info = &mergedInfo_.back();
-                }
-                ref.texture = r.kind == ResourceKind::Texture;
-                ref.cell = ref.texture ? ir::cellOf(r, use.range.baseMip, use.range.baseLayer) : r.cellBase;
-                ref.aspect = ref.texture ? st_.plan.resources[use.resource].aspect : 0;
-                ref.single = !ref.texture || (use.range.mipCount == 1 && use.range.layerCount == 1);
-                ref.writes = use.writes;
-                if (r.origin == ir::Origin::Imported) continue;
-                // A transient on one queue starts from its own end (or its
-                // aliases'), which the walk itself arrives at.
-                if (r.origin == ir::Origin::Transient && !st_.lifetimes[use.resource].crossQueue()) continue;
-                if (r.origin == ir::Origin::HistoryPrevious) {
-                    deferred.push_back(u);
-                    deferred.push_back(pos);
-                    continue;
-                }
-                applyEnd(u, q);
+        // Resources that start from where they end, known before the walk:
+        // history halves (each starts from the other's end, visibility
+        // included) and transients on both queues (their priors may need a
+        // wait on the other queue, which changes batches). Only their cells'
+        // ends_ and endSeen_ are used, so only those are reset.
+        ends_.resize(cellCount);
+        endSeen_.resize(cellCount);
+        early_.assign(d_.resources.size(), 0);
+        std::vector<uint32_t>& currents = scratch_.historyCurrents;
+        currents.clear();
+        bool anyEarly = false;
+        for (uint32_t r = 0; r < d_.resources.size(); ++r) {
+            const ir::Resource& res = d_.resources[r];
+            const bool history = res.partner != kNoIndex;
+            if (!history && !(res.origin == ir::Origin::Transient && st_.lifetimes[r].crossQueue())) continue;
+            early_[r] = 1;
+            anyEarly = true;
+            if (res.origin == ir::Origin::HistoryCurrent) currents.push_back(r);
+            for (uint32_t c = res.cellBase; c < res.cellBase + res.cellCount; ++c) {
+                ends_[c] = EndState{};
+                endSeen_[c] = Visibility{};
             }
         }
-        for (uint32_t r = 0; r < d_.resources.size(); ++r)
-            if (d_.resources[r].origin == ir::Origin::HistoryCurrent) seedHistoryPrevious(r);
-        for (size_t i = 0; i < deferred.size(); i += 2)
-            applyEnd(deferred[i], queueIndex(st_.queueOf[st_.order[deferred[i + 1]]]));
+
+        // What the frame leaves behind in them, use by use. A `previous` half
+        // starts from what its partner ended in, so it goes second.
+        if (anyEarly) {
+            std::vector<uint32_t>& deferred = scratch_.deferred;
+            deferred.clear();
+            for (uint32_t pos = 0; pos < st_.order.size(); ++pos) {
+                const uint32_t p = st_.order[pos];
+                const ir::Pass& pass = d_.passes[p];
+                for (uint32_t u = pass.firstUse; u < pass.firstUse + pass.useCount; ++u) {
+                    const uint32_t r = d_.uses[u].resource;
+                    if (!early_[r]) continue;
+                    if (d_.resources[r].origin == ir::Origin::HistoryPrevious) {
+                        deferred.push_back(u);
+                        deferred.push_back(pos);
+                        continue;
+                    }
+                    applyEnd(pass, u, queueIndex(st_.queueOf[p]));
+                }
+            }
+            for (const uint32_t r : currents) seedHistoryPrevious(r);
+            for (size_t i = 0; i < deferred.size(); i += 2) {
+                const uint32_t p = st_.order[deferred[i + 1]];
+                applyEnd(d_.passes[p], deferred[i], queueIndex(st_.queueOf[p]));
+            }
+        }
 
         imports_.clear();
         for (uint32_t r = 0; r < d_.resources.size(); ++r) {
@@ -561,7 +582,7 @@ private:
                     // its own). One queue: known once the walk is over.
                     if (!st_.lifetimes[r].used()) break;
                     const ir::Resource& res = d_.resources[r];
-                    const bool both = st_.lifetimes[r].crossQueue();
+                    const bool both = early_[r] != 0;
                     for (uint32_t c = res.cellBase; c < res.cellBase + res.cellCount; ++c) {
                         if (both) {
                             addPrior(cells_[c], ends_[c]);
@@ -581,22 +602,6 @@ private:
                                "' are on the other queue");
     }
 
-    // What the walk left in a cell, as the next frame's prior accesses (the
-    // bookkeeping EndState::apply() follows, which the walk's agrees with
-    // once the cell's first use has written it).
-    static EndState endOf(const Cell& c) {
-        EndState e;
-        e.touched = c.wQueue >= 0 || c.rStages[0] || c.rStages[1];
-        e.layout = c.layout;
-        e.wQueue = c.wQueue;
-        e.wPending = c.wPending;
-        e.wStages = c.wStages;
-        e.wAccess = c.wAccess;
-        e.rStages[0] = c.rStages[0];
-        e.rStages[1] = c.rStages[1];
-        return e;
-    }
-
     // Completes the first-use barriers of the transients on one queue: now
     // that the walk has seen the frame's last uses, each such use is
     // analysed again from its true frame-start state (its own last uses, or
@@ -606,41 +611,35 @@ private:
     // they add stages and accesses, never a wait.
     void resolveFirstUses() {
         if (firstUses_.empty()) return;
+        aliasedPriors_.resize(d_.resources.size());
         startAliased();
         std::vector<Barrier>& barriers = st_.plan.barriers;
         for (const FirstUse& f : firstUses_) {
             const ir::Use& use = d_.uses[f.use];
-            const UseRef& ref = useRefs_[f.use];
-            const EndState prior = st_.aliased[use.resource] ? ends_[f.cell] : endOf(cells_[f.cell]);
-            const UseInfo& info = *ref.info;
-            const bool transition = ref.texture; // from UNDEFINED
+            const uint32_t r = use.resource;
+            const LastUses prior = st_.aliased[r] ? aliasedPriors_[r] : lastUsesOf(f.cell, f.queue, r);
+            const UseInfo& info = *f.info;
+            const bool transition = d_.resources[r].kind == ResourceKind::Texture; // from UNDEFINED
             VkPipelineStageFlags2 srcStages = 0;
             VkAccessFlags2 srcAccess = 0;
             // analyse() of a use after `prior` alone: nothing is visible yet,
             // the use writes (or transitions), every prior is on its queue.
-            const bool write = prior.wQueue >= 0 && prior.wStages;
-            if (prior.wQueue != static_cast<int8_t>(f.queue) && write) [[unlikely]]
-                priorsElsewhere(use.resource);
+            const bool write = prior.wStages != 0;
             // Read after write.
             if (info.reads && write && !Visibility{}.covers(f.queue, info.readMask)) {
                 srcStages |= prior.wStages;
                 srcAccess |= prior.wAccess;
             }
             // Write after read.
-            for (uint32_t rq = 0; rq < kQueueCount; ++rq) {
-                if (!prior.rStages[rq]) continue;
-                if (rq != f.queue) [[unlikely]]
-                    priorsElsewhere(use.resource);
-                srcStages |= prior.rStages[rq];
-            }
+            srcStages |= prior.rStages;
             // Write after write.
-            if ((prior.wPending || transition) && write &&
+            if ((prior.pending || transition) && write &&
                 (transition || !Visibility{}.covers(f.queue, info.accessMask))) {
                 srcStages |= prior.wStages;
                 srcAccess |= prior.wAccess;
             }
             if (!transition && !srcStages) [[unlikely]]
-                throw std::logic_error("rg barriers: '" + std::string(d_.resources[use.resource].name) +
+                throw std::logic_error("rg barriers: '" + std::string(d_.resources[r].name) +
                                        "' starts the frame with no prior use");
             Barrier& b = barriers[f.barrier];
             b.srcStages |= srcStages;
@@ -657,10 +656,10 @@ private:
         firstUses_.clear();
     }
 
-    void applyEnd(uint32_t u, uint32_t q) {
+    void applyEnd(const ir::Pass& pass, uint32_t u, uint32_t q) {
         const ir::Use& use = d_.uses[u];
         const ir::Resource& r = d_.resources[use.resource];
-        const UseRef& ref = useRefs_[u];
+        const UseRef ref = useRefOf(pass, u);
         // Visibility carries over only for history images (imports restart
         // from their declared state, transients from discarded contents).
         const bool history = r.partner != kNoIndex;
@@ -684,7 +683,13 @@ private:
     void startImport(uint32_t r) {
         const ir::Resource& res = d_.resources[r];
         if (!res.hasInitial) return;
-        const SyncScope s = boundaryScope(res.initial, res.kind);
+        // A state named by an access kind is a use of that kind: its masks
+        // come from the table.
+        UseInfo raw;
+        if (res.initial.isRaw) raw = makeUseInfo(boundaryScope(res.initial, res.kind));
+        const UseInfo& state =
+            res.initial.isRaw ? raw : useInfoOf(res.initial.access, res.kind, res.initial.pipeline);
+        const SyncScope& s = state.scope;
         const uint32_t q = queueIndex(st_.boundaryQueue(res.initial.queue));
         for (uint32_t c = res.cellBase; c < res.cellBase + res.cellCount; ++c) {
             Cell& cell = cells_[c];
@@ -694,8 +699,8 @@ private:
             cell.wQueue = static_cast<int8_t>(q);
             cell.wStages = s.stages;
             cell.wPoint = kPreviousFrame;
-            if (hasWriteAccess(s.access)) {
-                cell.wAccess = writeAccessBits(s.access);
+            if (state.writeAccess) {
+                cell.wAccess = state.writeAccess;
                 cell.wPending = true;
             } else {
                 // A read state: whatever wrote the contents is visible to that
@@ -703,7 +708,7 @@ private:
                 cell.rStages[q] = s.stages;
                 cell.rPoint[q] = kPreviousFrame;
                 if (cell.contents)
-                    cell.addVisible(q, s.stages, s.access);
+                    cell.vis.add(q, state.accessMask);
                 else
                     cell.wQueue = -1;
             }
@@ -772,7 +777,7 @@ private:
             // offsets for many members, so the distinct ones are gathered
             // through a hash table first and only they are sorted.
             OffsetIndex& index = scratch_.offsetIndex;
-            index.reset(2 * list.size());
+            index.reset();
             for (const uint32_t r : list) {
                 const PlannedResource& placed = st_.plan.resources[r];
                 index.insert(placed.offset);
@@ -832,19 +837,31 @@ private:
         }
     }
 
-    // Keeps an aliased transient's priors in ends_ (which transients do not
-    // otherwise use) for resolveFirstUses().
-    void addAliasedPriors(uint32_t r, const LastUses& priors) {
-        const EndState prior = priors.endState();
-        const ir::Resource& res = d_.resources[r];
-        for (uint32_t c = res.cellBase; c < res.cellBase + res.cellCount; ++c) ends_[c] = prior;
-    }
+    // Keeps an aliased transient's priors for resolveFirstUses().
+    void addAliasedPriors(uint32_t r, const LastUses& priors) { aliasedPriors_[r] = priors; }
 
     // The last uses of any subresource of `r`: where the walk left its cells.
     LastUses summary(uint32_t r) const {
         const ir::Resource& res = d_.resources[r];
+        const uint32_t q = queueIndex(st_.plan.resources[r].queue);
         LastUses out;
-        for (uint32_t c = res.cellBase; c < res.cellBase + res.cellCount; ++c) out.add(endOf(cells_[c]));
+        for (uint32_t c = res.cellBase; c < res.cellBase + res.cellCount; ++c) out.merge(lastUsesOf(c, q, r));
+        return out;
+    }
+
+    // Where the walk left cell c of transient r, used on queue q only.
+    LastUses lastUsesOf(uint32_t c, uint32_t q, uint32_t r) const {
+        const Cell& cell = cells_[c];
+        const bool written = cell.wQueue >= 0 && cell.wStages;
+        if (cell.rStages[q ^ 1] || (written && cell.wQueue != static_cast<int8_t>(q))) [[unlikely]]
+            priorsElsewhere(r);
+        LastUses out;
+        out.rStages = cell.rStages[q];
+        if (written) {
+            out.wStages = cell.wStages;
+            out.wAccess = cell.wAccess;
+            out.pending = cell.wPending;
+        }
         return out;
     }
 
@@ -975,8 +992,9 @@ private:
     // next synchronises with them through `s`. Others are made to happen
     // before `s`.
     // `n` arrives value-initialised, as in analyse().
-    void analyseFinal(Need& n, uint32_t c, uint32_t q, const SyncScope& s, VkAccessFlags2 reads, bool texture) {
+    void analyseFinal(Need& n, uint32_t c, uint32_t q, const UseInfo& state, bool texture) {
         const Cell& cell = cells_[c];
+        const SyncScope& s = state.scope;
         n.cell = c;
         n.transition = texture && s.layout != VK_IMAGE_LAYOUT_UNDEFINED && cell.layout != s.layout;
         n.oldLayout = n.transition && !cell.contents ? VK_IMAGE_LAYOUT_UNDEFINED : cell.layout;
@@ -1005,7 +1023,7 @@ private:
         if (cell.wQueue >= 0 && cell.wStages) {
             const bool described = cell.wQueue == static_cast<int8_t>(q) && within(cell.wStages, s.stages) &&
                                    within(cell.wAccess, s.access);
-            const bool unseen = reads && !cell.visible(q, s.stages, reads);
+            const bool unseen = state.reads && !cell.vis.covers(q, state.readMask);
             if ((n.transition && cell.wPending) || (!described && (cell.wPending || unseen)))
                 order(static_cast<uint32_t>(cell.wQueue), cell.wPoint, cell.wStages, cell.wAccess, unseen);
         }
@@ -1071,9 +1089,10 @@ private:
 
     // Turns needs_[first, last) -- one use's cells in mip-major order -- into
     // barriers: runs of layers per mip, merged across mips when runs line up.
-    // `use` is the declared use on queue q (kNoIndex for frame-end states).
+    // `use` is the declared use on queue q with `info` (kNoIndex and null for
+    // frame-end states).
     void emit(uint32_t resource, bool texture, VkImageAspectFlags aspect, const Subresource& range, const SyncScope& s,
-              size_t first, size_t last, uint32_t use, uint32_t q) {
+              size_t first, size_t last, uint32_t use, uint32_t q, const UseInfo* info) {
         std::vector<Barrier>& out = st_.plan.barriers;
         const size_t firstBarrier = out.size();
         const uint32_t layers = texture ? range.layerCount : 1;
@@ -1111,12 +1130,12 @@ private:
                     prev.srcStages |= srcStages;
                     prev.srcAccess |= srcAccess;
                     prev.aliasing = prev.aliasing || aliasing;
-                    noteFirstUses(out.size() - 1, use, q, i, j);
+                    noteFirstUses(out.size() - 1, use, q, info, i, j);
                     i = j;
                     continue;
                 }
             }
-            noteFirstUses(out.size(), use, q, i, j);
+            noteFirstUses(out.size(), use, q, info, i, j);
             Barrier& b = out.emplace_back();
             b.resource = resource;
             b.range = {mip, 1, layer, layerCount};
@@ -1139,10 +1158,10 @@ private:
 
     // Records the first uses among needs_[first, last) of declared use
     // `use` on queue q, merged into barrier `barrier`.
-    void noteFirstUses(size_t barrier, uint32_t use, uint32_t q, size_t first, size_t last) {
+    void noteFirstUses(size_t barrier, uint32_t use, uint32_t q, const UseInfo* info, size_t first, size_t last) {
         for (size_t k = first; k < last; ++k)
             if (needs_[k].firstUse) [[unlikely]]
-                firstUses_.push_back({static_cast<uint32_t>(barrier), needs_[k].cell, use, q});
+                firstUses_.push_back({static_cast<uint32_t>(barrier), needs_[k].cell, use, q, info});
     }
 
     // Whether barrier k waits for resolveFirstUses() (debug logging only).
@@ -1154,7 +1173,7 @@ private:
     void emitOne(uint32_t resource, const UseRef& ref, const Subresource& range, const SyncScope& s, const Need& n,
                  uint32_t use, uint32_t q) {
         if (n.firstUse) [[unlikely]]
-            firstUses_.push_back({static_cast<uint32_t>(st_.plan.barriers.size()), n.cell, use, q});
+            firstUses_.push_back({static_cast<uint32_t>(st_.plan.barriers.size()), n.cell, use, q, ref.info});
         Barrier& b = st_.plan.barriers.emplace_back();
         b.resource = resource;
         b.range = ref.texture ? Subresource{range.baseMip, 1, range.baseLayer, 1} : Subresource{0, 1, 0, 1};
@@ -1178,24 +1197,22 @@ private:
         const ir::Pass& pass = d_.passes[p];
         const uint32_t q = queueIndex(st_.queueOf[p]);
         clearPending();
-        auto analysePass = [&] {
-            needs_.clear();
-            useNeed_.clear();
-            for (uint32_t u = pass.firstUse; u < pass.firstUse + pass.useCount; ++u) {
-                const UseRef& ref = useRefs_[u];
-                useNeed_.push_back(static_cast<uint32_t>(needs_.size()));
-                forCells(ref, d_.uses[u],
-                         [&](uint32_t c) { analyse(needs_.emplace_back(), c, q, *ref.info, ref.writes, ref.texture); });
-            }
-        };
-        analysePass();
+        needs_.clear();
+        useNeed_.clear();
+        refs_.clear();
+        for (uint32_t u = pass.firstUse; u < pass.firstUse + pass.useCount; ++u) {
+            const UseRef& ref = refs_.emplace_back(useRefOf(pass, u));
+            useNeed_.push_back(static_cast<uint32_t>(needs_.size()));
+            forCells(ref, d_.uses[u],
+                     [&](uint32_t c) { analyse(needs_.emplace_back(), c, q, *ref.info, ref.writes, ref.texture); });
+        }
         // A new wait changes only what uses that asked crossQueue() get;
         // whether a use asks depends on its cell alone, so those needs,
         // analysed again in the same order, replay the requests as a
         // second full pass would.
         if (pending_[0].active || pending_[1].active) {
             for (uint32_t i = 0; i < pass.useCount; ++i) {
-                const UseRef& ref = useRefs_[pass.firstUse + i];
+                const UseRef& ref = refs_[i];
                 const size_t last = i + 1 < pass.useCount ? useNeed_[i + 1] : needs_.size();
                 for (size_t k = useNeed_[i]; k < last; ++k) {
                     if (!needs_[k].waits) continue;
@@ -1210,7 +1227,7 @@ private:
 
         st_.barrierFirst[pos] = static_cast<uint32_t>(st_.plan.barriers.size());
         for (uint32_t i = 0; i < pass.useCount; ++i) {
-            const UseRef& ref = useRefs_[pass.firstUse + i];
+            const UseRef& ref = refs_[i];
             const UseInfo& info = *ref.info;
             const SyncScope& s = info.scope;
             const size_t first = useNeed_[i];
@@ -1228,7 +1245,7 @@ private:
             while (firstBarrier < last && !needs_[firstBarrier].barrier) ++firstBarrier;
             if (firstBarrier < last) {
                 const ir::Use& use = d_.uses[pass.firstUse + i];
-                emit(use.resource, ref.texture, ref.aspect, use.range, s, first, last, pass.firstUse + i, q);
+                emit(use.resource, ref.texture, ref.aspect, use.range, s, first, last, pass.firstUse + i, q, ref.info);
             }
             for (size_t k = first; k < last; ++k) update(needs_[k], q, info, ref.writes, now);
         }
@@ -1241,7 +1258,10 @@ private:
         // The imports that end in a state someone cares about, with that
         // state's queue and scope, looked up once.
         std::vector<FinalImport>& targets = scratch_.finalImports;
+        std::vector<UseInfo>& rawFinals = scratch_.rawFinals;
         targets.clear();
+        rawFinals.clear();
+        rawFinals.reserve(imports_.size()); // keeps pointers into it valid
         for (uint32_t r : imports_) {
             const ir::Resource& res = d_.resources[r];
             if (!res.hasFinal) continue;
@@ -1250,8 +1270,9 @@ private:
             FinalImport& target = targets.emplace_back();
             target.resource = r;
             target.queue = queueIndex(st_.boundaryQueue(res.final.queue));
-            target.scope = boundaryScope(res.final, res.kind);
-            target.reads = target.scope.access & ~writeAccessBits(target.scope.access);
+            // A state named by an access kind is a use of that kind: the table has its masks.
+            target.state = res.final.isRaw ? &rawFinals.emplace_back(makeUseInfo(boundaryScope(res.final, res.kind)))
+                                           : &useInfoOf(res.final.access, res.kind, res.final.pipeline);
         }
         for (uint32_t qi = 0; qi < kQueueCount; ++qi) {
             const auto q = static_cast<Queue>(qi);
@@ -1263,9 +1284,8 @@ private:
                 const ir::Resource& res = d_.resources[target.resource];
                 const bool texture = res.kind == ResourceKind::Texture;
                 const auto first = static_cast<uint32_t>(needs_.size());
-                forCells(res, wholeOf(res), [&](uint32_t c) {
-                    analyseFinal(needs_.emplace_back(), c, qi, target.scope, target.reads, texture);
-                });
+                forCells(res, wholeOf(res),
+                         [&](uint32_t c) { analyseFinal(needs_.emplace_back(), c, qi, *target.state, texture); });
                 finals_.push_back({&target, first, static_cast<uint32_t>(needs_.size())});
             }
             // As in walkPass(): a new wait changes only the needs that asked
@@ -1277,7 +1297,7 @@ private:
                         if (!needs_[k].waits) continue;
                         const uint32_t cell = needs_[k].cell;
                         needs_[k] = Need{};
-                        analyseFinal(needs_[k], cell, qi, f.target->scope, f.target->reads, texture);
+                        analyseFinal(needs_[k], cell, qi, *f.target->state, texture);
                     }
                 }
             }
@@ -1294,8 +1314,8 @@ private:
                 const uint32_t r = f.target->resource;
                 const ir::Resource& res = d_.resources[r];
                 const bool texture = res.kind == ResourceKind::Texture;
-                emit(r, texture, texture ? st_.plan.resources[r].aspect : 0, wholeOf(res), f.target->scope,
-                     f.firstNeed, f.endNeed, kNoIndex, qi);
+                emit(r, texture, texture ? st_.plan.resources[r].aspect : 0, wholeOf(res), f.target->state->scope,
+                     f.firstNeed, f.endNeed, kNoIndex, qi, nullptr);
             }
             batches_.setEndBarriers(q, firstBarrier, static_cast<uint32_t>(st_.plan.barriers.size()) - firstBarrier);
         }
@@ -1318,13 +1338,15 @@ private:
     std::vector<Cell>& cells_ = scratch_.cells;
     std::vector<EndState>& ends_ = scratch_.ends;
     std::vector<Visibility>& endSeen_ = scratch_.endSeen;     // history cells: visibility at the frame's end
-    std::vector<UseRef>& useRefs_ = scratch_.useRefs; // per declared use (scheduled ones filled in)
+    std::vector<uint8_t>& early_ = scratch_.early;
+    std::vector<UseRef>& refs_ = scratch_.passRefs; // the walked pass's uses, in order
     std::vector<UseInfo>& mergedInfo_ = scratch_.mergedInfo;
     std::vector<Need>& needs_ = scratch_.needs;
     std::vector<uint32_t>& useNeed_ = scratch_.useNeed;
     std::vector<Final>& finals_ = scratch_.finals;
     std::vector<uint32_t>& imports_ = scratch_.imports;
     std::vector<FirstUse>& firstUses_ = scratch_.firstUses;
+    std::vector<LastUses>& aliasedPriors_ = scratch_.aliasedPriors;
     WaitRequest pending_[kQueueCount];
     uint32_t pos_ = 0; // schedule position of the pass being walked
 };
