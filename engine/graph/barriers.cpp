@@ -213,12 +213,12 @@ struct Visibility {
 struct Cell {
     VkImageLayout layout = VK_IMAGE_LAYOUT_UNDEFINED;
     bool contents = false;
-    bool aliased = false;  // prior accesses include another resource on these bytes
-    // A transient used on one queue, not used yet this frame: its prior
-    // accesses (the previous frame's last uses of its bytes) are not known
-    // until the walk has seen those, so the first use's barrier is placed
-    // with the priors left out and completed by resolveFirstUses().
-    bool priorLater = false;
+    // Not used yet this frame, and its prior accesses (the previous frame's
+    // last uses of its bytes) are not known until the walk has seen those:
+    // the first use's barrier is placed with the priors (and the aliasing
+    // flag) left out and completed by resolveFirstUses(). A transient on
+    // one queue, the default: the frame start sets every other cell.
+    bool priorLater = true;
     bool wPending = false; // a later write must still be ordered after the write (no read came between)
     int8_t wQueue = -1;    // -1: no write to synchronise with
     TimelinePoint wPoint;
@@ -327,7 +327,6 @@ struct Need {
     bool transition;
     bool barrier;
     bool rawByBarrier;
-    bool aliased;
     bool waits;    // asked crossQueue(): the only part of analyse() that reads pending_
     bool firstUse; // of a priorLater cell: the barrier's priors come later
 };
@@ -364,7 +363,6 @@ struct FinalImport {
 struct UseRef {
     const UseInfo* info = nullptr;
     uint32_t cell = 0;              // first cell of the use's range
-    VkImageAspectFlags aspect = 0;  // textures: for the barriers
     bool texture = false;
     bool single = false; // the range is one cell
     bool writes = false;
@@ -450,6 +448,7 @@ struct Scratch {
     std::vector<UseInfo> rawFinals; // final states given as raw masks
     std::vector<uint32_t> deferred;
     std::vector<uint32_t> historyCurrents;
+    std::vector<uint32_t> earlyList; // the resources early marks
     std::vector<uint8_t> early; // per resource: starts from its own end, known before the walk
     std::vector<UseRef> passRefs; // the walked pass's uses
     std::vector<uint32_t> imports;
@@ -499,7 +498,6 @@ private:
         }
         ref.texture = r.kind == ResourceKind::Texture;
         ref.cell = ref.texture ? ir::cellOf(r, use.range.baseMip, use.range.baseLayer) : r.cellBase;
-        ref.aspect = ref.texture ? st_.plan.resources[use.resource].aspect : 0;
         ref.single = !ref.texture || (use.range.mipCount == 1 && use.range.layerCount == 1);
         ref.writes = use.writes;
         return ref;
@@ -514,85 +512,80 @@ private:
         mergedInfo_.clear();
         mergedInfo_.reserve(2 * d_.uses.size());
 
-        // Resources that start from where they end, known before the walk:
-        // history halves (each starts from the other's end, visibility
-        // included) and transients on both queues (their priors may need a
-        // wait on the other queue, which changes batches). Only their cells'
-        // ends_ and endSeen_ are used, so only those are reset.
+        // Imports start from their declared state. Resources that start from
+        // where they end, known before the walk: history halves (each starts
+        // from the other's end, visibility included) and transients on both
+        // queues (their priors may need a wait on the other queue, which
+        // changes batches). Only their cells' ends_ and endSeen_ are used, so
+        // only those are reset. Every other transient is priorLater, as its
+        // cells already are.
         ends_.resize(cellCount);
         endSeen_.resize(cellCount);
         early_.assign(d_.resources.size(), 0);
+        std::vector<uint32_t>& early = scratch_.earlyList;
         std::vector<uint32_t>& currents = scratch_.historyCurrents;
+        early.clear();
         currents.clear();
-        bool anyEarly = false;
+        imports_.clear();
         for (uint32_t r = 0; r < d_.resources.size(); ++r) {
             const ir::Resource& res = d_.resources[r];
-            const bool history = res.partner != kNoIndex;
-            if (!history && !(res.origin == ir::Origin::Transient && st_.lifetimes[r].crossQueue())) continue;
+            switch (res.origin) {
+                case ir::Origin::Imported:
+                    imports_.push_back(r);
+                    startImport(r);
+                    continue;
+                case ir::Origin::Transient:
+                    if (!st_.lifetimes[r].crossQueue()) continue;
+                    break;
+                case ir::Origin::HistoryCurrent:
+                    currents.push_back(r);
+                    break;
+                case ir::Origin::HistoryPrevious:
+                    break;
+            }
             early_[r] = 1;
-            anyEarly = true;
-            if (res.origin == ir::Origin::HistoryCurrent) currents.push_back(r);
+            early.push_back(r);
             for (uint32_t c = res.cellBase; c < res.cellBase + res.cellCount; ++c) {
                 ends_[c] = EndState{};
                 endSeen_[c] = Visibility{};
             }
         }
+        if (early.empty()) return;
 
         // What the frame leaves behind in them, use by use. A `previous` half
         // starts from what its partner ended in, so it goes second.
-        if (anyEarly) {
-            std::vector<uint32_t>& deferred = scratch_.deferred;
-            deferred.clear();
-            for (uint32_t pos = 0; pos < st_.order.size(); ++pos) {
-                const uint32_t p = st_.order[pos];
-                const ir::Pass& pass = d_.passes[p];
-                for (uint32_t u = pass.firstUse; u < pass.firstUse + pass.useCount; ++u) {
-                    const uint32_t r = d_.uses[u].resource;
-                    if (!early_[r]) continue;
-                    if (d_.resources[r].origin == ir::Origin::HistoryPrevious) {
-                        deferred.push_back(u);
-                        deferred.push_back(pos);
-                        continue;
-                    }
-                    applyEnd(pass, u, queueIndex(st_.queueOf[p]));
+        std::vector<uint32_t>& deferred = scratch_.deferred;
+        deferred.clear();
+        for (uint32_t pos = 0; pos < st_.order.size(); ++pos) {
+            const uint32_t p = st_.order[pos];
+            const ir::Pass& pass = d_.passes[p];
+            for (uint32_t u = pass.firstUse; u < pass.firstUse + pass.useCount; ++u) {
+                const uint32_t r = d_.uses[u].resource;
+                if (!early_[r]) continue;
+                if (d_.resources[r].origin == ir::Origin::HistoryPrevious) {
+                    deferred.push_back(u);
+                    deferred.push_back(pos);
+                    continue;
                 }
-            }
-            for (const uint32_t r : currents) seedHistoryPrevious(r);
-            for (size_t i = 0; i < deferred.size(); i += 2) {
-                const uint32_t p = st_.order[deferred[i + 1]];
-                applyEnd(d_.passes[p], deferred[i], queueIndex(st_.queueOf[p]));
+                applyEnd(pass, u, queueIndex(st_.queueOf[p]));
             }
         }
+        for (const uint32_t r : currents) seedHistoryPrevious(r);
+        for (size_t i = 0; i < deferred.size(); i += 2) {
+            const uint32_t p = st_.order[deferred[i + 1]];
+            applyEnd(d_.passes[p], deferred[i], queueIndex(st_.queueOf[p]));
+        }
 
-        imports_.clear();
-        for (uint32_t r = 0; r < d_.resources.size(); ++r) {
-            switch (d_.resources[r].origin) {
-                case ir::Origin::Imported:
-                    imports_.push_back(r);
-                    startImport(r);
-                    break;
-                case ir::Origin::HistoryPrevious:
-                case ir::Origin::HistoryCurrent:
-                    startHistory(r);
-                    break;
-                case ir::Origin::Transient: {
-                    // Its own bytes: last used by itself in the previous
-                    // frame; shared bytes: by any resource on them (see
-                    // startAliased). Both queues: known now (its bytes are
-                    // its own). One queue: known once the walk is over.
-                    if (!st_.lifetimes[r].used()) break;
-                    const ir::Resource& res = d_.resources[r];
-                    const bool both = early_[r] != 0;
-                    for (uint32_t c = res.cellBase; c < res.cellBase + res.cellCount; ++c) {
-                        if (both) {
-                            addPrior(cells_[c], ends_[c]);
-                            continue;
-                        }
-                        cells_[c].priorLater = true;
-                        cells_[c].aliased = st_.aliased[r] != 0;
-                    }
-                    break;
-                }
+        for (const uint32_t r : early) {
+            const ir::Resource& res = d_.resources[r];
+            if (res.origin != ir::Origin::Transient) {
+                startHistory(r);
+                continue;
+            }
+            // Its bytes are its own (no aliasing across queues).
+            for (uint32_t c = res.cellBase; c < res.cellBase + res.cellCount; ++c) {
+                cells_[c].priorLater = false;
+                addPrior(cells_[c], ends_[c]);
             }
         }
     }
@@ -644,6 +637,7 @@ private:
             Barrier& b = barriers[f.barrier];
             b.srcStages |= srcStages;
             b.srcAccess |= srcAccess;
+            b.aliasing = b.aliasing || st_.aliased[r];
         }
         if (st_.log) {
             for (size_t i = 0; i < firstUses_.size(); ++i) {
@@ -682,6 +676,7 @@ private:
 
     void startImport(uint32_t r) {
         const ir::Resource& res = d_.resources[r];
+        for (uint32_t c = res.cellBase; c < res.cellBase + res.cellCount; ++c) cells_[c].priorLater = false;
         if (!res.hasInitial) return;
         // A state named by an access kind is a use of that kind: its masks
         // come from the table.
@@ -731,6 +726,7 @@ private:
             const uint32_t fromCell = fromPartner ? partner.cellBase + i : res.cellBase + i;
             const EndState& from = ends_[fromCell];
             Cell& cell = cells_[res.cellBase + i];
+            cell.priorLater = false;
             cell.contents = true;
             if (!from.touched) continue;
             cell.layout = from.layout;
@@ -915,7 +911,7 @@ private:
     }
 
     // `n` arrives value-initialised (a fresh need, or one reset by the caller).
-    void analyse(Need& n, uint32_t c, uint32_t q, const UseInfo& use, bool writes, bool texture) {
+    [[gnu::always_inline]] void analyse(Need& n, uint32_t c, uint32_t q, const UseInfo& use, bool writes, bool texture) {
         const Cell& cell = cells_[c];
         const SyncScope& s = use.scope;
         if (cell.priorLater) {
@@ -926,7 +922,6 @@ private:
             n.cell = c;
             n.transition = texture && cell.layout != s.layout;
             n.oldLayout = VK_IMAGE_LAYOUT_UNDEFINED;
-            n.aliased = cell.aliased;
             n.barrier = true;
             n.firstUse = true;
             return;
@@ -934,7 +929,6 @@ private:
         n.cell = c;
         n.transition = texture && cell.layout != s.layout;
         n.oldLayout = n.transition && !cell.contents ? VK_IMAGE_LAYOUT_UNDEFINED : cell.layout;
-        n.aliased = cell.aliased;
         const bool writeOp = writes || n.transition;
         const VkPipelineStageFlags2 own = s.stages ? s.stages : VK_PIPELINE_STAGE_2_ALL_COMMANDS_BIT;
 
@@ -1030,7 +1024,7 @@ private:
         n.barrier = n.transition || n.srcStages != 0;
     }
 
-    void update(const Need& n, uint32_t q, const UseInfo& use, bool writes, TimelinePoint now) {
+    [[gnu::always_inline]] void update(const Need& n, uint32_t q, const UseInfo& use, bool writes, TimelinePoint now) {
         Cell& cell = cells_[n.cell];
         const SyncScope& s = use.scope;
         if (n.firstUse) [[unlikely]] {
@@ -1061,7 +1055,6 @@ private:
             cell.rOrdered[0] = cell.rOrdered[1] = 0;
             cell.clearVisible();
             cell.vis.add(q, use.accessMask);
-            cell.aliased = false;
         } else if (n.rawByBarrier) {
             cell.vis.add(q, use.readMask);
         }
@@ -1076,7 +1069,6 @@ private:
             cell.rOrdered[0] = cell.rOrdered[1] = 0;
             cell.clearVisible();
             cell.contents = true;
-            cell.aliased = false;
         } else {
             cell.rStages[q] |= s.stages;
             cell.rPoint[q] = now;
@@ -1108,14 +1100,12 @@ private:
             const uint32_t layer = texture ? range.baseLayer + offset % layers : 0;
             VkPipelineStageFlags2 srcStages = n.srcStages;
             VkAccessFlags2 srcAccess = n.srcAccess;
-            bool aliasing = n.aliased;
             uint32_t layerCount = 1;
             size_t j = i + 1;
             while (j < last && (j - first) / layers == offset / layers && needs_[j].barrier &&
                    needs_[j].oldLayout == n.oldLayout) {
                 srcStages |= needs_[j].srcStages;
                 srcAccess |= needs_[j].srcAccess;
-                aliasing = aliasing || needs_[j].aliased;
                 ++layerCount;
                 ++j;
             }
@@ -1129,7 +1119,6 @@ private:
                     ++prev.range.mipCount;
                     prev.srcStages |= srcStages;
                     prev.srcAccess |= srcAccess;
-                    prev.aliasing = prev.aliasing || aliasing;
                     noteFirstUses(out.size() - 1, use, q, info, i, j);
                     i = j;
                     continue;
@@ -1146,7 +1135,7 @@ private:
             b.dstAccess = s.access;
             b.oldLayout = oldLayout;
             b.newLayout = texture ? s.layout : VK_IMAGE_LAYOUT_UNDEFINED;
-            b.aliasing = aliasing;
+            b.aliasing = false; // set by resolveFirstUses() where the bytes are shared
             i = j;
         }
         if (st_.log) {
@@ -1177,14 +1166,14 @@ private:
         Barrier& b = st_.plan.barriers.emplace_back();
         b.resource = resource;
         b.range = ref.texture ? Subresource{range.baseMip, 1, range.baseLayer, 1} : Subresource{0, 1, 0, 1};
-        b.aspect = ref.aspect;
+        b.aspect = ref.texture ? st_.plan.resources[resource].aspect : 0; // read only when a barrier needs it
         b.srcStages = n.srcStages;
         b.srcAccess = n.srcAccess;
         b.dstStages = s.stages;
         b.dstAccess = s.access;
         b.oldLayout = ref.texture ? n.oldLayout : VK_IMAGE_LAYOUT_UNDEFINED;
         b.newLayout = ref.texture ? s.layout : VK_IMAGE_LAYOUT_UNDEFINED;
-        b.aliasing = n.aliased;
+        b.aliasing = false; // set by resolveFirstUses() where the bytes are shared
         if (st_.log && !n.firstUse) {
             const ir::Resource& r = d_.resources[resource];
             spdlog::debug("rg barriers: {}", describeBarrier(r.name, b, r.kind));
@@ -1245,7 +1234,8 @@ private:
             while (firstBarrier < last && !needs_[firstBarrier].barrier) ++firstBarrier;
             if (firstBarrier < last) {
                 const ir::Use& use = d_.uses[pass.firstUse + i];
-                emit(use.resource, ref.texture, ref.aspect, use.range, s, first, last, pass.firstUse + i, q, ref.info);
+                emit(use.resource, ref.texture, ref.texture ? st_.plan.resources[use.resource].aspect : 0, use.range, s,
+                     first, last, pass.firstUse + i, q, ref.info);
             }
             for (size_t k = first; k < last; ++k) update(needs_[k], q, info, ref.writes, now);
         }
