@@ -1125,17 +1125,8 @@ private:
                 }
             }
             noteFirstUses(out.size(), use, q, info, i, j);
-            Barrier& b = out.emplace_back();
-            b.resource = resource;
-            b.range = {mip, 1, layer, layerCount};
-            b.aspect = aspect;
-            b.srcStages = srcStages;
-            b.srcAccess = srcAccess;
-            b.dstStages = s.stages;
-            b.dstAccess = s.access;
-            b.oldLayout = oldLayout;
-            b.newLayout = texture ? s.layout : VK_IMAGE_LAYOUT_UNDEFINED;
-            b.aliasing = false; // set by resolveFirstUses() where the bytes are shared
+            out.emplace_back(resource, Subresource{mip, 1, layer, layerCount}, aspect, srcStages, srcAccess, s.stages,
+                             s.access, oldLayout, texture ? s.layout : VK_IMAGE_LAYOUT_UNDEFINED, false);
             i = j;
         }
         if (st_.log) {
@@ -1163,17 +1154,14 @@ private:
                  uint32_t use, uint32_t q) {
         if (n.firstUse) [[unlikely]]
             firstUses_.push_back({static_cast<uint32_t>(st_.plan.barriers.size()), n.cell, use, q, ref.info});
-        Barrier& b = st_.plan.barriers.emplace_back();
-        b.resource = resource;
-        b.range = ref.texture ? Subresource{range.baseMip, 1, range.baseLayer, 1} : Subresource{0, 1, 0, 1};
-        b.aspect = ref.texture ? st_.plan.resources[resource].aspect : 0; // read only when a barrier needs it
-        b.srcStages = n.srcStages;
-        b.srcAccess = n.srcAccess;
-        b.dstStages = s.stages;
-        b.dstAccess = s.access;
-        b.oldLayout = ref.texture ? n.oldLayout : VK_IMAGE_LAYOUT_UNDEFINED;
-        b.newLayout = ref.texture ? s.layout : VK_IMAGE_LAYOUT_UNDEFINED;
-        b.aliasing = false; // set by resolveFirstUses() where the bytes are shared
+        // Constructed from its fields: value-initialising it first would store
+        // every field twice. The aspect is read only when a barrier needs it;
+        // the aliasing flag is set by resolveFirstUses() where bytes are shared.
+        const Barrier& b = st_.plan.barriers.emplace_back(
+            resource, ref.texture ? Subresource{range.baseMip, 1, range.baseLayer, 1} : Subresource{0, 1, 0, 1},
+            ref.texture ? st_.plan.resources[resource].aspect : 0, n.srcStages, n.srcAccess, s.stages, s.access,
+            ref.texture ? n.oldLayout : VK_IMAGE_LAYOUT_UNDEFINED, ref.texture ? s.layout : VK_IMAGE_LAYOUT_UNDEFINED,
+            false);
         if (st_.log && !n.firstUse) {
             const ir::Resource& r = d_.resources[resource];
             spdlog::debug("rg barriers: {}", describeBarrier(r.name, b, r.kind));
@@ -1192,9 +1180,14 @@ private:
         for (uint32_t u = pass.firstUse; u < pass.firstUse + pass.useCount; ++u) {
             const UseRef& ref = refs_.emplace_back(useRefOf(pass, u));
             useNeed_.push_back(static_cast<uint32_t>(needs_.size()));
-            forCells(ref, d_.uses[u],
-                     [&](uint32_t c) { analyse(needs_.emplace_back(), c, q, *ref.info, ref.writes, ref.texture); });
+            // Most uses name one cell: analysed directly, not through forCells' callback.
+            if (ref.single)
+                analyse(needs_.emplace_back(), ref.cell, q, *ref.info, ref.writes, ref.texture);
+            else
+                forCells(d_.resources[d_.uses[u].resource], d_.uses[u].range,
+                         [&](uint32_t c) { analyse(needs_.emplace_back(), c, q, *ref.info, ref.writes, ref.texture); });
         }
+        useNeed_.push_back(static_cast<uint32_t>(needs_.size())); // use i's needs end where use i + 1's begin
         // A new wait changes only what uses that asked crossQueue() get;
         // whether a use asks depends on its cell alone, so those needs,
         // analysed again in the same order, replay the requests as a
@@ -1202,8 +1195,7 @@ private:
         if (pending_[0].active || pending_[1].active) {
             for (uint32_t i = 0; i < pass.useCount; ++i) {
                 const UseRef& ref = refs_[i];
-                const size_t last = i + 1 < pass.useCount ? useNeed_[i + 1] : needs_.size();
-                for (size_t k = useNeed_[i]; k < last; ++k) {
+                for (size_t k = useNeed_[i]; k < useNeed_[i + 1]; ++k) {
                     if (!needs_[k].waits) continue;
                     const uint32_t cell = needs_[k].cell;
                     needs_[k] = Need{};
@@ -1220,7 +1212,7 @@ private:
             const UseInfo& info = *ref.info;
             const SyncScope& s = info.scope;
             const size_t first = useNeed_[i];
-            const size_t last = i + 1 < pass.useCount ? useNeed_[i + 1] : needs_.size();
+            const size_t last = useNeed_[i + 1];
             if (ref.single) {
                 const Need& n = needs_[first];
                 if (n.barrier)
