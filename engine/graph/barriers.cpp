@@ -353,8 +353,10 @@ struct Final {
 
 struct FinalImport {
     uint32_t resource;
-    uint32_t queue;        // boundary queue of its final state
-    const UseInfo* state;  // the final state as a use: in the table, or in rawFinals
+    uint32_t cellBase; // its cells, all of them: [cellBase, +cellCount)
+    uint32_t cellCount;
+    bool texture;
+    const UseInfo* state; // the final state as a use: in the table, or in rawFinals
 };
 
 // A declared use as the walk reads it, resolved once per compile: the walk
@@ -444,7 +446,7 @@ struct Scratch {
     std::vector<Need> needs;
     std::vector<uint32_t> useNeed;
     std::vector<Final> finals;
-    std::vector<FinalImport> finalImports;
+    std::vector<FinalImport> finalImports[kQueueCount]; // by the final state's queue
     std::vector<UseInfo> rawFinals; // final states given as raw masks
     std::vector<uint32_t> deferred;
     std::vector<uint32_t> historyCurrents;
@@ -1237,11 +1239,12 @@ private:
     // ---- Frame end --------------------------------------------------------------
 
     void finalStates() {
-        // The imports that end in a state someone cares about, with that
-        // state's queue and scope, looked up once.
-        std::vector<FinalImport>& targets = scratch_.finalImports;
+        // The imports that end in a state someone cares about, by the queue
+        // of that state, with its scope looked up once.
+        std::vector<FinalImport>* targets = scratch_.finalImports;
         std::vector<UseInfo>& rawFinals = scratch_.rawFinals;
-        targets.clear();
+        targets[0].clear();
+        targets[1].clear();
         rawFinals.clear();
         rawFinals.reserve(imports_.size()); // keeps pointers into it valid
         for (uint32_t r : imports_) {
@@ -1249,9 +1252,11 @@ private:
             if (!res.hasFinal) continue;
             if (!res.final.isRaw && res.final.access == Access::None) continue; // the caller does not care
             if (!st_.lifetimes[r].used() && res.hasInitial && res.initial == res.final) continue;
-            FinalImport& target = targets.emplace_back();
+            FinalImport& target = targets[queueIndex(st_.boundaryQueue(res.final.queue))].emplace_back();
             target.resource = r;
-            target.queue = queueIndex(st_.boundaryQueue(res.final.queue));
+            target.cellBase = res.cellBase;
+            target.cellCount = res.cellCount;
+            target.texture = res.kind == ResourceKind::Texture;
             // A state named by an access kind is a use of that kind: the table has its masks.
             target.state = res.final.isRaw ? &rawFinals.emplace_back(makeUseInfo(boundaryScope(res.final, res.kind)))
                                            : &useInfoOf(res.final.access, res.kind, res.final.pipeline);
@@ -1261,25 +1266,30 @@ private:
             clearPending();
             finals_.clear();
             needs_.clear();
-            for (const FinalImport& target : targets) {
-                if (target.queue != qi) continue;
-                const ir::Resource& res = d_.resources[target.resource];
-                const bool texture = res.kind == ResourceKind::Texture;
+            for (const FinalImport& target : targets[qi]) {
+                // Every cell, mip-major, is the run of cells from cellBase.
                 const auto first = static_cast<uint32_t>(needs_.size());
-                forCells(res, wholeOf(res),
-                         [&](uint32_t c) { analyseFinal(needs_.emplace_back(), c, qi, *target.state, texture); });
-                finals_.push_back({&target, first, static_cast<uint32_t>(needs_.size())});
+                bool matters = false;
+                for (uint32_t c = target.cellBase; c < target.cellBase + target.cellCount; ++c) {
+                    Need& n = needs_.emplace_back();
+                    analyseFinal(n, c, qi, *target.state, target.texture);
+                    matters = matters || n.barrier || n.waits;
+                }
+                // Most imports end as the frame left them: nothing to keep.
+                if (matters)
+                    finals_.push_back({&target, first, static_cast<uint32_t>(needs_.size())});
+                else
+                    needs_.resize(first);
             }
             // As in walkPass(): a new wait changes only the needs that asked
             // for one, and analysing those again in order replays the requests.
             if (pending_[0].active || pending_[1].active) {
                 for (const Final& f : finals_) {
-                    const bool texture = d_.resources[f.target->resource].kind == ResourceKind::Texture;
                     for (uint32_t k = f.firstNeed; k < f.endNeed; ++k) {
                         if (!needs_[k].waits) continue;
                         const uint32_t cell = needs_[k].cell;
                         needs_[k] = Need{};
-                        analyseFinal(needs_[k], cell, qi, *f.target->state, texture);
+                        analyseFinal(needs_[k], cell, qi, *f.target->state, f.target->texture);
                     }
                 }
             }
@@ -1294,10 +1304,9 @@ private:
             const auto firstBarrier = static_cast<uint32_t>(st_.plan.barriers.size());
             for (const Final& f : finals_) {
                 const uint32_t r = f.target->resource;
-                const ir::Resource& res = d_.resources[r];
-                const bool texture = res.kind == ResourceKind::Texture;
-                emit(r, texture, texture ? st_.plan.resources[r].aspect : 0, wholeOf(res), f.target->state->scope,
-                     f.firstNeed, f.endNeed, kNoIndex, qi, nullptr);
+                const bool texture = f.target->texture;
+                emit(r, texture, texture ? st_.plan.resources[r].aspect : 0, wholeOf(d_.resources[r]),
+                     f.target->state->scope, f.firstNeed, f.endNeed, kNoIndex, qi, nullptr);
             }
             batches_.setEndBarriers(q, firstBarrier, static_cast<uint32_t>(st_.plan.barriers.size()) - firstBarrier);
         }
