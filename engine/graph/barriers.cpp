@@ -1039,6 +1039,22 @@ private:
                                        std::string(d_.passes[st_.order[pos_]].name) + "' reads it");
             cell.priorLater = false;
         }
+        if (writes) {
+            // A write replaces all the cell knew but its layout: what a
+            // transition, a barrier or a wait made visible or ordered came
+            // before it.
+            if (n.transition) cell.layout = s.layout;
+            cell.wQueue = static_cast<int8_t>(q);
+            cell.wPoint = now;
+            cell.wStages = s.stages;
+            cell.wAccess = use.writeAccess;
+            cell.wPending = true;
+            cell.rStages[0] = cell.rStages[1] = 0;
+            cell.rOrdered[0] = cell.rOrdered[1] = 0;
+            cell.clearVisible();
+            cell.contents = true;
+            return;
+        }
         // A barrier chained from a wait orders every read of the other queue
         // that wait reached, not only the hazard it was placed for.
         const uint32_t other = queueIndex(otherQueue(static_cast<Queue>(q)));
@@ -1061,22 +1077,10 @@ private:
             cell.vis.add(q, use.readMask);
         }
         if (n.visibleByWait) cell.addVisibleToAll(q, n.visibleByWait);
-        if (writes) {
-            cell.wQueue = static_cast<int8_t>(q);
-            cell.wPoint = now;
-            cell.wStages = s.stages;
-            cell.wAccess = use.writeAccess;
-            cell.wPending = true;
-            cell.rStages[0] = cell.rStages[1] = 0;
-            cell.rOrdered[0] = cell.rOrdered[1] = 0;
-            cell.clearVisible();
-            cell.contents = true;
-        } else {
-            cell.rStages[q] |= s.stages;
-            cell.rPoint[q] = now;
-            cell.rOrdered[other] = 0; // the new read is not ordered on the other queue yet
-            cell.wPending = false;
-        }
+        cell.rStages[q] |= s.stages;
+        cell.rPoint[q] = now;
+        cell.rOrdered[other] = 0; // the new read is not ordered on the other queue yet
+        cell.wPending = false;
     }
 
     // ---- Emission -------------------------------------------------------------
