@@ -932,18 +932,6 @@ private:
         n.transition = texture && cell.layout != s.layout;
         n.oldLayout = n.transition && !cell.contents ? VK_IMAGE_LAYOUT_UNDEFINED : cell.layout;
         const bool writeOp = writes || n.transition;
-        const VkPipelineStageFlags2 own = s.stages ? s.stages : VK_PIPELINE_STAGE_2_ALL_COMMANDS_BIT;
-
-        auto viaOtherQueue = [&](uint32_t from, TimelinePoint point, bool makesVisible) {
-            n.waits = true;
-            const VkPipelineStageFlags2 waited = crossQueue(q, from, point, s.stages);
-            if (n.transition || !within(own, waited)) {
-                n.srcStages |= waited; // chain through the wait
-                n.rawByBarrier = n.rawByBarrier || makesVisible;
-            } else if (makesVisible) {
-                n.visibleByWait |= waited;
-            }
-        };
 
         // Read after write.
         if (use.reads && cell.wQueue >= 0 && cell.wStages && !cell.vis.covers(q, use.readMask)) {
@@ -952,7 +940,7 @@ private:
                 n.srcAccess |= cell.wAccess;
                 n.rawByBarrier = true;
             } else {
-                viaOtherQueue(static_cast<uint32_t>(cell.wQueue), cell.wPoint, true);
+                viaOtherQueue(n, q, s, static_cast<uint32_t>(cell.wQueue), cell.wPoint, true);
             }
         }
         if (writeOp) {
@@ -961,8 +949,8 @@ private:
                 if (!cell.rStages[rq]) continue;
                 if (rq == q)
                     n.srcStages |= cell.rStages[rq];
-                else if (n.transition || !within(own, cell.rOrdered[q]))
-                    viaOtherQueue(rq, cell.rPoint[rq], false);
+                else if (n.transition || !within(ownStages(s), cell.rOrdered[q]))
+                    viaOtherQueue(n, q, s, rq, cell.rPoint[rq], false);
             }
             // Write after write. A layout transition names the last write
             // in its first scope even when an earlier barrier already made
@@ -975,11 +963,31 @@ private:
                     n.srcStages |= cell.wStages;
                     n.srcAccess |= cell.wAccess;
                 } else {
-                    viaOtherQueue(static_cast<uint32_t>(cell.wQueue), cell.wPoint, false);
+                    viaOtherQueue(n, q, s, static_cast<uint32_t>(cell.wQueue), cell.wPoint, false);
                 }
             }
         }
         n.barrier = n.transition || n.srcStages != 0;
+    }
+
+    // The stages a use's own work runs in (ALL_COMMANDS for a use of none).
+    static VkPipelineStageFlags2 ownStages(const SyncScope& s) {
+        return s.stages ? s.stages : VK_PIPELINE_STAGE_2_ALL_COMMANDS_BIT;
+    }
+
+    // analyse()'s dependency on a prior access on the other queue, `from`,
+    // at `point`: through a wait, chained into a barrier when the wait's
+    // stages do not cover the use's. Out of line: most uses never get here.
+    [[gnu::noinline]] void viaOtherQueue(Need& n, uint32_t q, const SyncScope& s, uint32_t from, TimelinePoint point,
+                                         bool makesVisible) {
+        n.waits = true;
+        const VkPipelineStageFlags2 waited = crossQueue(q, from, point, s.stages);
+        if (n.transition || !within(ownStages(s), waited)) {
+            n.srcStages |= waited; // chain through the wait
+            n.rawByBarrier = n.rawByBarrier || makesVisible;
+        } else if (makesVisible) {
+            n.visibleByWait |= waited;
+        }
     }
 
     // The frame's last word on an import: it ends in `s` on queue q, as if a
