@@ -183,12 +183,19 @@ void aliasMemory(CompileState& st) {
     keys.clear();
     s.all.clear();
 
+    // Local pointers: the stores into the plan could alias any vector's
+    // data pointer as far as the compiler knows.
+    const ir::Resource* const resources = d.resources.data();
+    const Lifetime* const lifetimes = st.lifetimes.data();
+    PlannedResource* const planned = plan.resources.data();
+    const auto resourceCount = static_cast<uint32_t>(d.resources.size());
+    uint32_t heapOf = 0; // of the previous transient: most share its heap
     TransientDescription desc;
-    for (uint32_t r = 0; r < d.resources.size(); ++r) {
-        const ir::Resource& res = d.resources[r];
-        const Lifetime& life = st.lifetimes[r];
+    for (uint32_t r = 0; r < resourceCount; ++r) {
+        const ir::Resource& res = resources[r];
+        const Lifetime& life = lifetimes[r];
         if (res.origin != ir::Origin::Transient || !life.used()) continue;
-        PlannedResource& out = plan.resources[r];
+        PlannedResource& out = planned[r];
         desc.name = res.name;
         desc.kind = res.kind;
         desc.texture = res.texture;
@@ -201,15 +208,25 @@ void aliasMemory(CompileState& st) {
         out.alignment = alignment;
         plan.stats.transientBytes += out.size;
 
+        // The heaps are described as their first members turn up.
         const HeapKey key{life.crossQueue() ? 2u : queueIndex(out.queue), req.memoryTypeBits};
-        auto it = std::find(keys.begin(), keys.end(), key);
-        if (it == keys.end()) {
-            keys.push_back(key);
-            it = keys.end() - 1;
+        if (heapOf == keys.size() || !(keys[heapOf] == key)) {
+            heapOf = static_cast<uint32_t>(std::find(keys.begin(), keys.end(), key) - keys.begin());
+            if (heapOf == keys.size()) {
+                keys.push_back(key);
+                MemoryHeap& heap = plan.heaps.emplace_back();
+                heap.queue = key.queueOrShared == 1 ? Queue::AsyncCompute : Queue::Graphics;
+                heap.crossQueue = key.queueOrShared == 2;
+                heap.memoryTypeBits = key.memoryTypeBits;
+            }
         }
-        const auto h = static_cast<uint32_t>(it - keys.begin());
-        out.heap = h;
-        s.all.push_back({r, life.first, life.last, h, alignUp(out.size, granularity), std::max(alignment, granularity)});
+        MemoryHeap& heap = plan.heaps[heapOf];
+        const uint64_t placedAlignment = std::max(alignment, granularity);
+        heap.alignment = std::max(heap.alignment, placedAlignment);
+        heap.images = heap.images || res.kind == ResourceKind::Texture;
+        heap.buffers = heap.buffers || res.kind != ResourceKind::Texture;
+        out.heap = heapOf;
+        s.all.push_back({r, life.first, life.last, heapOf, alignUp(out.size, granularity), placedAlignment});
     }
 
     // Placement order: by first use, larger first on ties (big resources
@@ -248,21 +265,10 @@ void aliasMemory(CompileState& st) {
         const Item* const items = s.items.data() + s.heapBegin[h];
         const uint32_t size = s.heapBegin[h + 1] - s.heapBegin[h];
         offsets.resize(size);
-        const bool alias = st.options.aliasing && keys[h].queueOrShared != 2;
-        MemoryHeap heap;
-        heap.queue = keys[h].queueOrShared == 1 ? Queue::AsyncCompute : Queue::Graphics;
-        heap.crossQueue = keys[h].queueOrShared == 2;
-        heap.memoryTypeBits = keys[h].memoryTypeBits;
+        MemoryHeap& heap = plan.heaps[h];
+        const bool alias = st.options.aliasing && !heap.crossQueue;
         heap.size = place(items, size, offsets.data(), alias, positions, s);
-        for (uint32_t i = 0; i < size; ++i) {
-            const Item& item = items[i];
-            heap.alignment = std::max(heap.alignment, item.alignment);
-            const bool image = d.resources[item.resource].kind == ResourceKind::Texture;
-            heap.images = heap.images || image;
-            heap.buffers = heap.buffers || !image;
-            plan.resources[item.resource].offset = offsets[i];
-        }
-        plan.heaps.push_back(heap);
+        for (uint32_t i = 0; i < size; ++i) planned[items[i].resource].offset = offsets[i];
         plan.stats.aliasedTransientBytes += heap.size;
 
         if (!alias) continue;
