@@ -73,8 +73,9 @@ Scratch& scratch() {
 }
 
 // Places items (sorted by first use) into one heap; returns its size.
-// `positions` bounds every first and last use.
-uint64_t place(const Item* items, uint32_t n, uint64_t* offsets, bool alias, uint32_t positions, Scratch& s) {
+// `positions` bounds every first and last use. Out of line: inlined into
+// aliasMemory, its loop ran short of registers.
+[[gnu::noinline]] uint64_t place(const Item* items, uint32_t n, uint64_t* offsets, bool alias, uint32_t positions, Scratch& s) {
     std::vector<Block>& free = s.free; // sorted by offset, coalesced
     free.clear();
     uint64_t top = 0;
