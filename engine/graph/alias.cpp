@@ -17,6 +17,7 @@
 // for the last users of those bytes, and an alias starts from UNDEFINED.
 
 #include <algorithm>
+#include <bit>
 
 #include <spdlog/spdlog.h>
 
@@ -45,6 +46,22 @@ struct Block {
     uint64_t size;
 };
 
+// The items of one heap placed at one offset.
+struct OffsetGroup {
+    uint64_t offset;
+    uint64_t end = 0;       // the furthest any of them reaches
+    uint32_t count = 0;     // how many
+    uint64_t below = 0;     // the furthest the groups at lower offsets reach
+    uint64_t above = ~0ull; // the next offset up
+};
+
+// A slot of the hash table from offsets to their groups.
+struct OffsetSlot {
+    uint64_t offset = 0;
+    uint32_t group = 0;
+    uint32_t stamp = 0; // the call that filled it
+};
+
 // Vulkan alignments are powers of two: a mask, not a 64-bit division, in
 // the best-fit scan.
 uint64_t alignUp(uint64_t v, uint64_t a) {
@@ -64,7 +81,11 @@ struct Scratch {
     std::vector<uint64_t> offsets;
     std::vector<Block> free;
     std::vector<uint32_t> releaseAt, next; // per position / item: items by last use
-    std::vector<uint32_t> byOffset, sortScratch;
+    std::vector<OffsetSlot> slots;
+    uint32_t stamp = 0; // of the slots markShared's current call filled
+    std::vector<OffsetGroup> groups;
+    std::vector<uint32_t> groupOf;               // per item
+    std::vector<uint32_t> byOffset, sortScratch; // groups in order of offset
 };
 
 Scratch& scratch() {
@@ -169,6 +190,62 @@ Scratch& scratch() {
     return top;
 }
 
+// Marks the items that share bytes with another item of the heap: those
+// at an offset where another one starts too, those starting below the end
+// of one at a lower offset, those ending above the next offset up.
+// Placement puts many items at a few offsets (a tiled frame's resources go
+// where the previous tile's were), so the sweep runs over the distinct
+// offsets, gathered in a hash table, instead of sorting the items.
+void markShared(const Item* items, uint32_t n, const uint64_t* offsets, uint8_t* aliased, Scratch& s) {
+    // At most half full. A slot is taken when it carries this call's stamp,
+    // so the table is not cleared for every heap of every frame.
+    const auto bits = static_cast<uint32_t>(std::bit_width(std::max<size_t>(2 * size_t{n}, 16) - 1));
+    const size_t mask = (size_t{1} << bits) - 1;
+    if (s.slots.size() <= mask) s.slots.resize(mask + 1);
+    if (++s.stamp == 0) { // wrapped: no slot may look taken
+        std::fill(s.slots.begin(), s.slots.end(), OffsetSlot{});
+        s.stamp = 1;
+    }
+    const uint32_t stamp = s.stamp;
+    OffsetSlot* const slots = s.slots.data();
+    // Room for every item in its own group: the loop appends without a
+    // capacity check.
+    if (s.groups.size() < n) s.groups.resize(n);
+    OffsetGroup* const groups = s.groups.data();
+    uint32_t groupCount = 0;
+    s.groupOf.resize(n);
+    uint32_t* const groupOf = s.groupOf.data();
+    for (uint32_t i = 0; i < n; ++i) {
+        const uint64_t offset = offsets[i];
+        size_t slot = static_cast<size_t>((offset * 0x9E3779B97F4A7C15ull) >> (64 - bits));
+        while (slots[slot].stamp == stamp && slots[slot].offset != offset) slot = (slot + 1) & mask;
+        if (slots[slot].stamp != stamp) {
+            slots[slot] = {offset, groupCount, stamp};
+            groups[groupCount++] = {offset};
+        }
+        const uint32_t g = slots[slot].group;
+        groupOf[i] = g;
+        groups[g].end = std::max(groups[g].end, offset + items[i].size);
+        ++groups[g].count;
+    }
+    std::vector<uint32_t>& byOffset = s.byOffset;
+    byOffset.resize(groupCount);
+    for (uint32_t g = 0; g < groupCount; ++g) byOffset[g] = g;
+    radixSort(byOffset, s.sortScratch, [&](uint32_t g) { return groups[g].offset; });
+    uint64_t reach = 0;
+    for (uint32_t k = 0; k < groupCount; ++k) {
+        OffsetGroup& group = groups[byOffset[k]];
+        group.below = reach;
+        if (k + 1 < groupCount) group.above = groups[byOffset[k + 1]].offset;
+        reach = std::max(reach, group.end);
+    }
+    for (uint32_t i = 0; i < n; ++i) {
+        const OffsetGroup& group = groups[groupOf[i]];
+        if (group.count > 1 || offsets[i] < group.below || group.above < offsets[i] + items[i].size)
+            aliased[items[i].resource] = 1;
+    }
+}
+
 } // namespace
 
 void aliasMemory(CompileState& st) {
@@ -261,7 +338,6 @@ void aliasMemory(CompileState& st) {
     }
 
     std::vector<uint64_t>& offsets = s.offsets;
-    std::vector<uint32_t>& byOffset = s.byOffset;
     for (uint32_t h = 0; h < heaps; ++h) {
         const Item* const items = s.items.data() + s.heapBegin[h];
         const uint32_t size = s.heapBegin[h + 1] - s.heapBegin[h];
@@ -273,21 +349,7 @@ void aliasMemory(CompileState& st) {
         plan.stats.aliasedTransientBytes += heap.size;
 
         if (!alias) continue;
-        // Sweep by offset: a resource is aliased when it starts below the end
-        // of an earlier one or the next one starts below its end.
-        // (Which of several resources at one offset comes first does not
-        // change the outcome: each is aliased by the other.)
-        byOffset.resize(size);
-        for (uint32_t i = 0; i < size; ++i) byOffset[i] = i;
-        radixSort(byOffset, s.sortScratch, [&](uint32_t i) { return offsets[i]; });
-        uint64_t reach = 0;
-        for (uint32_t i = 0; i < byOffset.size(); ++i) {
-            const uint32_t a = byOffset[i];
-            const uint64_t begin = offsets[a], end = begin + items[a].size;
-            const bool next = i + 1 < byOffset.size() && offsets[byOffset[i + 1]] < end;
-            if ((i > 0 && begin < reach) || next) st.aliased[items[a].resource] = 1;
-            reach = std::max(reach, end);
-        }
+        markShared(items, size, offsets.data(), st.aliased.data(), s);
         if (st.log)
             for (uint32_t i = 0; i < size; ++i)
                 spdlog::debug("rg alias: '{}' heap {} [{}, +{}) passes {}..{}{}", d.resources[items[i].resource].name,
