@@ -259,7 +259,10 @@ void aliasMemory(CompileState& st) {
     st.aliased.assign(d.resources.size(), 0);
     std::vector<HeapKey>& keys = s.keys;
     keys.clear();
-    s.all.clear();
+    // Room for every resource: the loop appends without a capacity check.
+    if (s.all.size() < d.resources.size()) s.all.resize(d.resources.size());
+    Item* const all = s.all.data();
+    uint32_t n = 0;
 
     // Local pointers: the stores into the plan could alias any vector's
     // data pointer as far as the compiler knows.
@@ -267,20 +270,15 @@ void aliasMemory(CompileState& st) {
     const Lifetime* const lifetimes = st.lifetimes.data();
     PlannedResource* const planned = plan.resources.data();
     const auto resourceCount = static_cast<uint32_t>(d.resources.size());
+    const bool custom = static_cast<bool>(requirementsOf);
     uint32_t heapOf = 0; // of the previous transient: most share its heap
-    TransientDescription desc;
     for (uint32_t r = 0; r < resourceCount; ++r) {
         const ir::Resource& res = resources[r];
         const Lifetime& life = lifetimes[r];
         if (res.origin != ir::Origin::Transient || !life.used()) continue;
         PlannedResource& out = planned[r];
-        desc.name = res.name;
-        desc.kind = res.kind;
-        desc.texture = res.texture;
-        desc.buffer = res.buffer;
-        desc.imageUsage = out.imageUsage;
-        desc.bufferUsage = out.bufferUsage;
-        const MemoryRequirements req = requirementsOf ? requirementsOf(desc) : estimateMemoryRequirements(desc);
+        const TransientDescription desc{res.name, res.kind, res.texture, res.buffer, out.imageUsage, out.bufferUsage};
+        const MemoryRequirements req = custom ? requirementsOf(desc) : estimateMemoryRequirements(desc);
         const uint64_t alignment = std::max<uint64_t>(req.alignment, 1);
         out.size = alignUp(req.size, alignment);
         out.alignment = alignment;
@@ -304,7 +302,7 @@ void aliasMemory(CompileState& st) {
         heap.images = heap.images || res.kind == ResourceKind::Texture;
         heap.buffers = heap.buffers || res.kind != ResourceKind::Texture;
         out.heap = heapOf;
-        s.all.push_back({r, life.first, life.last, heapOf, alignUp(out.size, granularity), placedAlignment});
+        all[n++] = {r, life.first, life.last, heapOf, alignUp(out.size, granularity), placedAlignment};
     }
 
     // Placement order: by first use, larger first on ties (big resources
@@ -312,17 +310,16 @@ void aliasMemory(CompileState& st) {
     // first use) gives each heap its items in first-use order, in resource
     // order within a position (it is stable); the runs sharing a first use
     // are short and get an insertion sort by size.
-    const auto n = static_cast<uint32_t>(s.all.size());
     const auto heaps = static_cast<uint32_t>(keys.size());
     const uint32_t buckets = heaps * positions;
     std::vector<uint32_t>& count = s.count;
     count.assign(buckets + 1, 0);
-    for (const Item& item : s.all) ++count[item.heap * positions + item.first + 1];
+    for (uint32_t i = 0; i < n; ++i) ++count[all[i].heap * positions + all[i].first + 1];
     for (uint32_t b = 0; b < buckets; ++b) count[b + 1] += count[b];
     s.heapBegin.resize(heaps + 1);
     for (uint32_t h = 0; h <= heaps; ++h) s.heapBegin[h] = count[h * positions];
     s.items.resize(n);
-    for (const Item& item : s.all) s.items[count[item.heap * positions + item.first]++] = item;
+    for (uint32_t i = 0; i < n; ++i) s.items[count[all[i].heap * positions + all[i].first]++] = all[i];
     for (uint32_t h = 0; h < heaps; ++h) {
         Item* const items = s.items.data() + s.heapBegin[h];
         const uint32_t size = s.heapBegin[h + 1] - s.heapBegin[h];
