@@ -272,6 +272,8 @@ void aliasMemory(CompileState& st) {
     const auto resourceCount = static_cast<uint32_t>(d.resources.size());
     const bool custom = static_cast<bool>(requirementsOf);
     uint32_t heapOf = 0; // of the previous transient: most share its heap
+    uint64_t previousOrder = 0; // (heap, first use) of the previous transient
+    bool inOrder = true;
     for (uint32_t r = 0; r < resourceCount; ++r) {
         const ir::Resource& res = resources[r];
         const Lifetime& life = lifetimes[r];
@@ -303,26 +305,39 @@ void aliasMemory(CompileState& st) {
         heap.buffers = heap.buffers || res.kind != ResourceKind::Texture;
         out.heap = heapOf;
         all[n++] = {r, life.first, life.last, heapOf, alignUp(out.size, granularity), placedAlignment};
+        const uint64_t order = uint64_t{heapOf} << 32 | life.first;
+        inOrder = inOrder && order >= previousOrder;
+        previousOrder = order;
     }
 
     // Placement order: by first use, larger first on ties (big resources
     // get the low bytes), then by resource. One counting sort by (heap,
     // first use) gives each heap its items in first-use order, in resource
     // order within a position (it is stable); the runs sharing a first use
-    // are short and get an insertion sort by size.
+    // are short and get an insertion sort by size. Resources are mostly
+    // declared in order of first use, and a frame mostly has one heap: when
+    // the items come in that order already, they stay where they are.
     const auto heaps = static_cast<uint32_t>(keys.size());
-    const uint32_t buckets = heaps * positions;
-    std::vector<uint32_t>& count = s.count;
-    count.assign(buckets + 1, 0);
-    for (uint32_t i = 0; i < n; ++i) ++count[all[i].heap * positions + all[i].first + 1];
-    for (uint32_t b = 0; b < buckets; ++b) count[b + 1] += count[b];
-    s.heapBegin.resize(heaps + 1);
-    for (uint32_t h = 0; h <= heaps; ++h) s.heapBegin[h] = count[h * positions];
-    s.items.resize(n);
-    for (uint32_t i = 0; i < n; ++i) s.items[count[all[i].heap * positions + all[i].first]++] = all[i];
+    std::vector<uint32_t>& heapBegin = s.heapBegin;
+    heapBegin.assign(heaps + 1, 0);
+    Item* sorted = all;
+    if (inOrder) {
+        for (uint32_t i = 0; i < n; ++i) ++heapBegin[all[i].heap + 1];
+        for (uint32_t h = 0; h < heaps; ++h) heapBegin[h + 1] += heapBegin[h];
+    } else {
+        const uint32_t buckets = heaps * positions;
+        std::vector<uint32_t>& count = s.count;
+        count.assign(buckets + 1, 0);
+        for (uint32_t i = 0; i < n; ++i) ++count[all[i].heap * positions + all[i].first + 1];
+        for (uint32_t b = 0; b < buckets; ++b) count[b + 1] += count[b];
+        for (uint32_t h = 0; h <= heaps; ++h) heapBegin[h] = count[h * positions];
+        s.items.resize(n);
+        sorted = s.items.data();
+        for (uint32_t i = 0; i < n; ++i) sorted[count[all[i].heap * positions + all[i].first]++] = all[i];
+    }
     for (uint32_t h = 0; h < heaps; ++h) {
-        Item* const items = s.items.data() + s.heapBegin[h];
-        const uint32_t size = s.heapBegin[h + 1] - s.heapBegin[h];
+        Item* const items = sorted + heapBegin[h];
+        const uint32_t size = heapBegin[h + 1] - heapBegin[h];
         for (uint32_t i = 1; i < size; ++i) {
             if (items[i].first != items[i - 1].first || items[i].size <= items[i - 1].size) continue;
             // Stable: equal sizes stay in resource order.
@@ -336,8 +351,8 @@ void aliasMemory(CompileState& st) {
 
     std::vector<uint64_t>& offsets = s.offsets;
     for (uint32_t h = 0; h < heaps; ++h) {
-        const Item* const items = s.items.data() + s.heapBegin[h];
-        const uint32_t size = s.heapBegin[h + 1] - s.heapBegin[h];
+        const Item* const items = sorted + heapBegin[h];
+        const uint32_t size = heapBegin[h + 1] - heapBegin[h];
         offsets.resize(size);
         MemoryHeap& heap = plan.heaps[h];
         const bool alias = st.options.aliasing && !heap.crossQueue;
