@@ -113,8 +113,10 @@ Scratch& scratch() {
 
     auto release = [&](uint32_t i) {
         const Block b{offsets[i], items[i].size};
-        auto it = std::lower_bound(free.begin(), free.end(), b.offset,
-                                   [](const Block& x, uint64_t off) { return x.offset < off; });
+        // The first block above it, by a scan: the list is short, and the
+        // best-fit scan walks all of it for every item anyway.
+        auto it = free.begin();
+        while (it != free.end() && it->offset < b.offset) ++it;
         const bool joinsPrev = it != free.begin() && (it - 1)->offset + (it - 1)->size == b.offset;
         const bool joinsNext = it != free.end() && b.offset + b.size == it->offset;
         // Grow a neighbour in place where one touches: an insert shifts the
