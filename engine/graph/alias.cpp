@@ -97,7 +97,11 @@ Scratch& scratch() {
 // `positions` bounds every first and last use. Out of line: inlined into
 // aliasMemory, its loop ran short of registers.
 [[gnu::noinline]] uint64_t place(const Item* items, uint32_t n, uint64_t* offsets, bool alias, uint32_t positions, Scratch& s) {
-    std::vector<Block>& free = s.free; // sorted by offset, coalesced
+    // The free list, sorted by offset and coalesced, is lent to a local for
+    // the loop: as a member of the thread's scratch, every store through
+    // `offsets` could change it as far as the compiler knows.
+    std::vector<Block> free;
+    free.swap(s.free);
     free.clear();
     uint64_t top = 0;
     // Items to release, listed by last use: after placing item i, it joins
@@ -109,6 +113,8 @@ Scratch& scratch() {
         s.releaseAt.assign(positions, kNoIndex);
         s.next.resize(n);
     }
+    uint32_t* const releaseAt = s.releaseAt.data();
+    uint32_t* const next = s.next.data();
     uint32_t released = 0; // positions before this one have been released
 
     auto release = [&](uint32_t i) {
@@ -138,7 +144,7 @@ Scratch& scratch() {
         const Item& item = items[i];
         if (alias) {
             for (; released < item.first; ++released)
-                for (uint32_t r = s.releaseAt[released]; r != kNoIndex; r = s.next[r]) release(r);
+                for (uint32_t r = releaseAt[released]; r != kNoIndex; r = next[r]) release(r);
         }
         // Best fit: the free block that leaves the least over.
         size_t best = free.size();
@@ -185,10 +191,11 @@ Scratch& scratch() {
         }
         offsets[i] = offset;
         if (alias) {
-            s.next[i] = s.releaseAt[item.last];
-            s.releaseAt[item.last] = i;
+            next[i] = releaseAt[item.last];
+            releaseAt[item.last] = i;
         }
     }
+    free.swap(s.free);
     return top;
 }
 
