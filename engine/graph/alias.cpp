@@ -280,7 +280,12 @@ void aliasMemory(CompileState& st) {
     PlannedResource* const planned = plan.resources.data();
     const auto resourceCount = static_cast<uint32_t>(d.resources.size());
     const bool custom = static_cast<bool>(requirementsOf);
-    uint32_t heapOf = 0; // of the previous transient: most share its heap
+    // The previous transient's heap, which most share: its index, key and
+    // description (plan.heaps grows only where this is looked up).
+    uint32_t heapOf = kNoIndex;
+    HeapKey heapKey{};
+    MemoryHeap* memberHeap = nullptr;
+    uint64_t transientBytes = 0;
     uint64_t previousOrder = 0; // (heap, first use) of the previous transient
     bool inOrder = true;
     for (uint32_t r = 0; r < resourceCount; ++r) {
@@ -293,31 +298,33 @@ void aliasMemory(CompileState& st) {
         const uint64_t alignment = std::max<uint64_t>(req.alignment, 1);
         out.size = alignUp(req.size, alignment);
         out.alignment = alignment;
-        plan.stats.transientBytes += out.size;
+        transientBytes += out.size;
 
         // The heaps are described as their first members turn up.
         const HeapKey key{life.crossQueue() ? 2u : queueIndex(out.queue), req.memoryTypeBits};
-        if (heapOf == keys.size() || !(keys[heapOf] == key)) {
+        if (heapOf == kNoIndex || !(key == heapKey)) {
             heapOf = static_cast<uint32_t>(std::find(keys.begin(), keys.end(), key) - keys.begin());
             if (heapOf == keys.size()) {
                 keys.push_back(key);
-                MemoryHeap& heap = plan.heaps.emplace_back();
-                heap.queue = key.queueOrShared == 1 ? Queue::AsyncCompute : Queue::Graphics;
-                heap.crossQueue = key.queueOrShared == 2;
-                heap.memoryTypeBits = key.memoryTypeBits;
+                MemoryHeap& added = plan.heaps.emplace_back();
+                added.queue = key.queueOrShared == 1 ? Queue::AsyncCompute : Queue::Graphics;
+                added.crossQueue = key.queueOrShared == 2;
+                added.memoryTypeBits = key.memoryTypeBits;
             }
+            heapKey = key;
+            memberHeap = &plan.heaps[heapOf];
         }
-        MemoryHeap& heap = plan.heaps[heapOf];
         const uint64_t placedAlignment = std::max(alignment, granularity);
-        heap.alignment = std::max(heap.alignment, placedAlignment);
-        heap.images = heap.images || res.kind == ResourceKind::Texture;
-        heap.buffers = heap.buffers || res.kind != ResourceKind::Texture;
+        memberHeap->alignment = std::max(memberHeap->alignment, placedAlignment);
+        memberHeap->images = memberHeap->images || res.kind == ResourceKind::Texture;
+        memberHeap->buffers = memberHeap->buffers || res.kind != ResourceKind::Texture;
         out.heap = heapOf;
         all[n++] = {r, life.first, life.last, heapOf, alignUp(out.size, granularity), placedAlignment};
         const uint64_t order = uint64_t{heapOf} << 32 | life.first;
         inOrder = inOrder && order >= previousOrder;
         previousOrder = order;
     }
+    plan.stats.transientBytes += transientBytes;
 
     // Placement order: by first use, larger first on ties (big resources
     // get the low bytes), then by resource. One counting sort by (heap,
