@@ -93,23 +93,6 @@ constinit const std::array<FormatBlock, detail::kCoreFormatCount> detail::kCoreF
     return table;
 }();
 
-VkImageAspectFlags aspectOf(VkFormat f) {
-    switch (f) {
-        case VK_FORMAT_D16_UNORM:
-        case VK_FORMAT_X8_D24_UNORM_PACK32:
-        case VK_FORMAT_D32_SFLOAT:
-            return VK_IMAGE_ASPECT_DEPTH_BIT;
-        case VK_FORMAT_S8_UINT:
-            return VK_IMAGE_ASPECT_STENCIL_BIT;
-        case VK_FORMAT_D16_UNORM_S8_UINT:
-        case VK_FORMAT_D24_UNORM_S8_UINT:
-        case VK_FORMAT_D32_SFLOAT_S8_UINT:
-            return VK_IMAGE_ASPECT_DEPTH_BIT | VK_IMAGE_ASPECT_STENCIL_BIT;
-        default:
-            return VK_IMAGE_ASPECT_COLOR_BIT;
-    }
-}
-
 uint64_t detail::blockCompressedBytes(const TextureDesc& t, FormatBlock block) {
     uint64_t bytes = 0;
     for (uint32_t m = 0; m < t.mips; ++m) {

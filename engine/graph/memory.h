@@ -6,9 +6,10 @@
 // caching by description, since a frame's graph repeats them every frame.
 // Tests and the benchmark use the deterministic estimate below, which
 // follows what desktop drivers report closely enough for aliasing decisions
-// (64 KiB-aligned optimal images, 256-byte buffers). compile() calls it for
-// every transient of every frame, so it is inline here, with block-
-// compressed sizes and the errors out of line.
+// (64 KiB-aligned optimal images, 256-byte buffers). compile() asks the
+// estimate, the format blocks and the aspects for every transient (every
+// texture) of every frame: they are inline here, with block-compressed sizes
+// and the errors out of line.
 
 #include <algorithm>
 #include <array>
@@ -70,7 +71,22 @@ inline FormatBlock formatBlock(VkFormat format) {
     return index < detail::kCoreFormatCount ? detail::kCoreFormatBlocks[index] : FormatBlock{0, 0, 0};
 }
 
-VkImageAspectFlags aspectOf(VkFormat format);
+inline VkImageAspectFlags aspectOf(VkFormat format) {
+    switch (format) {
+        case VK_FORMAT_D16_UNORM:
+        case VK_FORMAT_X8_D24_UNORM_PACK32:
+        case VK_FORMAT_D32_SFLOAT:
+            return VK_IMAGE_ASPECT_DEPTH_BIT;
+        case VK_FORMAT_S8_UINT:
+            return VK_IMAGE_ASPECT_STENCIL_BIT;
+        case VK_FORMAT_D16_UNORM_S8_UINT:
+        case VK_FORMAT_D24_UNORM_S8_UINT:
+        case VK_FORMAT_D32_SFLOAT_S8_UINT:
+            return VK_IMAGE_ASPECT_DEPTH_BIT | VK_IMAGE_ASPECT_STENCIL_BIT;
+        default:
+            return VK_IMAGE_ASPECT_COLOR_BIT;
+    }
+}
 
 inline MemoryRequirements estimateMemoryRequirements(const TransientDescription& d) {
     using detail::kBufferAlignment, detail::kImageAlignment;
