@@ -338,8 +338,9 @@ void aliasMemory(CompileState& st) {
     heapBegin.assign(heaps + 1, 0);
     Item* sorted = all;
     if (inOrder) {
-        for (uint32_t i = 0; i < n; ++i) ++heapBegin[all[i].heap + 1];
-        for (uint32_t h = 0; h < heaps; ++h) heapBegin[h + 1] += heapBegin[h];
+        for (uint32_t h = 1; h <= heaps; ++h)
+            heapBegin[h] = static_cast<uint32_t>(
+                std::partition_point(all, all + n, [h](const Item& item) { return item.heap < h; }) - all);
     } else {
         const uint32_t buckets = heaps * positions;
         std::vector<uint32_t>& count = s.count;
