@@ -255,17 +255,20 @@ void markShared(const Item* items, uint32_t n, const uint64_t* offsets, uint8_t*
     }
 }
 
-} // namespace
+struct Collected {
+    uint32_t count; // items in s.all
+    bool inOrder;   // sorted by (heap, first use) already
+};
 
-void aliasMemory(CompileState& st) {
+// Sizes the used transients and lists them as items in s.all, in resource
+// order; each heap is described in plan.heaps (keyed in s.keys) when its
+// first member turns up. Out of line, like place().
+
+[[gnu::noinline]] Collected collect(CompileState& st, Scratch& s) {
     const ir::Declaration& d = st.decl;
     Plan& plan = st.plan;
     const MemoryRequirementsFn& requirementsOf = st.options.memoryRequirements;
-    Scratch& s = scratch();
     const uint64_t granularity = std::max<uint64_t>(st.caps.bufferImageGranularity, 1);
-    const auto positions = static_cast<uint32_t>(st.order.size());
-
-    st.aliased.assign(d.resources.size(), 0);
     std::vector<HeapKey>& keys = s.keys;
     keys.clear();
     // Room for every resource: the loop appends without a capacity check.
@@ -300,7 +303,6 @@ void aliasMemory(CompileState& st) {
         out.alignment = alignment;
         transientBytes += out.size;
 
-        // The heaps are described as their first members turn up.
         const HeapKey key{life.crossQueue() ? 2u : queueIndex(out.queue), req.memoryTypeBits};
         if (heapOf == kNoIndex || !(key == heapKey)) {
             heapOf = static_cast<uint32_t>(std::find(keys.begin(), keys.end(), key) - keys.begin());
@@ -325,6 +327,20 @@ void aliasMemory(CompileState& st) {
         previousOrder = order;
     }
     plan.stats.transientBytes += transientBytes;
+    return {n, inOrder};
+}
+
+} // namespace
+
+void aliasMemory(CompileState& st) {
+    const ir::Declaration& d = st.decl;
+    Plan& plan = st.plan;
+    Scratch& s = scratch();
+    const auto positions = static_cast<uint32_t>(st.order.size());
+    st.aliased.assign(d.resources.size(), 0);
+    const auto [n, inOrder] = collect(st, s);
+    Item* const all = s.all.data();
+    PlannedResource* const planned = plan.resources.data();
 
     // Placement order: by first use, larger first on ties (big resources
     // get the low bytes), then by resource. One counting sort by (heap,
@@ -333,7 +349,7 @@ void aliasMemory(CompileState& st) {
     // are short and get an insertion sort by size. Resources are mostly
     // declared in order of first use, and a frame mostly has one heap: when
     // the items come in that order already, they stay where they are.
-    const auto heaps = static_cast<uint32_t>(keys.size());
+    const auto heaps = static_cast<uint32_t>(s.keys.size());
     std::vector<uint32_t>& heapBegin = s.heapBegin;
     heapBegin.assign(heaps + 1, 0);
     Item* sorted = all;
