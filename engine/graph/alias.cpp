@@ -93,10 +93,12 @@ Scratch& scratch() {
     return s;
 }
 
-// Places items (sorted by first use) into one heap; returns its size.
+// Places items (sorted by first use) into one heap, writing each offset to
+// `offsets` (by item) and to the planned resource; returns the heap's size.
 // `positions` bounds every first and last use. Out of line: inlined into
 // aliasMemory, its loop ran short of registers.
-[[gnu::noinline]] uint64_t place(const Item* items, uint32_t n, uint64_t* offsets, bool alias, uint32_t positions, Scratch& s) {
+[[gnu::noinline]] uint64_t place(const Item* items, uint32_t n, uint64_t* offsets, PlannedResource* planned, bool alias,
+                                 uint32_t positions, Scratch& s) {
     // The free list, sorted by offset and coalesced, is lent to a local for
     // the loop: as a member of the thread's scratch, every store through
     // `offsets` could change it as far as the compiler knows.
@@ -190,6 +192,7 @@ Scratch& scratch() {
             top = offset + item.size;
         }
         offsets[i] = offset;
+        planned[item.resource].offset = offset;
         if (alias) {
             next[i] = releaseAt[item.last];
             releaseAt[item.last] = i;
@@ -389,8 +392,7 @@ void aliasMemory(CompileState& st) {
         offsets.resize(size);
         MemoryHeap& heap = plan.heaps[h];
         const bool alias = st.options.aliasing && !heap.crossQueue;
-        heap.size = place(items, size, offsets.data(), alias, positions, s);
-        for (uint32_t i = 0; i < size; ++i) planned[items[i].resource].offset = offsets[i];
+        heap.size = place(items, size, offsets.data(), planned, alias, positions, s);
         plan.stats.aliasedTransientBytes += heap.size;
 
         if (!alias) continue;
