@@ -12,9 +12,10 @@
 // those whose last use is behind and placing each new one in the
 // best-fitting free block (or at the top). It is linear-scan register
 // allocation over bytes: O(n log n), good packing for frame-shaped
-// lifetimes, no quadratic interference test. A sweep by offset then marks
-// the resources that share bytes: barriers.cpp makes their first uses wait
-// for the last users of those bytes, and an alias starts from UNDEFINED.
+// lifetimes, no quadratic interference test. A sweep over the offsets then
+// marks the resources that share bytes: barriers.cpp makes their first uses
+// wait for the last users of those bytes, and an alias starts from
+// UNDEFINED.
 
 #include <algorithm>
 #include <bit>
@@ -75,8 +76,8 @@ uint64_t alignUp(uint64_t v, uint64_t a) {
 struct Scratch {
     std::vector<HeapKey> keys;
     std::vector<Item> all;           // used transients in resource order
-    std::vector<Item> items;         // grouped by heap, each sorted for placement
-    std::vector<uint32_t> heapBegin; // per heap: its span of `items`, then the end
+    std::vector<Item> items;         // `all` by (heap, first use), where it was not so already
+    std::vector<uint32_t> heapBegin; // per heap: its span of the sorted items, then the end
     std::vector<uint32_t> count;     // counting-sort buckets
     std::vector<uint64_t> offsets;
     std::vector<Block> free;
@@ -266,7 +267,6 @@ struct Collected {
 // Sizes the used transients and lists them as items in s.all, in resource
 // order; each heap is described in plan.heaps (keyed in s.keys) when its
 // first member turns up. Out of line, like place().
-
 [[gnu::noinline]] Collected collect(CompileState& st, Scratch& s) {
     const ir::Declaration& d = st.decl;
     Plan& plan = st.plan;
