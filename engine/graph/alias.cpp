@@ -47,20 +47,15 @@ struct Block {
     uint64_t size;
 };
 
-// The items of one heap placed at one offset.
+// The items of one heap placed at one offset, in a slot of the hash table
+// from offsets to them.
 struct OffsetGroup {
-    uint64_t offset;
+    uint64_t offset = 0;
     uint64_t end = 0;       // the furthest any of them reaches
-    uint32_t count = 0;     // how many
     uint64_t below = 0;     // the furthest the groups at lower offsets reach
     uint64_t above = ~0ull; // the next offset up
-};
-
-// A slot of the hash table from offsets to their groups.
-struct OffsetSlot {
-    uint64_t offset = 0;
-    uint32_t group = 0;
-    uint32_t stamp = 0; // the call that filled it
+    uint32_t count = 0;     // how many
+    uint32_t stamp = 0;     // the call that filled the slot
 };
 
 // Vulkan alignments are powers of two: a mask, not a 64-bit division, in
@@ -82,11 +77,10 @@ struct Scratch {
     std::vector<uint64_t> offsets;
     std::vector<Block> free;
     std::vector<uint32_t> releaseAt, next; // per position / item: items by last use
-    std::vector<OffsetSlot> slots;
-    uint32_t stamp = 0; // of the slots markShared's current call filled
-    std::vector<OffsetGroup> groups;
-    std::vector<uint32_t> groupOf;               // per item
-    std::vector<uint32_t> byOffset, sortScratch; // groups in order of offset
+    std::vector<OffsetGroup> groups; // hash table slots
+    uint32_t stamp = 0;              // of the slots markShared's current call filled
+    std::vector<uint32_t> groupOf;               // per item: its slot
+    std::vector<uint32_t> byOffset, sortScratch; // the filled slots in order of offset
 };
 
 Scratch& scratch() {
@@ -214,36 +208,33 @@ void markShared(const Item* items, uint32_t n, const uint64_t* offsets, uint8_t*
     // so the table is not cleared for every heap of every frame.
     const auto bits = static_cast<uint32_t>(std::bit_width(std::max<size_t>(2 * size_t{n}, 16) - 1));
     const size_t mask = (size_t{1} << bits) - 1;
-    if (s.slots.size() <= mask) s.slots.resize(mask + 1);
+    if (s.groups.size() <= mask) s.groups.resize(mask + 1);
     if (++s.stamp == 0) { // wrapped: no slot may look taken
-        std::fill(s.slots.begin(), s.slots.end(), OffsetSlot{});
+        std::fill(s.groups.begin(), s.groups.end(), OffsetGroup{});
         s.stamp = 1;
     }
     const uint32_t stamp = s.stamp;
-    OffsetSlot* const slots = s.slots.data();
-    // Room for every item in its own group: the loop appends without a
-    // capacity check.
-    if (s.groups.size() < n) s.groups.resize(n);
     OffsetGroup* const groups = s.groups.data();
+    // Room for every item in a group of its own: the loop appends without a
+    // capacity check.
+    std::vector<uint32_t>& byOffset = s.byOffset;
+    byOffset.resize(n);
     uint32_t groupCount = 0;
     s.groupOf.resize(n);
     uint32_t* const groupOf = s.groupOf.data();
     for (uint32_t i = 0; i < n; ++i) {
         const uint64_t offset = offsets[i];
-        size_t slot = static_cast<size_t>((offset * 0x9E3779B97F4A7C15ull) >> (64 - bits));
-        while (slots[slot].stamp == stamp && slots[slot].offset != offset) slot = (slot + 1) & mask;
-        if (slots[slot].stamp != stamp) {
-            slots[slot] = {offset, groupCount, stamp};
-            groups[groupCount++] = {offset};
+        auto g = static_cast<uint32_t>((offset * 0x9E3779B97F4A7C15ull) >> (64 - bits));
+        while (groups[g].stamp == stamp && groups[g].offset != offset) g = (g + 1) & mask;
+        if (groups[g].stamp != stamp) {
+            groups[g] = {.offset = offset, .stamp = stamp};
+            byOffset[groupCount++] = g;
         }
-        const uint32_t g = slots[slot].group;
         groupOf[i] = g;
         groups[g].end = std::max(groups[g].end, offset + items[i].size);
         ++groups[g].count;
     }
-    std::vector<uint32_t>& byOffset = s.byOffset;
     byOffset.resize(groupCount);
-    for (uint32_t g = 0; g < groupCount; ++g) byOffset[g] = g;
     radixSort(byOffset, s.sortScratch, [&](uint32_t g) { return groups[g].offset; });
     uint64_t reach = 0;
     for (uint32_t k = 0; k < groupCount; ++k) {
