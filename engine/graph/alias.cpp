@@ -312,8 +312,8 @@ struct Collected {
         }
         const uint64_t placedAlignment = std::max(alignment, granularity);
         memberHeap->alignment = std::max(memberHeap->alignment, placedAlignment);
-        memberHeap->images = memberHeap->images || res.kind == ResourceKind::Texture;
-        memberHeap->buffers = memberHeap->buffers || res.kind != ResourceKind::Texture;
+        memberHeap->images |= res.kind == ResourceKind::Texture;
+        memberHeap->buffers |= res.kind != ResourceKind::Texture;
         out.heap = heapOf;
         all[n++] = {r, life.first, life.last, heapOf, alignUp(out.size, granularity), placedAlignment};
         const uint64_t order = uint64_t{heapOf} << 32 | life.first;
