@@ -70,15 +70,15 @@ uint64_t alignUp(uint64_t v, uint64_t a) {
 // compile to the next (as barriers.cpp's scratch does).
 struct Scratch {
     std::vector<HeapKey> keys;
-    std::vector<Item> all;           // used transients in resource order
-    std::vector<Item> items;         // `all` by (heap, first use), where it was not so already
-    std::vector<uint32_t> heapBegin; // per heap: its span of the sorted items, then the end
-    std::vector<uint32_t> count;     // counting-sort buckets
-    std::vector<uint64_t> offsets;
-    std::vector<Block> free;
-    std::vector<uint32_t> releaseAt, next; // per position / item: items by last use
-    std::vector<OffsetGroup> groups; // hash table slots
-    uint32_t stamp = 0;              // of the slots markShared's current call filled
+    std::vector<Item> all;                       // used transients in resource order
+    std::vector<Item> items;                     // the counting sort's output, where `all` is out of order
+    std::vector<uint32_t> heapBegin;             // per heap: its span of the sorted items, then the end
+    std::vector<uint32_t> count;                 // counting-sort buckets
+    std::vector<uint64_t> offsets;               // per item of the heap being placed
+    std::vector<Block> free;                     // the free list, between placements
+    std::vector<uint32_t> releaseAt, next;       // per position / item: items by last use
+    std::vector<OffsetGroup> groups;             // markShared's hash table
+    uint32_t stamp = 0;                          // of the slots markShared's current call filled
     std::vector<uint32_t> groupOf;               // per item: its slot
     std::vector<uint32_t> byOffset, sortScratch; // the filled slots in order of offset
 };
