@@ -12,11 +12,13 @@
 // those whose last use is behind and placing each new one in the
 // best-fitting free block (or at the top). It is linear-scan register
 // allocation over bytes: O(n log n), good packing for frame-shaped
-// lifetimes, no quadratic interference test. A sweep by offset then marks
-// the resources that share bytes: barriers.cpp makes their first uses wait
-// for the last users of those bytes, and an alias starts from UNDEFINED.
+// lifetimes, no quadratic interference test. A sweep over the offsets then
+// marks the resources that share bytes: barriers.cpp makes their first uses
+// wait for the last users of those bytes, and an alias starts from
+// UNDEFINED.
 
 #include <algorithm>
+#include <bit>
 
 #include <spdlog/spdlog.h>
 
@@ -45,6 +47,17 @@ struct Block {
     uint64_t size;
 };
 
+// The items of one heap placed at one offset, in a slot of the hash table
+// from offsets to them.
+struct OffsetGroup {
+    uint64_t offset = 0;
+    uint64_t end = 0;       // the furthest any of them reaches
+    uint64_t below = 0;     // the furthest the groups at lower offsets reach
+    uint64_t above = ~0ull; // the next offset up
+    uint32_t count = 0;     // how many
+    uint32_t stamp = 0;     // the call that filled the slot
+};
+
 // Vulkan alignments are powers of two: a mask, not a 64-bit division, in
 // the best-fit scan.
 uint64_t alignUp(uint64_t v, uint64_t a) {
@@ -57,14 +70,17 @@ uint64_t alignUp(uint64_t v, uint64_t a) {
 // compile to the next (as barriers.cpp's scratch does).
 struct Scratch {
     std::vector<HeapKey> keys;
-    std::vector<Item> all;           // used transients in resource order
-    std::vector<Item> items;         // grouped by heap, each sorted for placement
-    std::vector<uint32_t> heapBegin; // per heap: its span of `items`, then the end
-    std::vector<uint32_t> count;     // counting-sort buckets
-    std::vector<uint64_t> offsets;
-    std::vector<Block> free;
-    std::vector<uint32_t> releaseAt, next; // per position / item: items by last use
-    std::vector<uint32_t> byOffset, sortScratch;
+    std::vector<Item> all;                       // used transients in resource order
+    std::vector<Item> items;                     // the counting sort's output, where `all` is out of order
+    std::vector<uint32_t> heapBegin;             // per heap: its span of the sorted items, then the end
+    std::vector<uint32_t> count;                 // counting-sort buckets
+    std::vector<uint64_t> offsets;               // per item of the heap being placed
+    std::vector<Block> free;                     // the free list, between placements
+    std::vector<uint32_t> releaseAt, next;       // per position / item: items by last use
+    std::vector<OffsetGroup> groups;             // markShared's hash table
+    uint32_t stamp = 0;                          // of the slots markShared's current call filled
+    std::vector<uint32_t> groupOf;               // per item: its slot
+    std::vector<uint32_t> byOffset, sortScratch; // the filled slots in order of offset
 };
 
 Scratch& scratch() {
@@ -72,10 +88,17 @@ Scratch& scratch() {
     return s;
 }
 
-// Places items (sorted by first use) into one heap; returns its size.
-// `positions` bounds every first and last use.
-uint64_t place(const Item* items, uint32_t n, uint64_t* offsets, bool alias, uint32_t positions, Scratch& s) {
-    std::vector<Block>& free = s.free; // sorted by offset, coalesced
+// Places items (sorted by first use) into one heap, writing each offset to
+// `offsets` (by item) and to the planned resource; returns the heap's size.
+// `positions` bounds every first and last use. Out of line: inlined into
+// aliasMemory, its loop ran short of registers.
+[[gnu::noinline]] uint64_t place(const Item* items, uint32_t n, uint64_t* offsets, PlannedResource* planned, bool alias,
+                                 uint32_t positions, Scratch& s) {
+    // The free list, sorted by offset and coalesced, is lent to a local for
+    // the loop: as a member of the thread's scratch, every store through
+    // `offsets` could change it as far as the compiler knows.
+    std::vector<Block> free;
+    free.swap(s.free);
     free.clear();
     uint64_t top = 0;
     // Items to release, listed by last use: after placing item i, it joins
@@ -87,12 +110,16 @@ uint64_t place(const Item* items, uint32_t n, uint64_t* offsets, bool alias, uin
         s.releaseAt.assign(positions, kNoIndex);
         s.next.resize(n);
     }
+    uint32_t* const releaseAt = s.releaseAt.data();
+    uint32_t* const next = s.next.data();
     uint32_t released = 0; // positions before this one have been released
 
     auto release = [&](uint32_t i) {
         const Block b{offsets[i], items[i].size};
-        auto it = std::lower_bound(free.begin(), free.end(), b.offset,
-                                   [](const Block& x, uint64_t off) { return x.offset < off; });
+        // The first block above it, by a scan: the list is short, and the
+        // best-fit scan walks all of it for every item anyway.
+        auto it = free.begin();
+        while (it != free.end() && it->offset < b.offset) ++it;
         const bool joinsPrev = it != free.begin() && (it - 1)->offset + (it - 1)->size == b.offset;
         const bool joinsNext = it != free.end() && b.offset + b.size == it->offset;
         // Grow a neighbour in place where one touches: an insert shifts the
@@ -114,7 +141,7 @@ uint64_t place(const Item* items, uint32_t n, uint64_t* offsets, bool alias, uin
         const Item& item = items[i];
         if (alias) {
             for (; released < item.first; ++released)
-                for (uint32_t r = s.releaseAt[released]; r != kNoIndex; r = s.next[r]) release(r);
+                for (uint32_t r = releaseAt[released]; r != kNoIndex; r = next[r]) release(r);
         }
         // Best fit: the free block that leaves the least over.
         size_t best = free.size();
@@ -160,12 +187,141 @@ uint64_t place(const Item* items, uint32_t n, uint64_t* offsets, bool alias, uin
             top = offset + item.size;
         }
         offsets[i] = offset;
+        planned[item.resource].offset = offset;
         if (alias) {
-            s.next[i] = s.releaseAt[item.last];
-            s.releaseAt[item.last] = i;
+            next[i] = releaseAt[item.last];
+            releaseAt[item.last] = i;
         }
     }
+    free.swap(s.free);
     return top;
+}
+
+// Marks the items that share bytes with another item of the heap: those
+// at an offset where another one starts too, those starting below the end
+// of one at a lower offset, those ending above the next offset up.
+// Placement puts many items at a few offsets (a tiled frame's resources go
+// where the previous tile's were), so the sweep runs over the distinct
+// offsets, gathered in a hash table, instead of sorting the items.
+void markShared(const Item* items, uint32_t n, const uint64_t* offsets, uint8_t* aliased, Scratch& s) {
+    // At most half full. A slot is taken when it carries this call's stamp,
+    // so the table is not cleared for every heap of every frame.
+    const auto bits = static_cast<uint32_t>(std::bit_width(std::max<size_t>(2 * size_t{n}, 16) - 1));
+    const size_t mask = (size_t{1} << bits) - 1;
+    if (s.groups.size() <= mask) s.groups.resize(mask + 1);
+    if (++s.stamp == 0) { // wrapped: no slot may look taken
+        std::fill(s.groups.begin(), s.groups.end(), OffsetGroup{});
+        s.stamp = 1;
+    }
+    const uint32_t stamp = s.stamp;
+    OffsetGroup* const groups = s.groups.data();
+    // Room for every item in a group of its own: the loop appends without a
+    // capacity check.
+    std::vector<uint32_t>& byOffset = s.byOffset;
+    byOffset.resize(n);
+    uint32_t groupCount = 0;
+    s.groupOf.resize(n);
+    uint32_t* const groupOf = s.groupOf.data();
+    for (uint32_t i = 0; i < n; ++i) {
+        const uint64_t offset = offsets[i];
+        auto g = static_cast<uint32_t>((offset * 0x9E3779B97F4A7C15ull) >> (64 - bits));
+        while (groups[g].stamp == stamp && groups[g].offset != offset) g = (g + 1) & mask;
+        if (groups[g].stamp != stamp) {
+            groups[g] = {.offset = offset, .stamp = stamp};
+            byOffset[groupCount++] = g;
+        }
+        groupOf[i] = g;
+        groups[g].end = std::max(groups[g].end, offset + items[i].size);
+        ++groups[g].count;
+    }
+    byOffset.resize(groupCount);
+    radixSort(byOffset, s.sortScratch, [&](uint32_t g) { return groups[g].offset; });
+    uint64_t reach = 0;
+    for (uint32_t k = 0; k < groupCount; ++k) {
+        OffsetGroup& group = groups[byOffset[k]];
+        group.below = reach;
+        if (k + 1 < groupCount) group.above = groups[byOffset[k + 1]].offset;
+        reach = std::max(reach, group.end);
+    }
+    for (uint32_t i = 0; i < n; ++i) {
+        const OffsetGroup& group = groups[groupOf[i]];
+        if (group.count > 1 || offsets[i] < group.below || group.above < offsets[i] + items[i].size)
+            aliased[items[i].resource] = 1;
+    }
+}
+
+struct Collected {
+    uint32_t count; // items in s.all
+    bool inOrder;   // sorted by (heap, first use) already
+};
+
+// Sizes the used transients and lists them as items in s.all, in resource
+// order; each heap is described in plan.heaps (keyed in s.keys) when its
+// first member turns up. Out of line, like place().
+[[gnu::noinline]] Collected collect(CompileState& st, Scratch& s) {
+    const ir::Declaration& d = st.decl;
+    Plan& plan = st.plan;
+    const MemoryRequirementsFn& requirementsOf = st.options.memoryRequirements;
+    const uint64_t granularity = std::max<uint64_t>(st.caps.bufferImageGranularity, 1);
+    std::vector<HeapKey>& keys = s.keys;
+    keys.clear();
+    // Room for every resource: the loop appends without a capacity check.
+    if (s.all.size() < d.resources.size()) s.all.resize(d.resources.size());
+    Item* const all = s.all.data();
+    uint32_t n = 0;
+
+    // Local pointers: the stores into the plan could alias any vector's
+    // data pointer as far as the compiler knows.
+    const ir::Resource* const resources = d.resources.data();
+    const Lifetime* const lifetimes = st.lifetimes.data();
+    PlannedResource* const planned = plan.resources.data();
+    const auto resourceCount = static_cast<uint32_t>(d.resources.size());
+    const bool custom = static_cast<bool>(requirementsOf);
+    // The previous transient's heap, which most share: its index, key and
+    // description (plan.heaps grows only where this is looked up).
+    uint32_t heapOf = kNoIndex;
+    HeapKey heapKey{};
+    MemoryHeap* memberHeap = nullptr;
+    uint64_t transientBytes = 0;
+    uint64_t previousOrder = 0; // (heap, first use) of the previous transient
+    bool inOrder = true;
+    for (uint32_t r = 0; r < resourceCount; ++r) {
+        const ir::Resource& res = resources[r];
+        const Lifetime& life = lifetimes[r];
+        if (res.origin != ir::Origin::Transient || !life.used()) continue;
+        PlannedResource& out = planned[r];
+        const TransientDescription desc{res.name, res.kind, res.texture, res.buffer, out.imageUsage, out.bufferUsage};
+        const MemoryRequirements req = custom ? requirementsOf(desc) : estimateMemoryRequirements(desc);
+        const uint64_t alignment = std::max<uint64_t>(req.alignment, 1);
+        out.size = alignUp(req.size, alignment);
+        out.alignment = alignment;
+        transientBytes += out.size;
+
+        const HeapKey key{life.crossQueue() ? 2u : queueIndex(out.queue), req.memoryTypeBits};
+        if (heapOf == kNoIndex || !(key == heapKey)) {
+            heapOf = static_cast<uint32_t>(std::find(keys.begin(), keys.end(), key) - keys.begin());
+            if (heapOf == keys.size()) {
+                keys.push_back(key);
+                MemoryHeap& added = plan.heaps.emplace_back();
+                added.queue = key.queueOrShared == 1 ? Queue::AsyncCompute : Queue::Graphics;
+                added.crossQueue = key.queueOrShared == 2;
+                added.memoryTypeBits = key.memoryTypeBits;
+            }
+            heapKey = key;
+            memberHeap = &plan.heaps[heapOf];
+        }
+        const uint64_t placedAlignment = std::max(alignment, granularity);
+        memberHeap->alignment = std::max(memberHeap->alignment, placedAlignment);
+        memberHeap->images |= res.kind == ResourceKind::Texture;
+        memberHeap->buffers |= res.kind != ResourceKind::Texture;
+        out.heap = heapOf;
+        all[n++] = {r, life.first, life.last, heapOf, alignUp(out.size, granularity), placedAlignment};
+        const uint64_t order = uint64_t{heapOf} << 32 | life.first;
+        inOrder = inOrder && order >= previousOrder;
+        previousOrder = order;
+    }
+    plan.stats.transientBytes += transientBytes;
+    return {n, inOrder};
 }
 
 } // namespace
@@ -173,64 +329,42 @@ uint64_t place(const Item* items, uint32_t n, uint64_t* offsets, bool alias, uin
 void aliasMemory(CompileState& st) {
     const ir::Declaration& d = st.decl;
     Plan& plan = st.plan;
-    const MemoryRequirementsFn& requirementsOf = st.options.memoryRequirements;
     Scratch& s = scratch();
-    const uint64_t granularity = std::max<uint64_t>(st.caps.bufferImageGranularity, 1);
     const auto positions = static_cast<uint32_t>(st.order.size());
-
     st.aliased.assign(d.resources.size(), 0);
-    std::vector<HeapKey>& keys = s.keys;
-    keys.clear();
-    s.all.clear();
-
-    TransientDescription desc;
-    for (uint32_t r = 0; r < d.resources.size(); ++r) {
-        const ir::Resource& res = d.resources[r];
-        const Lifetime& life = st.lifetimes[r];
-        if (res.origin != ir::Origin::Transient || !life.used()) continue;
-        PlannedResource& out = plan.resources[r];
-        desc.name = res.name;
-        desc.kind = res.kind;
-        desc.texture = res.texture;
-        desc.buffer = res.buffer;
-        desc.imageUsage = out.imageUsage;
-        desc.bufferUsage = out.bufferUsage;
-        const MemoryRequirements req = requirementsOf ? requirementsOf(desc) : estimateMemoryRequirements(desc);
-        const uint64_t alignment = std::max<uint64_t>(req.alignment, 1);
-        out.size = alignUp(req.size, alignment);
-        out.alignment = alignment;
-        plan.stats.transientBytes += out.size;
-
-        const HeapKey key{life.crossQueue() ? 2u : queueIndex(out.queue), req.memoryTypeBits};
-        auto it = std::find(keys.begin(), keys.end(), key);
-        if (it == keys.end()) {
-            keys.push_back(key);
-            it = keys.end() - 1;
-        }
-        const auto h = static_cast<uint32_t>(it - keys.begin());
-        out.heap = h;
-        s.all.push_back({r, life.first, life.last, h, alignUp(out.size, granularity), std::max(alignment, granularity)});
-    }
+    const auto [n, inOrder] = collect(st, s);
+    Item* const all = s.all.data();
+    PlannedResource* const planned = plan.resources.data();
 
     // Placement order: by first use, larger first on ties (big resources
     // get the low bytes), then by resource. One counting sort by (heap,
     // first use) gives each heap its items in first-use order, in resource
     // order within a position (it is stable); the runs sharing a first use
-    // are short and get an insertion sort by size.
-    const auto n = static_cast<uint32_t>(s.all.size());
-    const auto heaps = static_cast<uint32_t>(keys.size());
-    const uint32_t buckets = heaps * positions;
-    std::vector<uint32_t>& count = s.count;
-    count.assign(buckets + 1, 0);
-    for (const Item& item : s.all) ++count[item.heap * positions + item.first + 1];
-    for (uint32_t b = 0; b < buckets; ++b) count[b + 1] += count[b];
-    s.heapBegin.resize(heaps + 1);
-    for (uint32_t h = 0; h <= heaps; ++h) s.heapBegin[h] = count[h * positions];
-    s.items.resize(n);
-    for (const Item& item : s.all) s.items[count[item.heap * positions + item.first]++] = item;
+    // are short and get an insertion sort by size. Resources are mostly
+    // declared in order of first use, and a frame mostly has one heap: when
+    // the items come in that order already, they stay where they are.
+    const auto heaps = static_cast<uint32_t>(s.keys.size());
+    std::vector<uint32_t>& heapBegin = s.heapBegin;
+    heapBegin.assign(heaps + 1, 0);
+    Item* sorted = all;
+    if (inOrder) {
+        for (uint32_t h = 1; h <= heaps; ++h)
+            heapBegin[h] = static_cast<uint32_t>(
+                std::partition_point(all, all + n, [h](const Item& item) { return item.heap < h; }) - all);
+    } else {
+        const uint32_t buckets = heaps * positions;
+        std::vector<uint32_t>& count = s.count;
+        count.assign(buckets + 1, 0);
+        for (uint32_t i = 0; i < n; ++i) ++count[all[i].heap * positions + all[i].first + 1];
+        for (uint32_t b = 0; b < buckets; ++b) count[b + 1] += count[b];
+        for (uint32_t h = 0; h <= heaps; ++h) heapBegin[h] = count[h * positions];
+        s.items.resize(n);
+        sorted = s.items.data();
+        for (uint32_t i = 0; i < n; ++i) sorted[count[all[i].heap * positions + all[i].first]++] = all[i];
+    }
     for (uint32_t h = 0; h < heaps; ++h) {
-        Item* const items = s.items.data() + s.heapBegin[h];
-        const uint32_t size = s.heapBegin[h + 1] - s.heapBegin[h];
+        Item* const items = sorted + heapBegin[h];
+        const uint32_t size = heapBegin[h + 1] - heapBegin[h];
         for (uint32_t i = 1; i < size; ++i) {
             if (items[i].first != items[i - 1].first || items[i].size <= items[i - 1].size) continue;
             // Stable: equal sizes stay in resource order.
@@ -243,44 +377,17 @@ void aliasMemory(CompileState& st) {
     }
 
     std::vector<uint64_t>& offsets = s.offsets;
-    std::vector<uint32_t>& byOffset = s.byOffset;
     for (uint32_t h = 0; h < heaps; ++h) {
-        const Item* const items = s.items.data() + s.heapBegin[h];
-        const uint32_t size = s.heapBegin[h + 1] - s.heapBegin[h];
+        const Item* const items = sorted + heapBegin[h];
+        const uint32_t size = heapBegin[h + 1] - heapBegin[h];
         offsets.resize(size);
-        const bool alias = st.options.aliasing && keys[h].queueOrShared != 2;
-        MemoryHeap heap;
-        heap.queue = keys[h].queueOrShared == 1 ? Queue::AsyncCompute : Queue::Graphics;
-        heap.crossQueue = keys[h].queueOrShared == 2;
-        heap.memoryTypeBits = keys[h].memoryTypeBits;
-        heap.size = place(items, size, offsets.data(), alias, positions, s);
-        for (uint32_t i = 0; i < size; ++i) {
-            const Item& item = items[i];
-            heap.alignment = std::max(heap.alignment, item.alignment);
-            const bool image = d.resources[item.resource].kind == ResourceKind::Texture;
-            heap.images = heap.images || image;
-            heap.buffers = heap.buffers || !image;
-            plan.resources[item.resource].offset = offsets[i];
-        }
-        plan.heaps.push_back(heap);
+        MemoryHeap& heap = plan.heaps[h];
+        const bool alias = st.options.aliasing && !heap.crossQueue;
+        heap.size = place(items, size, offsets.data(), planned, alias, positions, s);
         plan.stats.aliasedTransientBytes += heap.size;
 
         if (!alias) continue;
-        // Sweep by offset: a resource is aliased when it starts below the end
-        // of an earlier one or the next one starts below its end.
-        // (Which of several resources at one offset comes first does not
-        // change the outcome: each is aliased by the other.)
-        byOffset.resize(size);
-        for (uint32_t i = 0; i < size; ++i) byOffset[i] = i;
-        radixSort(byOffset, s.sortScratch, [&](uint32_t i) { return offsets[i]; });
-        uint64_t reach = 0;
-        for (uint32_t i = 0; i < byOffset.size(); ++i) {
-            const uint32_t a = byOffset[i];
-            const uint64_t begin = offsets[a], end = begin + items[a].size;
-            const bool next = i + 1 < byOffset.size() && offsets[byOffset[i + 1]] < end;
-            if ((i > 0 && begin < reach) || next) st.aliased[items[a].resource] = 1;
-            reach = std::max(reach, end);
-        }
+        markShared(items, size, offsets.data(), st.aliased.data(), s);
         if (st.log)
             for (uint32_t i = 0; i < size; ++i)
                 spdlog::debug("rg alias: '{}' heap {} [{}, +{}) passes {}..{}{}", d.resources[items[i].resource].name,

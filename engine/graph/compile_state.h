@@ -73,11 +73,11 @@ void aliasMemory(CompileState& state);
 void placeBarriersAndBatches(CompileState& state);
 
 // Stable LSD radix sort by an unsigned 64-bit key, 8 bits a pass and only
-// as many passes as the keys' set bits span. The phases sort thousands of
-// byte offsets per compile; comparison sorts spent most of their time on
-// mispredicted branches there. One read counts every digit at once, and a
-// digit all keys share (one bucket holds them all) orders nothing, so its
-// scatter is skipped.
+// as many passes as the keys' set bits span. The alias phase sorts each
+// heap's distinct byte offsets, thousands in a frame that reuses little;
+// comparison sorts spent most of their time on mispredicted branches there.
+// One read counts every digit at once, and a digit all keys share (one
+// bucket holds them all) orders nothing, so its scatter is skipped.
 template <class T, class Key>
 void radixSort(std::vector<T>& items, std::vector<T>& scratch, Key key) {
     constexpr uint32_t kBits = 8, kBuckets = 1u << kBits, kDigits = 64 / kBits;

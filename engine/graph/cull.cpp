@@ -23,7 +23,11 @@ void cull(CompileState& st) {
     st.alive.assign(passCount + 1, 0);
     uint8_t* const alive = st.alive.data();
 
-    for (uint32_t p = 0; p < passCount; ++p) alive[p] = d.passes[p].sideEffects ? 1 : 0;
+    // Local pointers, and each pass's use count read once: the byte stores
+    // could alias the vectors' data pointers and the count.
+    const ir::Pass* const passes = d.passes.data();
+    const ir::Use* const allUses = d.uses.data();
+    for (uint32_t p = 0; p < passCount; ++p) alive[p] = passes[p].sideEffects ? 1 : 0;
     for (const ir::Output& o : d.outputs) alive[std::min(o.producer, passCount)] = 1;
     for (const ir::Resource& r : d.resources)
         if (r.origin == ir::Origin::Imported || r.origin == ir::Origin::HistoryCurrent)
@@ -35,9 +39,8 @@ void cull(CompileState& st) {
     // work list needed.
     for (uint32_t p = passCount; p-- > 0;) {
         if (!alive[p]) continue;
-        // The count is read once: the byte stores could alias it.
-        const ir::Use* const uses = d.uses.data() + d.passes[p].firstUse;
-        const uint32_t useCount = d.passes[p].useCount;
+        const ir::Use* const uses = allUses + passes[p].firstUse;
+        const uint32_t useCount = passes[p].useCount;
         for (uint32_t u = 0; u < useCount; ++u) alive[std::min(uses[u].producer, passCount)] = 1;
     }
     st.alive.pop_back();

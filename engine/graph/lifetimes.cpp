@@ -32,8 +32,9 @@ void computeLifetimes(CompileState& st) {
     const ir::Declaration& d = st.decl;
     st.lifetimes.assign(d.resources.size(), Lifetime{});
     // Reading a structure outside a ray tracing pipeline is a ray query.
-    // Checked once per pass on the union of its uses' kinds, not per use:
-    // the error names the first offending use either way.
+    // Checked once per pass on the union of its uses' kinds (which the pass
+    // keeps), not per use: the error names the first offending use either
+    // way.
     const AccessSet rayQueryRead = st.caps.rayQuery ? AccessSet{0} : accessBit(Access::AccelRead);
 
     // The loops work through local pointers: their byte-sized stores (queue
@@ -52,9 +53,9 @@ void computeLifetimes(CompileState& st) {
             throw GraphError(ErrorKind::UnsupportedFeature, pass.name,
                              pass.useCount ? d.resources[d.uses[pass.firstUse].resource].name : std::string(),
                              "uses a ray tracing pipeline, which the device does not support");
+        if ((pass.kinds & rayQueryRead) && pass.pipeline != Pipeline::RayTracing) rayQueryUnsupported(st, pass);
         const ir::Use* const uses = allUses + pass.firstUse;
         const uint32_t useCount = pass.useCount;
-        AccessSet passKinds = 0;
         for (uint32_t u = 0; u < useCount; ++u) {
             const ir::Use& use = uses[u];
             Lifetime& life = lifetimes[use.resource];
@@ -64,9 +65,7 @@ void computeLifetimes(CompileState& st) {
             life.last = pos;
             life.queues |= queueBit;
             life.kinds |= use.kinds;
-            passKinds |= use.kinds;
         }
-        if ((passKinds & rayQueryRead) && pass.pipeline != Pipeline::RayTracing) rayQueryUnsupported(st, pass);
     }
 
     const auto resourceCount = static_cast<uint32_t>(d.resources.size());

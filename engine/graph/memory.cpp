@@ -7,19 +7,6 @@
 namespace glint::rg {
 namespace {
 
-// Optimal-tiling images are placed at 64 KiB granularity by the desktop
-// drivers we target (NVIDIA, AMD, lavapipe report 4 KiB..64 KiB); the larger
-// value keeps the estimate on the safe side of real placement.
-constexpr uint64_t kImageAlignment = 64 * 1024;
-// minStorageBufferOffsetAlignment and friends top out at 256 bytes.
-constexpr uint64_t kBufferAlignment = 256;
-
-uint64_t alignUp(uint64_t v, uint64_t a) { return (v + a - 1) / a * a; }
-
-} // namespace
-
-namespace {
-
 constexpr FormatBlock blockOf(VkFormat f) {
     switch (f) {
         case VK_FORMAT_R8_UNORM:
@@ -97,67 +84,32 @@ constexpr FormatBlock blockOf(VkFormat f) {
     }
 }
 
-// The switch as a table over the core formats (every format above is one):
-// compile() sizes every transient every frame.
-constexpr uint32_t kCoreFormats = VK_FORMAT_ASTC_12x12_SRGB_BLOCK + 1;
-struct BlockTable {
-    FormatBlock block[kCoreFormats] = {};
-    constexpr BlockTable() {
-        for (uint32_t f = 0; f < kCoreFormats; ++f) block[f] = blockOf(static_cast<VkFormat>(f));
-    }
-};
-constexpr BlockTable kBlocks;
-
 } // namespace
 
-FormatBlock formatBlock(VkFormat f) {
-    const auto index = static_cast<uint32_t>(f);
-    return index < kCoreFormats ? kBlocks.block[index] : blockOf(f);
-}
+// The switch as a table, for formatBlock.
+constinit const std::array<FormatBlock, detail::kCoreFormatCount> detail::kCoreFormatBlocks = [] {
+    std::array<FormatBlock, kCoreFormatCount> table{};
+    for (uint32_t f = 0; f < kCoreFormatCount; ++f) table[f] = blockOf(static_cast<VkFormat>(f));
+    return table;
+}();
 
-VkImageAspectFlags aspectOf(VkFormat f) {
-    switch (f) {
-        case VK_FORMAT_D16_UNORM:
-        case VK_FORMAT_X8_D24_UNORM_PACK32:
-        case VK_FORMAT_D32_SFLOAT:
-            return VK_IMAGE_ASPECT_DEPTH_BIT;
-        case VK_FORMAT_S8_UINT:
-            return VK_IMAGE_ASPECT_STENCIL_BIT;
-        case VK_FORMAT_D16_UNORM_S8_UINT:
-        case VK_FORMAT_D24_UNORM_S8_UINT:
-        case VK_FORMAT_D32_SFLOAT_S8_UINT:
-            return VK_IMAGE_ASPECT_DEPTH_BIT | VK_IMAGE_ASPECT_STENCIL_BIT;
-        default:
-            return VK_IMAGE_ASPECT_COLOR_BIT;
-    }
-}
-
-MemoryRequirements estimateMemoryRequirements(const TransientDescription& d) {
-    if (d.kind == ResourceKind::Buffer) return {alignUp(d.buffer.size, kBufferAlignment), kBufferAlignment, ~0u};
-    if (d.kind != ResourceKind::Texture)
-        throw std::invalid_argument("estimateMemoryRequirements: only textures and buffers are transient");
-    const TextureDesc& t = d.texture;
-    const FormatBlock block = formatBlock(t.format);
-    if (block.bytes == 0)
-        throw std::invalid_argument("estimateMemoryRequirements: no size known for format " +
-                                    std::to_string(static_cast<int>(t.format)) + " of '" + std::string(d.name) +
-                                    "'; pass a MemoryRequirementsFn");
+uint64_t detail::blockCompressedBytes(const TextureDesc& t, FormatBlock block) {
     uint64_t bytes = 0;
-    if (block.width == 1 && block.height == 1) {
-        // Uncompressed formats (nearly every transient): texels are blocks,
-        // no rounding to block extents. compile() sizes every transient
-        // every frame.
-        uint64_t texels = 0;
-        for (uint32_t m = 0; m < t.mips; ++m)
-            texels += uint64_t{std::max(1u, t.width >> m)} * std::max(1u, t.height >> m) * std::max(1u, t.depth >> m);
-        bytes = texels * block.bytes;
-    } else {
-        for (uint32_t m = 0; m < t.mips; ++m) {
-            const uint64_t w = std::max(1u, t.width >> m), h = std::max(1u, t.height >> m), z = std::max(1u, t.depth >> m);
-            bytes += (w + block.width - 1) / block.width * ((h + block.height - 1) / block.height) * z * block.bytes;
-        }
+    for (uint32_t m = 0; m < t.mips; ++m) {
+        const uint64_t w = std::max(1u, t.width >> m), h = std::max(1u, t.height >> m), z = std::max(1u, t.depth >> m);
+        bytes += (w + block.width - 1) / block.width * ((h + block.height - 1) / block.height) * z * block.bytes;
     }
-    return {alignUp(bytes * t.layers, kImageAlignment), kImageAlignment, ~0u};
+    return bytes;
+}
+
+void detail::notTransient() {
+    throw std::invalid_argument("estimateMemoryRequirements: only textures and buffers are transient");
+}
+
+void detail::unknownFormat(const TransientDescription& d) {
+    throw std::invalid_argument("estimateMemoryRequirements: no size known for format " +
+                                std::to_string(static_cast<int>(d.texture.format)) + " of '" + std::string(d.name) +
+                                "'; pass a MemoryRequirementsFn");
 }
 
 } // namespace glint::rg
