@@ -7,7 +7,9 @@
 #include <algorithm>
 #include <chrono>
 #include <ctime>
+#include <mutex>
 #include <tuple>
+#include <unordered_map>
 
 namespace glint::rg {
 
@@ -128,8 +130,35 @@ struct Executor::FrameSlot {
 
 // ---------------------------------------------------------------- Executor
 
+// The driver's memory requirements by transient description. Asking is a
+// driver call (and a name copied into the description it takes) per
+// transient per compile; the descriptions repeat frame after frame. Locked:
+// plans may be compiled on several threads with one executor's options.
+struct Executor::RequirementsCache {
+    struct Key {
+        ResourceKind kind;
+        TextureDesc texture;      // textures only
+        uint64_t bufferSize;      // buffers only
+        VkFlags usage;            // image or buffer usage
+        friend bool operator==(const Key&, const Key&) = default;
+    };
+    struct Hash {
+        size_t operator()(const Key& k) const noexcept {
+            uint64_t h = uint64_t(k.kind) * 0x9E3779B97F4A7C15ull;
+            for (const uint64_t v : {uint64_t(k.texture.width) << 32 | k.texture.height,
+                                     uint64_t(k.texture.depth) << 32 | k.texture.layers,
+                                     uint64_t(k.texture.mips) << 32 | uint32_t(k.texture.format), k.bufferSize,
+                                     uint64_t(k.usage)})
+                h = (h ^ v) * 0x100000001B3ull + (h >> 29);
+            return size_t(h);
+        }
+    };
+    std::mutex mutex;
+    std::unordered_map<Key, MemoryRequirements, Hash> answers;
+};
+
 Executor::Executor(gpu::Context& gpu, uint32_t framesInFlight)
-    : gpu_(gpu), framesInFlight_(std::max(framesInFlight, 1u)) {
+    : gpu_(gpu), framesInFlight_(std::max(framesInFlight, 1u)), requirements_(std::make_unique<RequirementsCache>()) {
     timelines_[0] = gpu::TimelineSemaphore(gpu_, "rg.timeline.graphics");
     timelines_[1] = gpu::TimelineSemaphore(gpu_, "rg.timeline.compute");
     for (uint32_t i = 0; i < framesInFlight_; ++i) {
@@ -152,12 +181,22 @@ CompileOptions Executor::compileOptions(bool aliasing) const {
     CompileOptions o;
     o.aliasing = aliasing;
     gpu::Context* gpu = &gpu_;
-    o.memoryRequirements = [gpu](const TransientDescription& d) {
+    RequirementsCache* cache = requirements_.get();
+    o.memoryRequirements = [gpu, cache](const TransientDescription& d) {
+        const bool texture = d.kind == ResourceKind::Texture;
+        const RequirementsCache::Key key{d.kind, texture ? d.texture : TextureDesc{}, texture ? 0 : d.buffer.size,
+                                         texture ? d.imageUsage : d.bufferUsage};
+        {
+            const std::lock_guard lock(cache->mutex);
+            if (const auto it = cache->answers.find(key); it != cache->answers.end()) return it->second;
+        }
         const VkMemoryRequirements r =
-            d.kind == ResourceKind::Texture
-                ? gpu::Image::requirements(*gpu, imageDescOf(d.texture, d.imageUsage, std::string(d.name), false))
-                : gpu::Buffer::requirements(*gpu, bufferDescOf(d.buffer, d.bufferUsage, std::string(d.name), false));
-        return MemoryRequirements{r.size, r.alignment, r.memoryTypeBits};
+            texture ? gpu::Image::requirements(*gpu, imageDescOf(d.texture, d.imageUsage, std::string(d.name), false))
+                    : gpu::Buffer::requirements(*gpu, bufferDescOf(d.buffer, d.bufferUsage, std::string(d.name), false));
+        const MemoryRequirements answer{r.size, r.alignment, r.memoryTypeBits};
+        const std::lock_guard lock(cache->mutex);
+        cache->answers.emplace(key, answer);
+        return answer;
     };
     return o;
 }

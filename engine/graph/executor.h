@@ -190,7 +190,10 @@ public:
     Executor& operator=(const Executor&) = delete;
 
     QueueCaps queueCaps() const { return queueCapsOf(gpu_.caps()); }
-    // Compile options whose memory sizes are the driver's.
+    // Compile options whose memory sizes are the driver's. Each distinct
+    // transient description is asked about once and the answer kept (a frame
+    // loop compiles the same descriptions every frame); the options must not
+    // outlive the executor.
     CompileOptions compileOptions(bool aliasing = true) const;
 
     // Records and submits one frame of `plan`.
@@ -218,6 +221,7 @@ private:
     struct Transients;
     struct History;
     struct FrameSlot;
+    struct RequirementsCache;
 
     void prepareTransients(const Plan& plan);
     void prepareHistory(const Plan& plan);
@@ -236,6 +240,7 @@ private:
     uint64_t previousBase_[kQueueCount] = {0, 0};  // timeline value before the previous frame's batches
     std::vector<std::unique_ptr<FrameSlot>> slots_;
     std::unique_ptr<Transients> transients_;
+    std::unique_ptr<RequirementsCache> requirements_; // compileOptions()' answers by description
     std::map<std::string, std::unique_ptr<History>> history_;
     // Per declaration resource of the plan being run.
     std::vector<Physical> physical_;
