@@ -59,19 +59,25 @@ const AccessSet kNeedsRasterKinds = [] {
     return set;
 }();
 
-// The accesses a pass may declare on a resource kind, by direction (read,
-// write): not boundary-only, allowed on the kind, writing exactly when
-// declared with write(). use() checks a use against these with one bit test.
-struct DeclarableAccesses {
-    AccessSet of[3][2] = {};
+// The accesses a plain use may take, by resource kind, direction (read,
+// write), queue and pipeline of the pass: not boundary-only, allowed on the
+// kind, writing exactly when declared with write(), and available on the
+// queue with that pipeline. use() checks all of that with one bit test.
+struct PlainAccesses {
+    AccessSet of[3][2][kQueueCount][3] = {};
 };
-const DeclarableAccesses kDeclarable = [] {
-    DeclarableAccesses set;
+const PlainAccesses kPlain = [] {
+    PlainAccesses set;
     for (uint32_t i = 0; i < kAccessCount; ++i) {
         const auto a = static_cast<Access>(i);
         if (accessIsBoundaryOnly(a)) continue;
-        for (uint32_t k = 0; k < 3; ++k)
-            if (accessAllowedOn(a, static_cast<ResourceKind>(k))) set.of[k][accessWrites(a) ? 1 : 0] |= accessBit(a);
+        for (uint32_t k = 0; k < 3; ++k) {
+            if (!accessAllowedOn(a, static_cast<ResourceKind>(k))) continue;
+            for (uint32_t q = 0; q < kQueueCount; ++q)
+                for (uint32_t p = 0; p < 3; ++p)
+                    if (queueSupports(static_cast<Queue>(q), a, static_cast<Pipeline>(p)))
+                        set.of[k][accessWrites(a) ? 1 : 0][q][p] |= accessBit(a);
+        }
     }
     return set;
 }();
@@ -498,11 +504,11 @@ inline uint32_t Graph::use(uint32_t pass, ResourceKind kind, uint32_t index, uin
     const ir::Resource& r = d.resources[index];
     const ir::Pass& p = d.passes[pass];
     const AccessSet bit = accessBit(access);
+    const AccessSet plainAccesses =
+        kPlain.of[static_cast<uint32_t>(kind)][write][static_cast<uint32_t>(p.queue)][static_cast<uint32_t>(p.pipeline)];
     // Bitwise, not short-circuit: every term is cheap, and one branch
-    // predicts better than six.
-    const bool plain = (r.kind == kind) & ((kDeclarable.of[static_cast<uint32_t>(kind)][write] & bit) != 0) &
-                       ((p.queue == Queue::Graphics) |
-                        ((p.pipeline != Pipeline::Raster) & ((kNeedsRasterKinds & bit) == 0))) &
+    // predicts better than four.
+    const bool plain = (r.kind == kind) & ((plainAccesses & bit) != 0) &
                        ((r.origin != ir::Origin::Imported) | (r.hasInitial & r.hasFinal)) & (version == r.version);
     if (!plain) [[unlikely]]
         return useGeneral(pass, kind, index, version, graph, access, range, write);
