@@ -82,6 +82,14 @@ const PlainAccesses kPlain = [] {
     return set;
 }();
 
+// The kinds that need the subresource to hold data already, as one set.
+const AccessSet kNeedsContentsKinds = [] {
+    AccessSet set = 0;
+    for (uint32_t a = 0; a < kAccessCount; ++a)
+        if (accessNeedsContents(static_cast<Access>(a))) set |= accessBit(static_cast<Access>(a));
+    return set;
+}();
+
 // New resources are copied from this rather than value-initialised: GCC
 // clears a value-initialised Resource with `rep stos`, slow to start, and
 // declaring a frame makes thousands.
@@ -531,7 +539,7 @@ inline uint32_t Graph::use(uint32_t pass, ResourceKind kind, uint32_t index, uin
         resolved = {0, 1, 0, 1};
     }
 
-    if (accessNeedsContents(access)) {
+    if (kNeedsContentsKinds & bit) {
         // Cell (m, l) is cellBase + m * layers + l (ir::cellOf).
         const uint8_t* written = d.written.data() + r.cellBase + resolved.baseLayer;
         // Most uses name one cell; the loops' setup costs more than the check.
