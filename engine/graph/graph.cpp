@@ -223,8 +223,8 @@ void Graph::unshareDecl() {
 }
 
 // Resources are built in place: moving a Resource into the vector costs
-// more than everything else declaring it does.
-uint32_t Graph::newResource(std::string_view name, ResourceKind kind, ir::Origin origin) {
+// more than everything else declaring it does. Inline, like finishResource.
+inline uint32_t Graph::newResource(std::string_view name, ResourceKind kind, ir::Origin origin) {
     ir::Declaration& d = mutableDecl();
     const auto index = static_cast<uint32_t>(d.resources.size());
     ir::Resource& r = d.resources.emplace_back(kFreshResource);
