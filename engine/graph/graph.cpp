@@ -535,7 +535,10 @@ PassId Graph::endPass(uint32_t pass) {
 inline uint32_t Graph::use(uint32_t pass, ResourceKind kind, uint32_t index, uint32_t version, uint32_t graph,
                            Access access, Subresource range, bool write) {
     ir::Declaration& d = mutableDecl();
-    if (graph != d.graphId || index >= d.resources.size() || access >= Access::Count) [[unlikely]]
+    // index < size(), compared in bytes: size() divides by sizeof(Resource)
+    // (a multiply), and the byte offset is needed anyway.
+    if (graph != d.graphId || size_t{index} * sizeof(ir::Resource) >= d.resources.size() * sizeof(ir::Resource) ||
+        access >= Access::Count) [[unlikely]]
         return useGeneral(pass, kind, index, version, graph, access, range, write);
     const ir::Resource& r = d.resources[index];
     const ir::Pass& p = d.passes[pass];
