@@ -252,6 +252,7 @@ inline uint32_t Graph::newResource(std::string_view name, ResourceKind kind, ir:
     r.name = d.names.store(name);
     r.kind = kind;
     r.origin = origin;
+    r.declarableAs = static_cast<uint8_t>(kind);
     return index;
 }
 
@@ -294,6 +295,7 @@ void fillImport(ir::Resource& r, std::string_view name, ResourceKind kind, const
                 const std::optional<BoundaryState>& final) {
     r.hasInitial = initial.has_value();
     r.hasFinal = final.has_value();
+    if (!r.hasInitial || !r.hasFinal) r.declarableAs = ir::Resource::kNotDeclarable;
     if (initial) r.initial = *initial;
     if (final) r.final = *final;
     for (const BoundaryState* state : {&r.initial, &r.final}) {
@@ -381,6 +383,7 @@ std::pair<uint32_t, uint32_t> Graph::addHistory(std::string_view name, ResourceK
     ir::Resource& c = decl_->resources[current];
     c.name = d.names.store(name, ".current");
     c.kind = kind;
+    c.declarableAs = static_cast<uint8_t>(kind);
     c.origin = ir::Origin::HistoryCurrent;
     decl_->resources[previous].partner = current;
     c.partner = previous;
@@ -547,8 +550,8 @@ inline uint32_t Graph::use(uint32_t pass, ResourceKind kind, uint32_t index, uin
         kPlain.of[static_cast<uint32_t>(kind)][write][static_cast<uint32_t>(p.queue)][static_cast<uint32_t>(p.pipeline)];
     // Bitwise, not short-circuit: every term is cheap, and one branch
     // predicts better than four.
-    const bool plain = (r.kind == kind) & ((plainAccesses & bit) != 0) &
-                       ((r.origin != ir::Origin::Imported) | (r.hasInitial & r.hasFinal)) & (version == r.version);
+    const bool plain = (r.declarableAs == static_cast<uint8_t>(kind)) & ((plainAccesses & bit) != 0) &
+                       (version == r.version);
     if (!plain) [[unlikely]]
         return useGeneral(pass, kind, index, version, graph, access, range, write);
 

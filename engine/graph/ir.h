@@ -43,6 +43,12 @@ struct Resource {
     std::string_view name; // in Declaration::names
     ResourceKind kind = ResourceKind::Texture;
     Origin origin = Origin::Transient;
+    // Declaration bookkeeping: the kind a use must name to take the fast
+    // path -- `kind`, or kNotDeclarable for an import without both boundary
+    // states (no use of it is legal; the general path says why) -- so one
+    // compare stands for three.
+    static constexpr uint8_t kNotDeclarable = 0xff;
+    uint8_t declarableAs = 0;
     TextureDesc texture;
     BufferDesc buffer;
     // Imports only.
