@@ -291,22 +291,37 @@ uint32_t Graph::declareBuffer(std::string_view name, const BufferDesc& desc) {
 
 namespace {
 
-void fillImport(ir::Resource& r, std::string_view name, ResourceKind kind, const std::optional<BoundaryState>& initial,
-                const std::optional<BoundaryState>& final) {
+[[noreturn, gnu::cold]] void throwInvalidBoundary(std::string_view name, ResourceKind kind, Access access) {
+    throw GraphError(ErrorKind::InvalidAccess, kNoPass, std::string(name),
+                     "boundary state " + std::string(toString(access)) + " is not valid for a " +
+                         std::string(toString(kind)));
+}
+
+// A boundary state must name an access the kind can take (Present: a
+// texture); raw states are taken as they are.
+void validateBoundary(std::string_view name, ResourceKind kind, const std::optional<BoundaryState>& state) {
+    if (!state || state->isRaw || state->access == Access::None) return;
+    const bool valid =
+        state->access == Access::Present ? kind == ResourceKind::Texture : accessAllowedOn(state->access, kind);
+    if (!valid) [[unlikely]]
+        throwInvalidBoundary(name, kind, state->access);
+}
+
+} // namespace
+
+// The states are checked before the resource exists, so a bad one leaves
+// nothing to take back.
+uint32_t Graph::addImport(std::string_view name, ResourceKind kind, const std::optional<BoundaryState>& initial,
+                          const std::optional<BoundaryState>& final) {
+    validateBoundary(name, kind, initial);
+    validateBoundary(name, kind, final);
+    const uint32_t index = newResource(name, kind, ir::Origin::Imported);
+    ir::Resource& r = decl_->resources[index];
     r.hasInitial = initial.has_value();
     r.hasFinal = final.has_value();
     if (!r.hasInitial || !r.hasFinal) r.declarableAs = ir::Resource::kNotDeclarable;
     if (initial) r.initial = *initial;
     if (final) r.final = *final;
-    for (const BoundaryState* state : {&r.initial, &r.final}) {
-        if (state->isRaw || state->access == Access::None) continue;
-        const bool valid =
-            state->access == Access::Present ? kind == ResourceKind::Texture : accessAllowedOn(state->access, kind);
-        if (!valid)
-            throw GraphError(ErrorKind::InvalidAccess, kNoPass, std::string(name),
-                             "boundary state " + std::string(toString(state->access)) + " is not valid for a " +
-                                 std::string(toString(kind)));
-    }
     // Contents exist at the start when the initial state names a use that
     // left data behind (raw states: when they name a layout or any access).
     if (r.hasInitial) {
@@ -314,19 +329,6 @@ void fillImport(ir::Resource& r, std::string_view name, ResourceKind kind, const
         r.contentsAtStart = kind == ResourceKind::Texture
                                 ? s.layout != VK_IMAGE_LAYOUT_UNDEFINED
                                 : (r.initial.isRaw ? (s.stages | s.access) != 0 : r.initial.access != Access::None);
-    }
-}
-
-} // namespace
-
-uint32_t Graph::addImport(std::string_view name, ResourceKind kind, const std::optional<BoundaryState>& initial,
-                          const std::optional<BoundaryState>& final) {
-    const uint32_t index = newResource(name, kind, ir::Origin::Imported);
-    try {
-        fillImport(decl_->resources[index], name, kind, initial, final);
-    } catch (...) {
-        decl_->resources.pop_back();
-        throw;
     }
     return index;
 }
