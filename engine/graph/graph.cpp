@@ -557,11 +557,18 @@ inline uint32_t Graph::use(uint32_t pass, ResourceKind kind, uint32_t index, uin
     if (!plain) [[unlikely]]
         return useGeneral(pass, kind, index, version, graph, access, range, write);
 
-    Subresource resolved = range;
-    uint32_t layers = 1;
-    if (kind == ResourceKind::Texture) {
+    // Most uses name one cell: a buffer, a structure, or a texture of one mip
+    // and one layer used whole. Those need no range resolved and check one
+    // byte of contents.
+    Subresource resolved{0, 1, 0, 1};
+    bool oneCell = true;
+    if (kind != ResourceKind::Texture) {
+        if (range != Subresource{}) [[unlikely]]
+            return useGeneral(pass, kind, index, version, graph, access, range, write);
+    } else if (r.cellCount != 1 || range != Subresource{}) {
+        oneCell = false;
         const TextureDesc& t = r.texture;
-        layers = t.layers;
+        resolved = range;
         if (resolved.mipCount == Subresource::kAll)
             resolved.mipCount = resolved.baseMip < t.mips ? t.mips - resolved.baseMip : 0;
         if (resolved.layerCount == Subresource::kAll)
@@ -569,24 +576,27 @@ inline uint32_t Graph::use(uint32_t pass, ResourceKind kind, uint32_t index, uin
         if (resolved.mipCount == 0 || resolved.layerCount == 0 || resolved.baseMip + resolved.mipCount > t.mips ||
             resolved.baseLayer + resolved.layerCount > t.layers) [[unlikely]]
             return useGeneral(pass, kind, index, version, graph, access, range, write);
-    } else {
-        if (range != Subresource{}) [[unlikely]]
-            return useGeneral(pass, kind, index, version, graph, access, range, write);
-        resolved = {0, 1, 0, 1};
     }
 
     if (kNeedsContentsKinds & bit) {
         // Cell (m, l) is cellBase + m * layers + l (ir::cellOf).
-        const uint8_t* written = d.written.data() + r.cellBase + resolved.baseLayer;
-        // Most uses name one cell; the loops' setup costs more than the check.
-        if (resolved.mipCount == 1 && resolved.layerCount == 1) {
-            if (!written[resolved.baseMip * layers]) [[unlikely]]
+        const uint8_t* written = d.written.data() + r.cellBase;
+        if (oneCell) {
+            if (!written[0]) [[unlikely]]
                 return useGeneral(pass, kind, index, version, graph, access, range, write);
         } else {
-            for (uint32_t m = resolved.baseMip; m < resolved.baseMip + resolved.mipCount; ++m)
-                for (uint32_t l = 0; l < resolved.layerCount; ++l)
-                    if (!written[m * layers + l]) [[unlikely]]
-                        return useGeneral(pass, kind, index, version, graph, access, range, write);
+            const uint32_t layers = r.texture.layers;
+            // One mip and layer of a larger texture: the loops' setup costs
+            // more than the check.
+            if (resolved.mipCount == 1 && resolved.layerCount == 1) {
+                if (!written[resolved.baseMip * layers + resolved.baseLayer]) [[unlikely]]
+                    return useGeneral(pass, kind, index, version, graph, access, range, write);
+            } else {
+                for (uint32_t m = resolved.baseMip; m < resolved.baseMip + resolved.mipCount; ++m)
+                    for (uint32_t l = resolved.baseLayer; l < resolved.baseLayer + resolved.layerCount; ++l)
+                        if (!written[m * layers + l]) [[unlikely]]
+                            return useGeneral(pass, kind, index, version, graph, access, range, write);
+            }
         }
     }
 
