@@ -441,7 +441,7 @@ void Graph::order(PassId before, PassId after) {
     mutableDecl().orderings.push_back({before.index, after.index});
 }
 
-Builder Graph::beginPass(std::string_view name, Queue queue, ExecuteFn execute) {
+Builder Graph::beginPass(std::string_view name, Queue queue, ExecuteFn& execute) {
     ir::Declaration& d = mutableDecl();
     ir::Pass& p = d.passes.emplace_back();
     p.name = d.names.store(name);

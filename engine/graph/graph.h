@@ -103,7 +103,7 @@ public:
 
     template <class Setup>
     PassId addPass(std::string_view name, Queue queue, Setup&& setup, ExecuteFn execute = {}) {
-        Builder builder = beginPass(name, queue, std::move(execute));
+        Builder builder = beginPass(name, queue, execute);
         try {
             std::forward<Setup>(setup)(builder);
             return endPass(builder.pass_);
@@ -178,7 +178,9 @@ private:
     friend class Builder;
     friend Plan compile(const Graph&, const QueueCaps&, const CompileOptions&, Plan&&);
 
-    Builder beginPass(std::string_view name, Queue queue, ExecuteFn execute);
+    // Takes the callback out of `execute`, leaving it empty: by reference,
+    // so no third std::function is moved into and destroyed for every pass.
+    Builder beginPass(std::string_view name, Queue queue, ExecuteFn& execute);
     void abortPass(uint32_t pass);
     PassId endPass(uint32_t pass);
 
