@@ -18,9 +18,11 @@ std::atomic<uint32_t> gNextGraphId{1};
 
 const std::string kNoPass = "(graph)";
 
-// Cold, so it is never inlined: inline, its string building made every
-// validateTexture() save six registers and set up a frame.
-[[noreturn, gnu::cold]] void throwInvalidTexture(std::string_view name, const TextureDesc& d) {
+// The throw helpers here are cold and never inlined, not even into a
+// caller's cold part: with their message building inside, a check such as
+// validateTexture() or endPass() saved six registers and set up a frame on
+// every call.
+[[noreturn, gnu::cold, gnu::noinline]] void throwInvalidTexture(std::string_view name, const TextureDesc& d) {
     std::string problem;
     if (d.width == 0 || d.height == 0 || d.depth == 0 || d.layers == 0 || d.mips == 0)
         problem = "every extent, the layer count and the mip count must be at least 1";
@@ -44,7 +46,7 @@ void validateTexture(std::string_view name, const TextureDesc& d) {
         throwInvalidTexture(name, d);
 }
 
-[[noreturn, gnu::cold]] void throwInvalidBuffer(std::string_view name) {
+[[noreturn, gnu::cold, gnu::noinline]] void throwInvalidBuffer(std::string_view name) {
     throw GraphError(ErrorKind::InvalidDescription, kNoPass, std::string(name), "buffer size is 0");
 }
 
@@ -291,7 +293,7 @@ uint32_t Graph::declareBuffer(std::string_view name, const BufferDesc& desc) {
 
 namespace {
 
-[[noreturn, gnu::cold]] void throwInvalidBoundary(std::string_view name, ResourceKind kind, Access access) {
+[[noreturn, gnu::cold, gnu::noinline]] void throwInvalidBoundary(std::string_view name, ResourceKind kind, Access access) {
     throw GraphError(ErrorKind::InvalidAccess, kNoPass, std::string(name),
                      "boundary state " + std::string(toString(access)) + " is not valid for a " +
                          std::string(toString(kind)));
@@ -471,7 +473,7 @@ namespace {
 
 // endPass found a use that needs a raster pipeline on a pass without one, or
 // a raster pass on the async compute queue: says which, as it always has.
-[[noreturn]] void throwPassNeedsRaster(const ir::Declaration& d, uint32_t pass) {
+[[noreturn, gnu::cold, gnu::noinline]] void throwPassNeedsRaster(const ir::Declaration& d, uint32_t pass) {
     const ir::Pass& p = d.passes[pass];
     const uint32_t end = p.firstUse + p.useCount;
     if (p.pipeline != Pipeline::Raster) {
