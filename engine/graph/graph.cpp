@@ -246,25 +246,30 @@ void Graph::unshareDecl() {
 }
 
 // Resources are built in place: moving a Resource into the vector costs
-// more than everything else declaring it does. Inline, like finishResource.
-inline uint32_t Graph::newResource(std::string_view name, ResourceKind kind, ir::Origin origin) {
+// more than everything else declaring it does. The name is stored first
+// (stored after, its byte copies could alias anything, and the caller
+// reloaded the resource's address), and the resource comes back by
+// reference, so callers fill it in without indexing again. Inline, like
+// finishResource.
+inline Graph::NewResource Graph::newResource(std::string_view name, ResourceKind kind, ir::Origin origin,
+                                              std::string_view suffix) {
     ir::Declaration& d = mutableDecl();
     const auto index = static_cast<uint32_t>(d.resources.size());
+    const std::string_view stored = d.names.store(name, suffix);
     ir::Resource& r = d.resources.emplace_back(kFreshResource);
-    r.name = d.names.store(name);
+    r.name = stored;
     r.kind = kind;
     r.origin = origin;
     r.declarableAs = static_cast<uint8_t>(kind);
-    return index;
+    return {index, r};
 }
 
 // Gives a resource, once described, its cells: mips x layers of a texture,
 // one otherwise. The caller passes the count from the description it
 // holds; read back from the resource just written, it waited on the stores.
 // Inline (only this file calls it): a call cost about as much as its work.
-inline void Graph::finishResource(uint32_t index, uint32_t cells) {
+inline void Graph::finishResource(ir::Resource& r, uint32_t cells) {
     ir::Declaration& d = *decl_;
-    ir::Resource& r = d.resources[index];
     r.cellBase = d.cellCount;
     r.cellCount = cells;
     d.cellCount = r.cellBase + r.cellCount;
@@ -277,17 +282,17 @@ inline void Graph::finishResource(uint32_t index, uint32_t cells) {
 
 uint32_t Graph::declareTexture(std::string_view name, const TextureDesc& desc) {
     validateTexture(name, desc);
-    const uint32_t index = newResource(name, ResourceKind::Texture, ir::Origin::Transient);
-    decl_->resources[index].texture = desc;
-    finishResource(index, desc.mips * desc.layers);
+    const auto [index, r] = newResource(name, ResourceKind::Texture, ir::Origin::Transient);
+    r.texture = desc;
+    finishResource(r, desc.mips * desc.layers);
     return index;
 }
 
 uint32_t Graph::declareBuffer(std::string_view name, const BufferDesc& desc) {
     validateBuffer(name, desc);
-    const uint32_t index = newResource(name, ResourceKind::Buffer, ir::Origin::Transient);
-    decl_->resources[index].buffer = desc;
-    finishResource(index, 1);
+    const auto [index, r] = newResource(name, ResourceKind::Buffer, ir::Origin::Transient);
+    r.buffer = desc;
+    finishResource(r, 1);
     return index;
 }
 
@@ -313,12 +318,13 @@ void validateBoundary(std::string_view name, ResourceKind kind, const std::optio
 
 // The states are checked before the resource exists, so a bad one leaves
 // nothing to take back.
-uint32_t Graph::addImport(std::string_view name, ResourceKind kind, const std::optional<BoundaryState>& initial,
-                          const std::optional<BoundaryState>& final) {
+Graph::NewResource Graph::addImport(std::string_view name, ResourceKind kind,
+                                    const std::optional<BoundaryState>& initial,
+                                    const std::optional<BoundaryState>& final) {
     validateBoundary(name, kind, initial);
     validateBoundary(name, kind, final);
-    const uint32_t index = newResource(name, kind, ir::Origin::Imported);
-    ir::Resource& r = decl_->resources[index];
+    const NewResource made = newResource(name, kind, ir::Origin::Imported);
+    ir::Resource& r = made.resource;
     r.hasInitial = initial.has_value();
     r.hasFinal = final.has_value();
     if (!r.hasInitial || !r.hasFinal) r.declarableAs = ir::Resource::kNotDeclarable;
@@ -332,28 +338,28 @@ uint32_t Graph::addImport(std::string_view name, ResourceKind kind, const std::o
                                 ? s.layout != VK_IMAGE_LAYOUT_UNDEFINED
                                 : (r.initial.isRaw ? (s.stages | s.access) != 0 : r.initial.access != Access::None);
     }
-    return index;
+    return made;
 }
 
 uint32_t Graph::declareTextureImport(std::string_view name, const TextureImport& import) {
     validateTexture(name, import.desc);
-    const uint32_t index = addImport(name, ResourceKind::Texture, import.initial, import.final);
-    decl_->resources[index].texture = import.desc;
-    finishResource(index, import.desc.mips * import.desc.layers);
+    const auto [index, r] = addImport(name, ResourceKind::Texture, import.initial, import.final);
+    r.texture = import.desc;
+    finishResource(r, import.desc.mips * import.desc.layers);
     return index;
 }
 
 uint32_t Graph::declareBufferImport(std::string_view name, const BufferImport& import) {
     validateBuffer(name, import.desc);
-    const uint32_t index = addImport(name, ResourceKind::Buffer, import.initial, import.final);
-    decl_->resources[index].buffer = import.desc;
-    finishResource(index, 1);
+    const auto [index, r] = addImport(name, ResourceKind::Buffer, import.initial, import.final);
+    r.buffer = import.desc;
+    finishResource(r, 1);
     return index;
 }
 
 uint32_t Graph::declareAccelStructImport(std::string_view name, const AccelStructImport& import) {
-    const uint32_t index = addImport(name, ResourceKind::AccelStruct, import.initial, import.final);
-    finishResource(index, 1);
+    const auto [index, r] = addImport(name, ResourceKind::AccelStruct, import.initial, import.final);
+    finishResource(r, 1);
     return index;
 }
 
@@ -361,8 +367,9 @@ HistoryTexture Graph::createHistoryTexture(std::string_view name, const TextureD
     validateTexture(name, desc);
     const auto [previous, current] = addHistory(name, ResourceKind::Texture);
     for (uint32_t r : {previous, current}) {
-        decl_->resources[r].texture = desc;
-        finishResource(r, desc.mips * desc.layers);
+        ir::Resource& half = decl_->resources[r];
+        half.texture = desc;
+        finishResource(half, desc.mips * desc.layers);
     }
     return {Texture{previous, 0, id()}, Texture{current, 0, id()}};
 }
@@ -371,25 +378,20 @@ HistoryBuffer Graph::createHistoryBuffer(std::string_view name, const BufferDesc
     validateBuffer(name, desc);
     const auto [previous, current] = addHistory(name, ResourceKind::Buffer);
     for (uint32_t r : {previous, current}) {
-        decl_->resources[r].buffer = desc;
-        finishResource(r, 1);
+        ir::Resource& half = decl_->resources[r];
+        half.buffer = desc;
+        finishResource(half, 1);
     }
     return {Buffer{previous, 0, id()}, Buffer{current, 0, id()}};
 }
 
 // Both halves of a pair; the description is filled in by the caller.
 std::pair<uint32_t, uint32_t> Graph::addHistory(std::string_view name, ResourceKind kind) {
-    ir::Declaration& d = mutableDecl();
-    const uint32_t previous = newResource(d.names.store(name, ".previous"), kind, ir::Origin::HistoryPrevious);
-    decl_->resources[previous].contentsAtStart = true;
-    const uint32_t current = previous + 1;
-    decl_->resources.emplace_back(kFreshResource);
-    ir::Resource& c = decl_->resources[current];
-    c.name = d.names.store(name, ".current");
-    c.kind = kind;
-    c.declarableAs = static_cast<uint8_t>(kind);
-    c.origin = ir::Origin::HistoryCurrent;
-    decl_->resources[previous].partner = current;
+    const auto [previous, p] = newResource(name, kind, ir::Origin::HistoryPrevious, ".previous");
+    p.contentsAtStart = true;
+    p.partner = previous + 1;
+    // The second emplace may reallocate: the first half is set up before it.
+    const auto [current, c] = newResource(name, kind, ir::Origin::HistoryCurrent, ".current");
     c.partner = previous;
     return {previous, current};
 }
