@@ -514,6 +514,11 @@ PassId Graph::endPass(uint32_t pass) {
         ir::Resource& r = d.resources[use->resource];
         r.version = use->version + 1;
         r.lastWriter = pass;
+        // Most resources have one cell: it needs no range looked at.
+        if (r.cellCount == 1) {
+            d.written[r.cellBase] = 1;
+            continue;
+        }
         // Cell (m, l) is cellBase + m * layers + l (ir::cellOf). Mostly one
         // cell, stored without the loops' setup; otherwise a loop still
         // beats a call to memset. The range is copied: the
