@@ -298,7 +298,8 @@ uint32_t Graph::declareBuffer(std::string_view name, const BufferDesc& desc) {
 
 namespace {
 
-[[noreturn, gnu::cold, gnu::noinline]] void throwInvalidBoundary(std::string_view name, ResourceKind kind, Access access) {
+[[noreturn, gnu::cold, gnu::noinline]] void throwInvalidBoundary(std::string_view name, ResourceKind kind,
+                                                                  Access access) {
     throw GraphError(ErrorKind::InvalidAccess, kNoPass, std::string(name),
                      "boundary state " + std::string(toString(access)) + " is not valid for a " +
                          std::string(toString(kind)));
@@ -557,8 +558,8 @@ inline uint32_t Graph::use(uint32_t pass, ResourceKind kind, uint32_t index, uin
     const ir::Resource& r = d.resources[index];
     const ir::Pass& p = d.passes[pass];
     const AccessSet bit = accessBit(access);
-    const AccessSet plainAccesses =
-        kPlain.of[static_cast<uint32_t>(kind)][write][static_cast<uint32_t>(p.queue)][static_cast<uint32_t>(p.pipeline)];
+    const AccessSet plainAccesses = kPlain.of[static_cast<uint32_t>(kind)][write][static_cast<uint32_t>(p.queue)]
+                                             [static_cast<uint32_t>(p.pipeline)];
     // Bitwise, not short-circuit: every term is cheap, and one branch
     // predicts better than four.
     const bool plain = (r.declarableAs == static_cast<uint8_t>(kind)) & ((plainAccesses & bit) != 0) &
