@@ -18,7 +18,11 @@ std::atomic<uint32_t> gNextGraphId{1};
 
 const std::string kNoPass = "(graph)";
 
-[[noreturn]] void throwInvalidTexture(std::string_view name, const TextureDesc& d) {
+// The throw helpers here are cold and never inlined, not even into a
+// caller's cold part: with their message building inside, a check such as
+// validateTexture() or endPass() saved six registers and set up a frame on
+// every call.
+[[noreturn, gnu::cold, gnu::noinline]] void throwInvalidTexture(std::string_view name, const TextureDesc& d) {
     std::string problem;
     if (d.width == 0 || d.height == 0 || d.depth == 0 || d.layers == 0 || d.mips == 0)
         problem = "every extent, the layer count and the mip count must be at least 1";
@@ -42,8 +46,13 @@ void validateTexture(std::string_view name, const TextureDesc& d) {
         throwInvalidTexture(name, d);
 }
 
+[[noreturn, gnu::cold, gnu::noinline]] void throwInvalidBuffer(std::string_view name) {
+    throw GraphError(ErrorKind::InvalidDescription, kNoPass, std::string(name), "buffer size is 0");
+}
+
 void validateBuffer(std::string_view name, const BufferDesc& d) {
-    if (d.size == 0) throw GraphError(ErrorKind::InvalidDescription, kNoPass, std::string(name), "buffer size is 0");
+    if (d.size == 0) [[unlikely]]
+        throwInvalidBuffer(name);
 }
 
 bool rangesOverlap(const Subresource& a, const Subresource& b) {
@@ -59,20 +68,34 @@ const AccessSet kNeedsRasterKinds = [] {
     return set;
 }();
 
-// The accesses a pass may declare on a resource kind, by direction (read,
-// write): not boundary-only, allowed on the kind, writing exactly when
-// declared with write(). use() checks a use against these with one bit test.
-struct DeclarableAccesses {
-    AccessSet of[3][2] = {};
+// The accesses a plain use may take, by resource kind, direction (read,
+// write), queue and pipeline of the pass: not boundary-only, allowed on the
+// kind, writing exactly when declared with write(), and available on the
+// queue with that pipeline. use() checks all of that with one bit test.
+struct PlainAccesses {
+    AccessSet of[3][2][kQueueCount][3] = {};
 };
-const DeclarableAccesses kDeclarable = [] {
-    DeclarableAccesses set;
+const PlainAccesses kPlain = [] {
+    PlainAccesses set;
     for (uint32_t i = 0; i < kAccessCount; ++i) {
         const auto a = static_cast<Access>(i);
         if (accessIsBoundaryOnly(a)) continue;
-        for (uint32_t k = 0; k < 3; ++k)
-            if (accessAllowedOn(a, static_cast<ResourceKind>(k))) set.of[k][accessWrites(a) ? 1 : 0] |= accessBit(a);
+        for (uint32_t k = 0; k < 3; ++k) {
+            if (!accessAllowedOn(a, static_cast<ResourceKind>(k))) continue;
+            for (uint32_t q = 0; q < kQueueCount; ++q)
+                for (uint32_t p = 0; p < 3; ++p)
+                    if (queueSupports(static_cast<Queue>(q), a, static_cast<Pipeline>(p)))
+                        set.of[k][accessWrites(a) ? 1 : 0][q][p] |= accessBit(a);
+        }
     }
+    return set;
+}();
+
+// The kinds that need the subresource to hold data already, as one set.
+const AccessSet kNeedsContentsKinds = [] {
+    AccessSet set = 0;
+    for (uint32_t a = 0; a < kAccessCount; ++a)
+        if (accessNeedsContents(static_cast<Access>(a))) set |= accessBit(static_cast<Access>(a));
     return set;
 }();
 
@@ -88,15 +111,10 @@ inline uint32_t appendUse(ir::Declaration& d, uint32_t pass, uint32_t index, uin
                           bool write, const Subresource& range) {
     ir::Resource& r = d.resources[index];
     r.lastUser = pass;
-    // Built in place: assembling it on the stack and copying it stalls on
-    // store forwarding, and this runs for every use of every pass.
-    ir::Use& use = d.uses.emplace_back();
-    use.resource = index;
-    use.version = version;
-    use.producer = r.lastWriter;
-    use.kinds = bit;
-    use.writes = write;
-    use.range = range;
+    // Built in place, each field stored once: assembling it on the stack and
+    // copying it stalls on store forwarding, and this runs for every use of
+    // every pass.
+    d.uses.emplace_back(index, version, r.lastWriter, bit, write, range);
     ir::Pass& owner = d.passes[pass];
     ++owner.useCount;
     owner.kinds |= bit;
@@ -116,6 +134,32 @@ void ir::NameArena::grow(size_t size) {
     used_ = 0;
 }
 
+namespace {
+
+// Copies `size` bytes as two fixed-size copies that overlap when the size is
+// not a multiple (memcpy's own trick for short sizes), without calling it:
+// names are short (a frame's are 2 to 30 bytes), and the call cost more
+// than the copy.
+template <size_t N>
+void copyOverlapping(char* out, const char* in, size_t size) {
+    std::memcpy(out, in, N);
+    std::memcpy(out + size - N, in + size - N, N);
+}
+
+void copyName(char* out, std::string_view name) {
+    const size_t size = name.size();
+    if (size >= 16 && size <= 32)
+        copyOverlapping<16>(out, name.data(), size);
+    else if (size >= 8 && size < 16)
+        copyOverlapping<8>(out, name.data(), size);
+    else if (size >= 4 && size < 8)
+        copyOverlapping<4>(out, name.data(), size);
+    else if (size != 0)
+        std::memcpy(out, name.data(), size);
+}
+
+} // namespace
+
 // Every pass and resource name comes through here; the rare new chunk stays
 // out of line so this stays small.
 std::string_view ir::NameArena::store(std::string_view a, std::string_view b) {
@@ -123,8 +167,8 @@ std::string_view ir::NameArena::store(std::string_view a, std::string_view b) {
     if (used_ + size > capacity_) [[unlikely]]
         grow(size);
     char* out = chunks_.back().get() + used_;
-    if (!a.empty()) std::memcpy(out, a.data(), a.size());
-    if (!b.empty()) std::memcpy(out + a.size(), b.data(), b.size());
+    copyName(out, a);
+    copyName(out + a.size(), b);
     used_ += size;
     return {out, size};
 }
@@ -202,24 +246,30 @@ void Graph::unshareDecl() {
 }
 
 // Resources are built in place: moving a Resource into the vector costs
-// more than everything else declaring it does.
-uint32_t Graph::newResource(std::string_view name, ResourceKind kind, ir::Origin origin) {
+// more than everything else declaring it does. The name is stored first
+// (stored after, its byte copies could alias anything, and the caller
+// reloaded the resource's address), and the resource comes back by
+// reference, so callers fill it in without indexing again. Inline, like
+// finishResource.
+inline Graph::NewResource Graph::newResource(std::string_view name, ResourceKind kind, ir::Origin origin,
+                                              std::string_view suffix) {
     ir::Declaration& d = mutableDecl();
     const auto index = static_cast<uint32_t>(d.resources.size());
+    const std::string_view stored = d.names.store(name, suffix);
     ir::Resource& r = d.resources.emplace_back(kFreshResource);
-    r.name = d.names.store(name);
+    r.name = stored;
     r.kind = kind;
     r.origin = origin;
-    return index;
+    r.declarableAs = static_cast<uint8_t>(kind);
+    return {index, r};
 }
 
 // Gives a resource, once described, its cells: mips x layers of a texture,
 // one otherwise. The caller passes the count from the description it
 // holds; read back from the resource just written, it waited on the stores.
 // Inline (only this file calls it): a call cost about as much as its work.
-inline void Graph::finishResource(uint32_t index, uint32_t cells) {
+inline void Graph::finishResource(ir::Resource& r, uint32_t cells) {
     ir::Declaration& d = *decl_;
-    ir::Resource& r = d.resources[index];
     r.cellBase = d.cellCount;
     r.cellCount = cells;
     d.cellCount = r.cellBase + r.cellCount;
@@ -232,37 +282,55 @@ inline void Graph::finishResource(uint32_t index, uint32_t cells) {
 
 uint32_t Graph::declareTexture(std::string_view name, const TextureDesc& desc) {
     validateTexture(name, desc);
-    const uint32_t index = newResource(name, ResourceKind::Texture, ir::Origin::Transient);
-    decl_->resources[index].texture = desc;
-    finishResource(index, desc.mips * desc.layers);
+    const auto [index, r] = newResource(name, ResourceKind::Texture, ir::Origin::Transient);
+    r.texture = desc;
+    finishResource(r, desc.mips * desc.layers);
     return index;
 }
 
 uint32_t Graph::declareBuffer(std::string_view name, const BufferDesc& desc) {
     validateBuffer(name, desc);
-    const uint32_t index = newResource(name, ResourceKind::Buffer, ir::Origin::Transient);
-    decl_->resources[index].buffer = desc;
-    finishResource(index, 1);
+    const auto [index, r] = newResource(name, ResourceKind::Buffer, ir::Origin::Transient);
+    r.buffer = desc;
+    finishResource(r, 1);
     return index;
 }
 
 namespace {
 
-void fillImport(ir::Resource& r, std::string_view name, ResourceKind kind, const std::optional<BoundaryState>& initial,
-                const std::optional<BoundaryState>& final) {
+[[noreturn, gnu::cold, gnu::noinline]] void throwInvalidBoundary(std::string_view name, ResourceKind kind,
+                                                                  Access access) {
+    throw GraphError(ErrorKind::InvalidAccess, kNoPass, std::string(name),
+                     "boundary state " + std::string(toString(access)) + " is not valid for a " +
+                         std::string(toString(kind)));
+}
+
+// A boundary state must name an access the kind can take (Present: a
+// texture); raw states are taken as they are.
+void validateBoundary(std::string_view name, ResourceKind kind, const std::optional<BoundaryState>& state) {
+    if (!state || state->isRaw || state->access == Access::None) return;
+    const bool valid =
+        state->access == Access::Present ? kind == ResourceKind::Texture : accessAllowedOn(state->access, kind);
+    if (!valid) [[unlikely]]
+        throwInvalidBoundary(name, kind, state->access);
+}
+
+} // namespace
+
+// The states are checked before the resource exists, so a bad one leaves
+// nothing to take back.
+Graph::NewResource Graph::addImport(std::string_view name, ResourceKind kind,
+                                    const std::optional<BoundaryState>& initial,
+                                    const std::optional<BoundaryState>& final) {
+    validateBoundary(name, kind, initial);
+    validateBoundary(name, kind, final);
+    const NewResource made = newResource(name, kind, ir::Origin::Imported);
+    ir::Resource& r = made.resource;
     r.hasInitial = initial.has_value();
     r.hasFinal = final.has_value();
+    if (!r.hasInitial || !r.hasFinal) r.declarableAs = ir::Resource::kNotDeclarable;
     if (initial) r.initial = *initial;
     if (final) r.final = *final;
-    for (const BoundaryState* state : {&r.initial, &r.final}) {
-        if (state->isRaw || state->access == Access::None) continue;
-        const bool valid =
-            state->access == Access::Present ? kind == ResourceKind::Texture : accessAllowedOn(state->access, kind);
-        if (!valid)
-            throw GraphError(ErrorKind::InvalidAccess, kNoPass, std::string(name),
-                             "boundary state " + std::string(toString(state->access)) + " is not valid for a " +
-                                 std::string(toString(kind)));
-    }
     // Contents exist at the start when the initial state names a use that
     // left data behind (raw states: when they name a layout or any access).
     if (r.hasInitial) {
@@ -271,41 +339,28 @@ void fillImport(ir::Resource& r, std::string_view name, ResourceKind kind, const
                                 ? s.layout != VK_IMAGE_LAYOUT_UNDEFINED
                                 : (r.initial.isRaw ? (s.stages | s.access) != 0 : r.initial.access != Access::None);
     }
-}
-
-} // namespace
-
-uint32_t Graph::addImport(std::string_view name, ResourceKind kind, const std::optional<BoundaryState>& initial,
-                          const std::optional<BoundaryState>& final) {
-    const uint32_t index = newResource(name, kind, ir::Origin::Imported);
-    try {
-        fillImport(decl_->resources[index], name, kind, initial, final);
-    } catch (...) {
-        decl_->resources.pop_back();
-        throw;
-    }
-    return index;
+    return made;
 }
 
 uint32_t Graph::declareTextureImport(std::string_view name, const TextureImport& import) {
     validateTexture(name, import.desc);
-    const uint32_t index = addImport(name, ResourceKind::Texture, import.initial, import.final);
-    decl_->resources[index].texture = import.desc;
-    finishResource(index, import.desc.mips * import.desc.layers);
+    const auto [index, r] = addImport(name, ResourceKind::Texture, import.initial, import.final);
+    r.texture = import.desc;
+    finishResource(r, import.desc.mips * import.desc.layers);
     return index;
 }
 
 uint32_t Graph::declareBufferImport(std::string_view name, const BufferImport& import) {
     validateBuffer(name, import.desc);
-    const uint32_t index = addImport(name, ResourceKind::Buffer, import.initial, import.final);
-    decl_->resources[index].buffer = import.desc;
-    finishResource(index, 1);
+    const auto [index, r] = addImport(name, ResourceKind::Buffer, import.initial, import.final);
+    r.buffer = import.desc;
+    finishResource(r, 1);
     return index;
 }
 
 uint32_t Graph::declareAccelStructImport(std::string_view name, const AccelStructImport& import) {
-    const uint32_t index = addImport(name, ResourceKind::AccelStruct, import.initial, import.final);
-    finishResource(index, 1);
+    const auto [index, r] = addImport(name, ResourceKind::AccelStruct, import.initial, import.final);
+    finishResource(r, 1);
     return index;
 }
 
@@ -313,8 +368,9 @@ HistoryTexture Graph::createHistoryTexture(std::string_view name, const TextureD
     validateTexture(name, desc);
     const auto [previous, current] = addHistory(name, ResourceKind::Texture);
     for (uint32_t r : {previous, current}) {
-        decl_->resources[r].texture = desc;
-        finishResource(r, desc.mips * desc.layers);
+        ir::Resource& half = decl_->resources[r];
+        half.texture = desc;
+        finishResource(half, desc.mips * desc.layers);
     }
     return {Texture{previous, 0, id()}, Texture{current, 0, id()}};
 }
@@ -323,24 +379,20 @@ HistoryBuffer Graph::createHistoryBuffer(std::string_view name, const BufferDesc
     validateBuffer(name, desc);
     const auto [previous, current] = addHistory(name, ResourceKind::Buffer);
     for (uint32_t r : {previous, current}) {
-        decl_->resources[r].buffer = desc;
-        finishResource(r, 1);
+        ir::Resource& half = decl_->resources[r];
+        half.buffer = desc;
+        finishResource(half, 1);
     }
     return {Buffer{previous, 0, id()}, Buffer{current, 0, id()}};
 }
 
 // Both halves of a pair; the description is filled in by the caller.
 std::pair<uint32_t, uint32_t> Graph::addHistory(std::string_view name, ResourceKind kind) {
-    ir::Declaration& d = mutableDecl();
-    const uint32_t previous = newResource(d.names.store(name, ".previous"), kind, ir::Origin::HistoryPrevious);
-    decl_->resources[previous].contentsAtStart = true;
-    const uint32_t current = previous + 1;
-    decl_->resources.emplace_back(kFreshResource);
-    ir::Resource& c = decl_->resources[current];
-    c.name = d.names.store(name, ".current");
-    c.kind = kind;
-    c.origin = ir::Origin::HistoryCurrent;
-    decl_->resources[previous].partner = current;
+    const auto [previous, p] = newResource(name, kind, ir::Origin::HistoryPrevious, ".previous");
+    p.contentsAtStart = true;
+    p.partner = previous + 1;
+    // The second emplace may reallocate: the first half is set up before it.
+    const auto [current, c] = newResource(name, kind, ir::Origin::HistoryCurrent, ".current");
     c.partner = previous;
     return {previous, current};
 }
@@ -394,7 +446,7 @@ void Graph::order(PassId before, PassId after) {
     mutableDecl().orderings.push_back({before.index, after.index});
 }
 
-Builder Graph::beginPass(std::string_view name, Queue queue, ExecuteFn execute) {
+Builder Graph::beginPass(std::string_view name, Queue queue, ExecuteFn& execute) {
     ir::Declaration& d = mutableDecl();
     ir::Pass& p = d.passes.emplace_back();
     p.name = d.names.store(name);
@@ -424,7 +476,7 @@ namespace {
 
 // endPass found a use that needs a raster pipeline on a pass without one, or
 // a raster pass on the async compute queue: says which, as it always has.
-[[noreturn]] void throwPassNeedsRaster(const ir::Declaration& d, uint32_t pass) {
+[[noreturn, gnu::cold, gnu::noinline]] void throwPassNeedsRaster(const ir::Declaration& d, uint32_t pass) {
     const ir::Pass& p = d.passes[pass];
     const uint32_t end = p.firstUse + p.useCount;
     if (p.pipeline != Pipeline::Raster) {
@@ -463,6 +515,11 @@ PassId Graph::endPass(uint32_t pass) {
         ir::Resource& r = d.resources[use->resource];
         r.version = use->version + 1;
         r.lastWriter = pass;
+        // Most resources have one cell: it needs no range looked at.
+        if (r.cellCount == 1) {
+            d.written[r.cellBase] = 1;
+            continue;
+        }
         // Cell (m, l) is cellBase + m * layers + l (ir::cellOf). Mostly one
         // cell, stored without the loops' setup; otherwise a loop still
         // beats a call to memset. The range is copied: the
@@ -493,25 +550,35 @@ PassId Graph::endPass(uint32_t pass) {
 inline uint32_t Graph::use(uint32_t pass, ResourceKind kind, uint32_t index, uint32_t version, uint32_t graph,
                            Access access, Subresource range, bool write) {
     ir::Declaration& d = mutableDecl();
-    if (graph != d.graphId || index >= d.resources.size() || access >= Access::Count) [[unlikely]]
+    // index < size(), compared in bytes: size() divides by sizeof(Resource)
+    // (a multiply), and the byte offset is needed anyway.
+    if (graph != d.graphId || size_t{index} * sizeof(ir::Resource) >= d.resources.size() * sizeof(ir::Resource) ||
+        access >= Access::Count) [[unlikely]]
         return useGeneral(pass, kind, index, version, graph, access, range, write);
     const ir::Resource& r = d.resources[index];
     const ir::Pass& p = d.passes[pass];
     const AccessSet bit = accessBit(access);
+    const AccessSet plainAccesses = kPlain.of[static_cast<uint32_t>(kind)][write][static_cast<uint32_t>(p.queue)]
+                                             [static_cast<uint32_t>(p.pipeline)];
     // Bitwise, not short-circuit: every term is cheap, and one branch
-    // predicts better than six.
-    const bool plain = (r.kind == kind) & ((kDeclarable.of[static_cast<uint32_t>(kind)][write] & bit) != 0) &
-                       ((p.queue == Queue::Graphics) |
-                        ((p.pipeline != Pipeline::Raster) & ((kNeedsRasterKinds & bit) == 0))) &
-                       ((r.origin != ir::Origin::Imported) | (r.hasInitial & r.hasFinal)) & (version == r.version);
+    // predicts better than four.
+    const bool plain = (r.declarableAs == static_cast<uint8_t>(kind)) & ((plainAccesses & bit) != 0) &
+                       (version == r.version);
     if (!plain) [[unlikely]]
         return useGeneral(pass, kind, index, version, graph, access, range, write);
 
-    Subresource resolved = range;
-    uint32_t layers = 1;
-    if (kind == ResourceKind::Texture) {
+    // Most uses name one cell: a buffer, a structure, or a texture of one mip
+    // and one layer used whole. Those need no range resolved and check one
+    // byte of contents.
+    Subresource resolved{0, 1, 0, 1};
+    bool oneCell = true;
+    if (kind != ResourceKind::Texture) {
+        if (range != Subresource{}) [[unlikely]]
+            return useGeneral(pass, kind, index, version, graph, access, range, write);
+    } else if (r.cellCount != 1 || range != Subresource{}) {
+        oneCell = false;
         const TextureDesc& t = r.texture;
-        layers = t.layers;
+        resolved = range;
         if (resolved.mipCount == Subresource::kAll)
             resolved.mipCount = resolved.baseMip < t.mips ? t.mips - resolved.baseMip : 0;
         if (resolved.layerCount == Subresource::kAll)
@@ -519,24 +586,27 @@ inline uint32_t Graph::use(uint32_t pass, ResourceKind kind, uint32_t index, uin
         if (resolved.mipCount == 0 || resolved.layerCount == 0 || resolved.baseMip + resolved.mipCount > t.mips ||
             resolved.baseLayer + resolved.layerCount > t.layers) [[unlikely]]
             return useGeneral(pass, kind, index, version, graph, access, range, write);
-    } else {
-        if (range != Subresource{}) [[unlikely]]
-            return useGeneral(pass, kind, index, version, graph, access, range, write);
-        resolved = {0, 1, 0, 1};
     }
 
-    if (accessNeedsContents(access)) {
+    if (kNeedsContentsKinds & bit) {
         // Cell (m, l) is cellBase + m * layers + l (ir::cellOf).
-        const uint8_t* written = d.written.data() + r.cellBase + resolved.baseLayer;
-        // Most uses name one cell; the loops' setup costs more than the check.
-        if (resolved.mipCount == 1 && resolved.layerCount == 1) {
-            if (!written[resolved.baseMip * layers]) [[unlikely]]
+        const uint8_t* written = d.written.data() + r.cellBase;
+        if (oneCell) {
+            if (!written[0]) [[unlikely]]
                 return useGeneral(pass, kind, index, version, graph, access, range, write);
         } else {
-            for (uint32_t m = resolved.baseMip; m < resolved.baseMip + resolved.mipCount; ++m)
-                for (uint32_t l = 0; l < resolved.layerCount; ++l)
-                    if (!written[m * layers + l]) [[unlikely]]
-                        return useGeneral(pass, kind, index, version, graph, access, range, write);
+            const uint32_t layers = r.texture.layers;
+            // One mip and layer of a larger texture: the loops' setup costs
+            // more than the check.
+            if (resolved.mipCount == 1 && resolved.layerCount == 1) {
+                if (!written[resolved.baseMip * layers + resolved.baseLayer]) [[unlikely]]
+                    return useGeneral(pass, kind, index, version, graph, access, range, write);
+            } else {
+                for (uint32_t m = resolved.baseMip; m < resolved.baseMip + resolved.mipCount; ++m)
+                    for (uint32_t l = resolved.baseLayer; l < resolved.baseLayer + resolved.layerCount; ++l)
+                        if (!written[m * layers + l]) [[unlikely]]
+                            return useGeneral(pass, kind, index, version, graph, access, range, write);
+            }
         }
     }
 

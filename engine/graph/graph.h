@@ -103,7 +103,7 @@ public:
 
     template <class Setup>
     PassId addPass(std::string_view name, Queue queue, Setup&& setup, ExecuteFn execute = {}) {
-        Builder builder = beginPass(name, queue, std::move(execute));
+        Builder builder = beginPass(name, queue, execute);
         try {
             std::forward<Setup>(setup)(builder);
             return endPass(builder.pass_);
@@ -178,7 +178,9 @@ private:
     friend class Builder;
     friend Plan compile(const Graph&, const QueueCaps&, const CompileOptions&, Plan&&);
 
-    Builder beginPass(std::string_view name, Queue queue, ExecuteFn execute);
+    // Takes the callback out of `execute`, leaving it empty: by reference,
+    // so no third std::function is moved into and destroyed for every pass.
+    Builder beginPass(std::string_view name, Queue queue, ExecuteFn& execute);
     void abortPass(uint32_t pass);
     PassId endPass(uint32_t pass);
 
@@ -198,10 +200,16 @@ private:
     uint32_t declareTextureImport(std::string_view name, const TextureImport& import);
     uint32_t declareBufferImport(std::string_view name, const BufferImport& import);
     uint32_t declareAccelStructImport(std::string_view name, const AccelStructImport& import);
-    uint32_t newResource(std::string_view name, ResourceKind kind, ir::Origin origin);
-    void finishResource(uint32_t index, uint32_t cells);
-    uint32_t addImport(std::string_view name, ResourceKind kind, const std::optional<BoundaryState>& initial,
-                       const std::optional<BoundaryState>& final);
+    // A resource just made: its index, and the resource itself (valid
+    // until the next one is made).
+    struct NewResource {
+        uint32_t index;
+        ir::Resource& resource;
+    };
+    NewResource newResource(std::string_view name, ResourceKind kind, ir::Origin origin, std::string_view suffix = {});
+    void finishResource(ir::Resource& resource, uint32_t cells);
+    NewResource addImport(std::string_view name, ResourceKind kind, const std::optional<BoundaryState>& initial,
+                          const std::optional<BoundaryState>& final);
     std::pair<uint32_t, uint32_t> addHistory(std::string_view name, ResourceKind kind);
     uint32_t use(uint32_t pass, ResourceKind kind, uint32_t index, uint32_t version, uint32_t graph, Access access,
                  Subresource range, bool write);
