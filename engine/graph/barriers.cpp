@@ -334,11 +334,14 @@ struct Need {
 // A barrier that holds a priorLater cell's first use: resolveFirstUses()
 // analyses that use again against the frame-start priors and ORs what they
 // add into it.
+// What it needs is kept here rather than looked up again: resolving reads
+// these in barrier order, long after the walk had them at hand.
 struct FirstUse {
     uint32_t barrier; // index into Plan::barriers
     uint32_t cell;
-    uint32_t use; // declared use index
+    uint32_t resource;
     uint32_t queue;
+    bool texture;
     const UseInfo* info;
 };
 
@@ -610,11 +613,10 @@ private:
         startAliased();
         std::vector<Barrier>& barriers = st_.plan.barriers;
         for (const FirstUse& f : firstUses_) {
-            const ir::Use& use = d_.uses[f.use];
-            const uint32_t r = use.resource;
+            const uint32_t r = f.resource;
             const LastUses prior = st_.aliased[r] ? aliasedPriors_[r] : lastUsesOf(f.cell, f.queue, r);
             const UseInfo& info = *f.info;
-            const bool transition = d_.resources[r].kind == ResourceKind::Texture; // from UNDEFINED
+            const bool transition = f.texture; // from UNDEFINED
             VkPipelineStageFlags2 srcStages = 0;
             VkAccessFlags2 srcAccess = 0;
             // analyse() of a use after `prior` alone: nothing is visible yet,
@@ -1095,10 +1097,9 @@ private:
 
     // Turns needs_[first, last) -- one use's cells in mip-major order -- into
     // barriers: runs of layers per mip, merged across mips when runs line up.
-    // `use` is the declared use on queue q with `info` (kNoIndex and null for
-    // frame-end states).
+    // The use is on queue q, with `info` (null for frame-end states).
     void emit(uint32_t resource, bool texture, VkImageAspectFlags aspect, const Subresource& range, const SyncScope& s,
-              size_t first, size_t last, uint32_t use, uint32_t q, const UseInfo* info) {
+              size_t first, size_t last, uint32_t q, const UseInfo* info) {
         std::vector<Barrier>& out = st_.plan.barriers;
         const size_t firstBarrier = out.size();
         const uint32_t layers = texture ? range.layerCount : 1;
@@ -1133,12 +1134,12 @@ private:
                     ++prev.range.mipCount;
                     prev.srcStages |= srcStages;
                     prev.srcAccess |= srcAccess;
-                    noteFirstUses(out.size() - 1, use, q, info, i, j);
+                    noteFirstUses(out.size() - 1, resource, texture, q, info, i, j);
                     i = j;
                     continue;
                 }
             }
-            noteFirstUses(out.size(), use, q, info, i, j);
+            noteFirstUses(out.size(), resource, texture, q, info, i, j);
             out.emplace_back(resource, Subresource{mip, 1, layer, layerCount}, aspect, srcStages, srcAccess, s.stages,
                              s.access, oldLayout, texture ? s.layout : VK_IMAGE_LAYOUT_UNDEFINED, false);
             i = j;
@@ -1150,12 +1151,13 @@ private:
         }
     }
 
-    // Records the first uses among needs_[first, last) of declared use
-    // `use` on queue q, merged into barrier `barrier`.
-    void noteFirstUses(size_t barrier, uint32_t use, uint32_t q, const UseInfo* info, size_t first, size_t last) {
+    // Records the first uses among needs_[first, last) of a use of
+    // `resource` on queue q, merged into barrier `barrier`.
+    void noteFirstUses(size_t barrier, uint32_t resource, bool texture, uint32_t q, const UseInfo* info, size_t first,
+                       size_t last) {
         for (size_t k = first; k < last; ++k)
             if (needs_[k].firstUse) [[unlikely]]
-                firstUses_.push_back({static_cast<uint32_t>(barrier), needs_[k].cell, use, q, info});
+                firstUses_.push_back({static_cast<uint32_t>(barrier), needs_[k].cell, resource, q, texture, info});
     }
 
     // Whether barrier k waits for resolveFirstUses() (debug logging only).
@@ -1165,9 +1167,9 @@ private:
 
     // emit() of a use of one cell (most uses): one barrier, nothing to merge.
     void emitOne(uint32_t resource, const UseRef& ref, const Subresource& range, const SyncScope& s, const Need& n,
-                 uint32_t use, uint32_t q) {
+                 uint32_t q) {
         if (n.firstUse) [[unlikely]]
-            firstUses_.push_back({static_cast<uint32_t>(st_.plan.barriers.size()), n.cell, use, q, ref.info});
+            firstUses_.push_back({static_cast<uint32_t>(st_.plan.barriers.size()), n.cell, resource, q, ref.texture, ref.info});
         // Constructed from its fields: value-initialising it first would store
         // every field twice. The aspect is read only when a barrier needs it;
         // the aliasing flag is set by resolveFirstUses() where bytes are shared.
@@ -1230,8 +1232,7 @@ private:
             if (ref.single) {
                 const Need& n = needs_[first];
                 if (n.barrier)
-                    emitOne(d_.uses[pass.firstUse + i].resource, ref, d_.uses[pass.firstUse + i].range, s, n,
-                            pass.firstUse + i, q);
+                    emitOne(d_.uses[pass.firstUse + i].resource, ref, d_.uses[pass.firstUse + i].range, s, n, q);
                 update(n, q, info, ref.writes, now);
                 continue;
             }
@@ -1241,7 +1242,7 @@ private:
             if (firstBarrier < last) {
                 const ir::Use& use = d_.uses[pass.firstUse + i];
                 emit(use.resource, ref.texture, ref.texture ? st_.plan.resources[use.resource].aspect : 0, use.range, s,
-                     first, last, pass.firstUse + i, q, ref.info);
+                     first, last, q, ref.info);
             }
             for (size_t k = first; k < last; ++k) update(needs_[k], q, info, ref.writes, now);
         }
@@ -1318,7 +1319,7 @@ private:
                 const uint32_t r = f.target->resource;
                 const bool texture = f.target->texture;
                 emit(r, texture, texture ? st_.plan.resources[r].aspect : 0, wholeOf(d_.resources[r]),
-                     f.target->state->scope, f.firstNeed, f.endNeed, kNoIndex, qi, nullptr);
+                     f.target->state->scope, f.firstNeed, f.endNeed, qi, nullptr);
             }
             batches_.setEndBarriers(q, firstBarrier, static_cast<uint32_t>(st_.plan.barriers.size()) - firstBarrier);
         }
