@@ -25,6 +25,15 @@
 // accesses on the other queue are waited for on the previous frame's last
 // batch of that queue. After the last pass, imports move to their final
 // state.
+//
+// A transient used on one queue starts from where this very walk leaves
+// its bytes, so its priors are not known before the walk: its first use of
+// each cell (always a write or a layout transition, after which nothing of
+// the priors remains in the cell) gets a barrier without them, completed
+// once the walk is over (resolveFirstUses). Those priors are on the use's
+// own queue, so they add stages and accesses to that barrier, never a wait.
+// Only history halves and transients on both queues have their end states
+// worked out before the walk, from their own uses.
 
 #include <algorithm>
 #include <bit>
@@ -231,8 +240,6 @@ struct Cell {
     // before (a barrier on that queue chained from a wait that reached them).
     VkPipelineStageFlags2 rOrdered[kQueueCount] = {0, 0};
 
-    bool visible(uint32_t q, VkPipelineStageFlags2 s, VkAccessFlags2 a) const { return vis.covers(q, maskOf(s, pack(a))); }
-    void addVisible(uint32_t q, VkPipelineStageFlags2 s, VkAccessFlags2 a) { vis.add(q, maskOf(s, pack(a))); }
     void addVisibleToAll(uint32_t q, VkPipelineStageFlags2 s) { vis.add(q, maskOf(s, kAnyPacked)); }
     void clearVisible() { vis.clear(); }
 };
@@ -333,9 +340,8 @@ struct Need {
 
 // A barrier that holds a priorLater cell's first use: resolveFirstUses()
 // analyses that use again against the frame-start priors and ORs what they
-// add into it.
-// What it needs is kept here rather than looked up again: resolving reads
-// these in barrier order, long after the walk had them at hand.
+// add into it. What that needs is kept here, not looked up again: resolving
+// reads these long after the walk had them at hand.
 struct FirstUse {
     uint32_t barrier; // index into Plan::barriers
     uint32_t cell;
@@ -362,7 +368,7 @@ struct FinalImport {
     const UseInfo* state; // the final state as a use: in the table, or in rawFinals
 };
 
-// A declared use as the walk reads it, resolved once per compile: the walk
+// A declared use as the walk reads it, resolved once per pass: the walk
 // then touches neither the (large) declared resource nor the planned one
 // for the common use of one subresource.
 struct UseRef {
@@ -915,7 +921,10 @@ private:
     }
 
     // `n` arrives value-initialised (a fresh need, or one reset by the caller).
-    [[gnu::always_inline]] void analyse(Need& n, uint32_t c, uint32_t q, const UseInfo& use, bool writes, bool texture) {
+    // Inline in the walk (it and update() run for every use; as calls they
+    // spent a tenth of the walk saving and restoring registers).
+    [[gnu::always_inline]] void analyse(Need& n, uint32_t c, uint32_t q, const UseInfo& use, bool writes,
+                                        bool texture) {
         const Cell& cell = cells_[c];
         const SyncScope& s = use.scope;
         if (cell.priorLater) {
@@ -1036,6 +1045,7 @@ private:
         n.barrier = n.transition || n.srcStages != 0;
     }
 
+    // Inline in the walk, as analyse() is.
     [[gnu::always_inline]] void update(const Need& n, uint32_t q, const UseInfo& use, bool writes, TimelinePoint now) {
         Cell& cell = cells_[n.cell];
         const SyncScope& s = use.scope;
@@ -1169,7 +1179,8 @@ private:
     void emitOne(uint32_t resource, const UseRef& ref, const Subresource& range, const SyncScope& s, const Need& n,
                  uint32_t q) {
         if (n.firstUse) [[unlikely]]
-            firstUses_.push_back({static_cast<uint32_t>(st_.plan.barriers.size()), n.cell, resource, q, ref.texture, ref.info});
+            firstUses_.push_back(
+                {static_cast<uint32_t>(st_.plan.barriers.size()), n.cell, resource, q, ref.texture, ref.info});
         // Constructed from its fields: value-initialising it first would store
         // every field twice. The aspect is read only when a barrier needs it;
         // the aliasing flag is set by resolveFirstUses() where bytes are shared.
