@@ -538,15 +538,14 @@ private:
         early.clear();
         currents.clear();
         imports_.clear();
-        for (uint32_t r = 0; r < d_.resources.size(); ++r) {
+        for (const uint32_t r : st_.startKnown) {
             const ir::Resource& res = d_.resources[r];
             switch (res.origin) {
                 case ir::Origin::Imported:
                     imports_.push_back(r);
                     startImport(r);
                     continue;
-                case ir::Origin::Transient:
-                    if (!st_.lifetimes[r].crossQueue()) continue;
+                case ir::Origin::Transient: // on both queues
                     break;
                 case ir::Origin::HistoryCurrent:
                     currents.push_back(r);

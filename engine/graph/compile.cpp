@@ -19,6 +19,7 @@ struct Scratch {
     std::vector<uint32_t> position;
     std::vector<Queue> queueOf;
     std::vector<detail::Lifetime> lifetimes;
+    std::vector<uint32_t> startKnown;
     std::vector<uint8_t> aliased;
     std::vector<uint32_t> barrierFirst;
     std::vector<uint32_t> barrierCount;
@@ -31,6 +32,7 @@ void swapVectors(Scratch& s, detail::CompileState& st) {
     s.position.swap(st.position);
     s.queueOf.swap(st.queueOf);
     s.lifetimes.swap(st.lifetimes);
+    s.startKnown.swap(st.startKnown);
     s.aliased.swap(st.aliased);
     s.barrierFirst.swap(st.barrierFirst);
     s.barrierCount.swap(st.barrierCount);

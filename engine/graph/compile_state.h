@@ -44,6 +44,11 @@ struct CompileState {
     bool queueActive[kQueueCount] = {false, false};
     // lifetimes
     std::vector<Lifetime> lifetimes; // per resource
+    // Imports, history halves and transients used on both queues, in
+    // declaration order: the resources whose state at the frame's start is
+    // known before the barrier walk (every other one is a transient on one
+    // queue, which starts where the walk leaves it).
+    std::vector<uint32_t> startKnown;
     // alias: transients whose bytes some other transient also uses
     std::vector<uint8_t> aliased; // per resource
     // barriers -> batches

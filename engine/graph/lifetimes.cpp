@@ -72,10 +72,13 @@ void computeLifetimes(CompileState& st) {
     st.plan.resources.assign(resourceCount, PlannedResource{});
     PlannedResource* const planned = st.plan.resources.data();
     const ir::Resource* const resources = d.resources.data();
+    std::vector<uint32_t>& startKnown = st.startKnown;
+    startKnown.clear();
     for (uint32_t r = 0; r < resourceCount; ++r) {
         const ir::Resource& res = resources[r];
         const Lifetime& life = lifetimes[r];
         PlannedResource& out = planned[r];
+        if (res.origin != ir::Origin::Transient || life.crossQueue()) startKnown.push_back(r);
         out.kind = res.kind;
         out.origin = res.origin;
         out.partner = res.partner;
