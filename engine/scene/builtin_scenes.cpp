@@ -4,6 +4,7 @@
 #include "scene/error.h"
 #include "scene/mesh_tools.h"
 #include "scene/procedural_meshes.h"
+#include "scene/scene_builder.h"
 
 #include <glm/gtc/constants.hpp>
 #include <glm/gtc/matrix_transform.hpp>
@@ -15,57 +16,6 @@
 namespace glint::scene {
 
 namespace {
-
-// ---------------------------------------------------------------------------
-// Building blocks
-// ---------------------------------------------------------------------------
-
-// Deterministic hash -> [0, 1) (a 32-bit integer finaliser, as in
-// MurmurHash3's fmix32), so generated textures are identical on every run.
-float hash01(int32_t x, int32_t y, uint32_t seed) {
-    uint32_t h = uint32_t(x) * 0x8da6b343u ^ uint32_t(y) * 0xd8163841u ^ seed * 0xcb1ab31fu;
-    h ^= h >> 16;
-    h *= 0x85ebca6bu;
-    h ^= h >> 13;
-    h *= 0xc2b2ae35u;
-    h ^= h >> 16;
-    return float(h >> 8) / float(1u << 24);
-}
-
-// Value noise on a lattice of `period` cells that wraps, so textures tile.
-float valueNoise(float x, float y, int32_t period, uint32_t seed) {
-    const float fx = std::floor(x), fy = std::floor(y);
-    const float tx = x - fx, ty = y - fy;
-    const float sx = tx * tx * (3.0f - 2.0f * tx);
-    const float sy = ty * ty * (3.0f - 2.0f * ty);
-    const auto at = [&](int32_t i, int32_t j) {
-        return hash01(((i % period) + period) % period, ((j % period) + period) % period, seed);
-    };
-    const int32_t i = int32_t(fx), j = int32_t(fy);
-    const float top = glm::mix(at(i, j), at(i + 1, j), sx);
-    const float bottom = glm::mix(at(i, j + 1), at(i + 1, j + 1), sx);
-    return glm::mix(top, bottom, sy);
-}
-
-float fbm(float u, float v, uint32_t seed) {
-    float sum = 0.0f, amplitude = 0.5f, norm = 0.0f;
-    int32_t period = 4;
-    for (int octave = 0; octave < 4; ++octave) {
-        sum += amplitude * valueNoise(u * float(period), v * float(period), period, seed + uint32_t(octave));
-        norm += amplitude;
-        amplitude *= 0.5f;
-        period *= 2;
-    }
-    return sum / norm;
-}
-
-uint8_t toByte(float v) {
-    return uint8_t(std::clamp(v, 0.0f, 1.0f) * 255.0f + 0.5f);
-}
-
-uint8_t toSrgbByte(float linear) {
-    return toByte(shader::linearToSrgb(linear));
-}
 
 struct PavingTextures {
     Texture baseColor;
@@ -114,148 +64,6 @@ PavingTextures makePavingTextures(uint32_t size) {
     return t;
 }
 
-Material makeMaterial(const std::string& name, const glm::vec3& baseColor, float metallic, float roughness) {
-    Material m;
-    m.name = name;
-    m.baseColorFactor = glm::vec4(baseColor, 1.0f);
-    m.metallicFactor = metallic;
-    m.roughnessFactor = roughness;
-    return m;
-}
-
-Material makeEmissive(const std::string& name, const glm::vec3& color, float strength) {
-    Material m = makeMaterial(name, glm::vec3(0.05f), 0.0f, 0.4f);
-    m.emissiveFactor = color;
-    m.emissiveStrength = strength;
-    return m;
-}
-
-glm::quat axisAngle(const glm::vec3& axis, float radians) {
-    return glm::angleAxis(radians, glm::normalize(axis));
-}
-
-// Builds a scene: nodes, meshes, instances, skins and sampled animation
-// tracks, keeping the index bookkeeping in one place.
-class Builder {
-public:
-    explicit Builder(std::string name) { scene.name = std::move(name); }
-
-    uint32_t material(Material m) {
-        scene.materials.push_back(std::move(m));
-        return uint32_t(scene.materials.size() - 1);
-    }
-
-    int32_t texture(Texture t) {
-        scene.textures.push_back(std::move(t));
-        return int32_t(scene.textures.size() - 1);
-    }
-
-    uint32_t mesh(std::string name, std::vector<std::vector<Geometry>> lods) {
-        Mesh m;
-        m.name = std::move(name);
-        for (std::vector<Geometry>& lod : lods) {
-            m.lods.push_back({std::move(lod)});
-        }
-        scene.meshes.push_back(std::move(m));
-        return uint32_t(scene.meshes.size() - 1);
-    }
-
-    uint32_t node(std::string name, int32_t parent, const glm::vec3& translation,
-                  const glm::quat& rotation = glm::quat(1, 0, 0, 0), const glm::vec3& scale = glm::vec3(1.0f)) {
-        Node n;
-        n.name = std::move(name);
-        n.parent = parent;
-        n.translation = translation;
-        n.rotation = rotation;
-        n.scale = scale;
-        scene.nodes.push_back(std::move(n));
-        return uint32_t(scene.nodes.size() - 1);
-    }
-
-    Instance& instance(std::string name, uint32_t meshIndex, uint32_t nodeIndex, Motion motion = Motion::Static) {
-        Instance inst;
-        inst.name = std::move(name);
-        inst.mesh = meshIndex;
-        inst.node = int32_t(nodeIndex);
-        inst.motion = motion;
-        scene.instances.push_back(std::move(inst));
-        return scene.instances.back();
-    }
-
-    // A static instance at `translation` with its own node.
-    Instance& place(const std::string& name, uint32_t meshIndex, const glm::vec3& translation,
-                    const glm::quat& rotation = glm::quat(1, 0, 0, 0), const glm::vec3& scale = glm::vec3(1.0f)) {
-        return instance(name, meshIndex, node(name, kNone, translation, rotation, scale));
-    }
-
-    // A chain of `count` joints below `instanceNode`, `step` apart, and the
-    // skin binding them in the current (rest) pose: inverse bind =
-    // inverse(joint world) * instance world, so the rest pose skins to the
-    // unskinned mesh placed by the instance node.
-    std::pair<int32_t, std::vector<uint32_t>> jointChain(const std::string& name, uint32_t instanceNode,
-                                                         const glm::vec3& step, uint32_t count) {
-        std::vector<uint32_t> joints;
-        int32_t parent = int32_t(instanceNode);
-        for (uint32_t k = 0; k < count; ++k) {
-            joints.push_back(node(name + "_joint" + std::to_string(k), parent, k == 0 ? glm::vec3(0.0f) : step));
-            parent = int32_t(joints.back());
-        }
-        const std::vector<glm::mat4> world = worldTransforms(scene.nodes);
-        Skin skin;
-        skin.name = name;
-        skin.joints = joints;
-        for (uint32_t j : joints) {
-            skin.inverseBindMatrices.push_back(glm::inverse(world[j]) * world[instanceNode]);
-        }
-        scene.skins.push_back(std::move(skin));
-        return {int32_t(scene.skins.size() - 1), joints};
-    }
-
-    // Samples `f` (seconds -> value) at `keys` evenly spaced keys over
-    // `duration` into a LINEAR track of `animation`.
-    void track(Animation& animation, uint32_t nodeIndex, AnimationPath path, float duration, uint32_t keys,
-               const std::function<glm::vec4(float)>& f) {
-        AnimationSampler sampler;
-        sampler.interpolation = Interpolation::Linear;
-        for (uint32_t k = 0; k < keys; ++k) {
-            const float t = duration * float(k) / float(keys - 1);
-            sampler.times.push_back(t);
-            sampler.values.push_back(f(t));
-        }
-        animation.samplers.push_back(std::move(sampler));
-        animation.channels.push_back({uint32_t(animation.samplers.size() - 1), nodeIndex, path});
-    }
-
-    void rotationTrack(Animation& animation, uint32_t nodeIndex, float duration, uint32_t keys,
-                       const std::function<glm::quat(float)>& f) {
-        track(animation, nodeIndex, AnimationPath::Rotation, duration, keys, [&](float t) {
-            const glm::quat q = f(t);
-            return glm::vec4(q.x, q.y, q.z, q.w);
-        });
-    }
-
-    void translationTrack(Animation& animation, uint32_t nodeIndex, float duration, uint32_t keys,
-                          const std::function<glm::vec3(float)>& f) {
-        track(animation, nodeIndex, AnimationPath::Translation, duration, keys,
-              [&](float t) { return glm::vec4(f(t), 0.0f); });
-    }
-
-    void play(Animation animation) {
-        scene.animations.push_back(std::move(animation));
-        scene.playbacks.push_back({uint32_t(scene.animations.size() - 1), 1.0f, true});
-    }
-
-    Scene scene;
-};
-
-Geometry transformed(Geometry g, const glm::mat4& m) {
-    transformGeometry(g, m);
-    return g;
-}
-
-glm::mat4 translation(const glm::vec3& t) {
-    return glm::translate(glm::mat4(1.0f), t);
-}
 
 // ---------------------------------------------------------------------------
 // Plaza
@@ -273,7 +81,7 @@ struct PlazaMaterials {
         carPaint, tyre, flag, cloth, hills, tower, mirrorTower, water, brass, lampGlow, skinTone;
 };
 
-PlazaMaterials plazaMaterials(Builder& b) {
+PlazaMaterials plazaMaterials(SceneBuilder& b) {
     PlazaMaterials m{};
     const PavingTextures paving = makePavingTextures(256);
     Material wet = makeMaterial("wet paving", glm::vec3(1.0f), 1.0f, 1.0f);
@@ -336,7 +144,7 @@ std::vector<Geometry> buildingGeometry(const glm::vec3& size, uint32_t wall, uin
 }
 
 Scene buildPlaza() {
-    Builder b("plaza");
+    SceneBuilder b("plaza");
     const PlazaMaterials mat = plazaMaterials(b);
     Scene& s = b.scene;
 
@@ -688,7 +496,7 @@ Scene buildPlaza() {
 constexpr glm::vec3 kFarOrigin{10000.0f, 0.0f, 10000.0f};
 
 Scene buildHardCases() {
-    Builder b("hard-cases");
+    SceneBuilder b("hard-cases");
     Scene& s = b.scene;
     const uint32_t mirror = b.material(makeMaterial("perfect mirror", {0.95f, 0.95f, 0.95f}, 1.0f, 0.0f));
     const uint32_t glossy = b.material(makeMaterial("glossy mirror", {0.9f, 0.9f, 0.92f}, 1.0f, 0.08f));
@@ -801,13 +609,13 @@ Scene buildHardCases() {
 } // namespace
 
 std::span<const std::string_view> builtinSceneNames() {
-    static constexpr std::array<std::string_view, 2> kNames = {"plaza", "hard-cases"};
+    static constexpr std::array<std::string_view, 3> kNames = {"plaza", "hard-cases", "city"};
     return kNames;
 }
 
 bool isBuiltinScene(std::string_view name) {
     const auto names = builtinSceneNames();
-    return std::find(names.begin(), names.end(), name) != names.end();
+    return std::find(names.begin(), names.end(), name.substr(0, name.find(':'))) != names.end();
 }
 
 Scene makePlaza() {
@@ -829,7 +637,10 @@ Scene makeBuiltinScene(std::string_view name) {
     if (name == "hard-cases") {
         return makeHardCases();
     }
-    throw SceneError(std::string(name), "", "no such built-in scene (plaza, hard-cases)");
+    if (name.substr(0, name.find(':')) == "city") {
+        return makeCity(parseCityOptions(name));
+    }
+    throw SceneError(std::string(name), "", "no such built-in scene (plaza, hard-cases, city)");
 }
 
 Scene loadScene(std::string_view nameOrPath, const GltfLoadOptions& options) {

@@ -39,7 +39,7 @@ using namespace glint;
 namespace {
 
 constexpr const char* kUsage =
-    "usage: glint-bench [--scene plaza|hard-cases|FILE.gltf|FILE.glb] [--frames N] [--size WxH|N]\n"
+    "usage: glint-bench [--scene plaza|hard-cases|city[:OPTIONS]|FILE.gltf|FILE.glb] [--frames N] [--size WxH|N]\n"
     "                   [--modes hybrid,ssr,rt] [--sweep-modes hybrid[,ssr,rt]|\"\"] [--quick]\n"
     "                   [--out-dir DIR] [--csv FILE] [--json FILE] [--plot FILE.png]\n"
     "                   [--time SECONDS] [--ppd N] [--backend auto|query|pipeline]\n"

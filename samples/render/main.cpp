@@ -23,7 +23,7 @@ using namespace glint;
 namespace {
 
 constexpr const char* kUsage =
-    "usage: glint-render [--scene plaza|hard-cases|smoke|FILE.gltf|FILE.glb] [--mode hybrid|ssr|rt|reference]\n"
+    "usage: glint-render [--scene plaza|hard-cases|city[:OPTIONS]|smoke|FILE.gltf|FILE.glb] [--mode hybrid|ssr|rt|reference]\n"
     "                    [--size WxH|N] [--frames N] [--out IMAGE.png] [--debug-view NAME] [--stats FILE.json]\n"
     "                    [--backend auto|query|pipeline] [--bvh-queue async|graphics] [--time SECONDS]\n"
     "                    [--camera NAME|INDEX] [--environment FILE.hdr] [--pass-timer auto|gpu|host]\n"
@@ -32,6 +32,8 @@ constexpr const char* kUsage =
     "                    [--list-debug-views] [--list-parameters] [--validate]\n"
     "--pass-timer: GPU timestamps, or each pass submitted alone and timed on the host (auto: host on a CPU\n"
     "                    device such as lavapipe, whose timestamps do not cover compute dispatches)\n"
+    "--scene city:instances=N,triangles=T,seed=S: the built-in city at a size (16..4096 buildings, about T\n"
+    "                    triangles each; default city:instances=64,triangles=40000,seed=1)\n"
     "--environment FILE.hdr: light and reflect the scene with an equirectangular HDR image (Radiance .hdr, twice\n"
     "                    as wide as high; -Z at its centre, +Y at its top) in place of the scene's sky, prefiltered\n"
     "                    by roughness on the GPU once (its sun, intensity and rotation stay the scene's)";

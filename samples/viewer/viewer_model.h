@@ -19,7 +19,7 @@
 namespace glint::viewer {
 
 inline constexpr const char* kUsage =
-    "usage: glint-viewer [--scene plaza|hard-cases|FILE.gltf|FILE.glb] [--size WxH] [--mode hybrid|ssr|rt]\n"
+    "usage: glint-viewer [--scene plaza|hard-cases|city[:OPTIONS]|FILE.gltf|FILE.glb] [--size WxH] [--mode hybrid|ssr|rt]\n"
     "                    [--backend auto|query|pipeline] [--debug-view NAME] [--frames N] [--validate]\n"
     "  --mode, --backend, --debug-view: what the panel starts with (it changes them later)\n"
     "  --frames N: close after N frames (smoke tests on a virtual display)\n"
