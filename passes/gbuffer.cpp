@@ -6,6 +6,7 @@
 #include "graph/executor.h"
 #include "passes/environment.h"
 #include "scene/animation.h"
+#include "scene/frustum.h"
 #include "scene/packed_primitives.h"
 
 #include "glint/gbuffer_shared.h"
@@ -251,6 +252,10 @@ struct GBufferRenderer::FrameWork {
     shader::GBufferFrame frame{};
     std::vector<shader::GBufferInstance> instances;
     std::vector<uint32_t> meshes;  // per instance
+    // Per instance: drawn into the G-buffer (its bounds meet the camera's
+    // frustum) and into the shadow map (they meet the map's box).
+    std::vector<uint8_t> visible;
+    std::vector<uint8_t> castsShadow;
     std::vector<glm::mat4> joints;
     std::vector<glm::mat4> previousJoints;
     // Morphing instances: the mesh's vertices with the instance's weights
@@ -488,7 +493,23 @@ std::shared_ptr<GBufferRenderer::FrameWork> GBufferRenderer::prepare(const GBuff
     stats_.shadow = f.shadow;
 
     work->instances.reserve(scene_.instances.size());
+    const scene::Frustum view(f.jitteredViewProjection);
+    const scene::Frustum sun(f.shadow.viewProjection);
+    stats_.instancesCulled = 0;
+    stats_.shadowInstancesCulled = 0;
     for (const scene::Instance& inst : scene_.instances) {
+        // Culled instances keep their slot (the shaders index instances by
+        // scene order), they only get no draws.
+        bool drawn = true, casts = f.shadow.enabled != 0;
+        if (settings.frustumCulling) {
+            const scene::Aabb bounds = scene::instanceBounds(scene_, inst);
+            drawn = view.intersects(bounds);
+            casts = casts && sun.intersects(bounds);
+            stats_.instancesCulled += drawn ? 0u : 1u;
+            stats_.shadowInstancesCulled += casts || f.shadow.enabled == 0 ? 0u : 1u;
+        }
+        work->visible.push_back(drawn ? 1 : 0);
+        work->castsShadow.push_back(casts ? 1 : 0);
         shader::GBufferInstance gi{};
         gi.transform = inst.transform;
         gi.previousTransform = inst.previousTransform;
@@ -619,6 +640,7 @@ void GBufferRenderer::recordShadowMap(const FrameWork& work, rg::PassContext& pc
         pushBindings(*boundVertices);
         vkCmdBindIndexBuffer(cmd, indices_.handle(), 0, VK_INDEX_TYPE_UINT32);
         for (size_t i = 0; i < work.instances.size(); ++i) {
+            if (!work.castsShadow[i]) continue;
             const auto [vertices, vertexShift] = vertexSource(work, i, slot);
             if (vertices != boundVertices) {
                 boundVertices = vertices;
@@ -719,6 +741,7 @@ void GBufferRenderer::record(const FrameWork& work, rg::PassContext& pc, const G
     pushBindings(surfacePipeline_, *boundVertices, boundTextures);
     vkCmdBindIndexBuffer(cmd, indices_.handle(), 0, VK_INDEX_TYPE_UINT32);
     for (size_t i = 0; i < work.instances.size(); ++i) {
+        if (!work.visible[i]) continue;
         const auto [vertices, vertexShift] = vertexSource(work, i, slot);
         for (const DrawRange& range : meshDraws_.at(work.meshes[i])) {
             if (range.indexCount == 0) continue;

@@ -1,7 +1,7 @@
 #pragma once
-// Pass 1 of the reflection pipeline (issue 5): the G-buffer. One raster
-// pass on the graphics queue draws every instance of a scene::Scene (mesh
-// LOD 0) into reversed-Z depth, world normal, albedo, roughness/metallic,
+// Pass 1 of the reflection pipeline: the G-buffer. One raster pass on the
+// graphics queue draws every instance of a scene::Scene (mesh LOD 0) whose
+// bounds meet the view frustum (GBufferSettings::frustumCulling) into reversed-Z depth, world normal, albedo, roughness/metallic,
 // motion (camera, rigid and skinned motion) and the lit colour of the
 // opaque scene that SSLR samples; a sky triangle fills what no geometry
 // covers. Output conventions: glint/gbuffer_shared.h.
@@ -19,7 +19,7 @@
 // SSLR and in an RT reflection is shadowed alike). The shadow map is a
 // pass of its own ("shadow_map", graphics queue, before "gbuffer"): an
 // orthographic depth-only raster along the sun's rays of every instance's
-// LOD 0, the G-buffer's own vertex buffer and skinning, fitted to the
+// LOD 0 that meets the map's box, the G-buffer's own vertex buffer and skinning, fitted to the
 // camera's view up to a distance or to the whole scene where that is
 // smaller, on a world-fixed texel grid so it does not shimmer as the camera
 // moves. It needs no BVH, so every mode and device gets the same shadows.
@@ -122,6 +122,11 @@ struct GBufferSettings {
     bool drawSky = true;
     // The sun's shadows in the lit colour.
     SunShadowSettings shadow;
+    // Draw only the instances whose world bounds meet the camera's frustum
+    // (the G-buffer) or the shadow map's box (the shadow map), tested on
+    // the CPU per instance. Off: every instance is drawn in both (the
+    // image is the same; only the raster work differs).
+    bool frustumCulling = true;
 };
 
 struct GBufferOutputs {
@@ -144,6 +149,8 @@ struct GBufferStats {
     uint32_t draws = 0;           // this frame: vkCmdDrawIndexed calls
     uint64_t triangles = 0;       // this frame
     uint32_t shadowDraws = 0;     // this frame, into the shadow map
+    uint32_t instancesCulled = 0;        // this frame: outside the camera's frustum, not drawn
+    uint32_t shadowInstancesCulled = 0;  // this frame: outside the shadow map's box, not drawn into it
     // This frame's shadow map fit (enabled = 0 with shadows off).
     shader::GBufferShadow shadow{};
     uint64_t geometryBytes = 0;   // the uploaded vertex and index buffers

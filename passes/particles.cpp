@@ -3,6 +3,7 @@
 #include "gpu/descriptors.h"
 #include "gpu/error.h"
 #include "graph/executor.h"
+#include "scene/frustum.h"
 
 #include "glint/packing.h"
 #include "glint/particles_shared.h"
@@ -278,13 +279,22 @@ ParticleForwardOutputs addParticleForwardPass(rg::Graph& graph, ParticlePipeline
         throw gpu::GpuError("addParticleForwardPass: the G-buffer has no size");
     }
 
-    // Back to front along the view direction: "over" does not commute.
-    // Ties keep the scene's order, so the image is deterministic.
+    // The particles whose quads can reach the screen (a quad lies within
+    // its radius of the centre), back to front along the view direction:
+    // "over" does not commute. Ties keep the scene's order, so the image is
+    // deterministic.
     const glm::mat4& view = inputs.camera.view;
-    std::vector<uint32_t> order(inputs.particles.size());
-    std::iota(order.begin(), order.end(), 0u);
+    const scene::Frustum frustum(inputs.camera.jitteredProjection * view);
+    std::vector<uint32_t> order;
+    for (uint32_t i = 0; i < inputs.particles.size(); ++i) {
+        if (frustum.intersects(inputs.particles[i].position, inputs.particles[i].radius)) order.push_back(i);
+    }
+    result.culled = uint32_t(inputs.particles.size() - order.size());
+    if (order.empty()) {
+        return result;
+    }
     std::vector<float> viewZ(inputs.particles.size());
-    for (size_t i = 0; i < viewZ.size(); ++i) {
+    for (const uint32_t i : order) {
         viewZ[i] = (view * glm::vec4(inputs.particles[i].position, 1.0f)).z;  // more negative: farther
     }
     std::stable_sort(order.begin(), order.end(), [&](uint32_t a, uint32_t b) { return viewZ[a] < viewZ[b]; });

@@ -122,10 +122,11 @@ struct ParticleForwardInputs {
 
 struct ParticleForwardOutputs {
     // The lit colour with the particles blended in: the next version of
-    // gbuffer.lit, or gbuffer.lit itself when there are no particles (then
+    // gbuffer.lit, or gbuffer.lit itself when no particle is in view (then
     // nothing is declared).
     rg::Texture lit;
     uint32_t particles = 0;  // drawn
+    uint32_t culled = 0;     // outside the view frustum, not drawn
 };
 
 // The pipelines the passes record with; created once. The trace's

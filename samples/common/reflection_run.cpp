@@ -75,9 +75,10 @@ struct ParameterSlot {
     Parameter parameter;
     float* (*floatField)(ReflectionRunOptions&);
     uint32_t* (*uintField)(ReflectionRunOptions&);
+    bool* (*boolField)(ReflectionRunOptions&) = nullptr;  // 0 or 1
 };
 
-const std::array<ParameterSlot, 9> kParameters = {{
+const std::array<ParameterSlot, 10> kParameters = {{
     {{"sslr_threshold", "SslrSettings::confidenceThreshold"},
      [](ReflectionRunOptions& o) { return &o.frame.sslr.confidenceThreshold; }, nullptr},
     {{"sslr_steps", "SslrSettings::linearSteps"}, nullptr,
@@ -95,6 +96,8 @@ const std::array<ParameterSlot, 9> kParameters = {{
     {{"bvh_radius", "BvhSettings::radius"}, [](ReflectionRunOptions& o) { return &o.renderer.bvh.radius; }, nullptr},
     {{"rt_max_distance", "RtTraceSettings::maxDistance"},
      [](ReflectionRunOptions& o) { return &o.frame.rt.maxDistance; }, nullptr},
+    {{"frustum_culling", "GBufferSettings::frustumCulling (0 or 1)"}, nullptr, nullptr,
+     [](ReflectionRunOptions& o) { return &o.frame.gbuffer.frustumCulling; }},
 }};
 
 const ParameterSlot& findParameter(std::string_view name) {
@@ -130,7 +133,12 @@ void setParameter(ReflectionRunOptions& options, std::string_view name, std::str
     if (used == 0 || used != text.size() || !std::isfinite(v) || v < 0.0) {
         throw std::invalid_argument("parameter " + std::string(name) + "=" + text + ": not a non-negative number");
     }
-    if (slot.uintField) {
+    if (slot.boolField) {
+        if (v != 0.0 && v != 1.0) {
+            throw std::invalid_argument("parameter " + std::string(name) + "=" + text + ": not 0 or 1");
+        }
+        *slot.boolField(options) = v == 1.0;
+    } else if (slot.uintField) {
         if (v != std::floor(v) || v < 1.0 || v > 4096.0) {
             throw std::invalid_argument("parameter " + std::string(name) + "=" + text + ": not an integer in 1..4096");
         }
@@ -143,6 +151,7 @@ void setParameter(ReflectionRunOptions& options, std::string_view name, std::str
 double getParameter(const ReflectionRunOptions& options, std::string_view name) {
     const ParameterSlot& slot = findParameter(name);
     auto& o = const_cast<ReflectionRunOptions&>(options);  // the accessors are shared with setParameter
+    if (slot.boolField) return *slot.boolField(o) ? 1.0 : 0.0;
     return slot.uintField ? double(*slot.uintField(o)) : double(*slot.floatField(o));
 }
 
@@ -390,6 +399,7 @@ ReflectionRunResult runReflections(gpu::Context& ctx, scene::Scene& scene, const
     result.sslrRays = words[shader::kCountSslrRays];
     result.rtRays = words[shader::kCountRtRays];
     result.tlasInstances = options.frame.mode == passes::ReflectionMode::Ssr ? 0 : renderer.bvhGpuStats().tlasInstances;
+    result.gbuffer = renderer.gbufferStats();
     return result;
 }
 
@@ -435,6 +445,12 @@ std::string statsJson(const gpu::Context& ctx, const ReflectionRunOptions& optio
                           {"rt", share(shader::kPixelRt)},    {"env", share(shader::kPixelEnv)},
                           {"sky", share(shader::kPixelSky)}};
     j["bvh"] = {{"blas_built", r.blasBuilt}, {"blas_rebuilt", r.blasRebuilt}, {"tlas_instances", r.tlasInstances}};
+    // The last frame's raster work: what frustum culling left to draw.
+    j["raster"] = {{"draws", r.gbuffer.draws},
+                   {"triangles", r.gbuffer.triangles},
+                   {"instances_culled", r.gbuffer.instancesCulled},
+                   {"shadow_draws", r.gbuffer.shadowDraws},
+                   {"shadow_instances_culled", r.gbuffer.shadowInstancesCulled}};
     return j.dump(2) + "\n";
 }
 

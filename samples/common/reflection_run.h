@@ -93,6 +93,7 @@ struct ReflectionRunResult {
     uint64_t blasBuilt = 0;
     uint64_t blasRebuilt = 0;
     uint32_t tlasInstances = 0;
+    passes::GBufferStats gbuffer;  // the last frame's
     passes::RtBackend backend = passes::RtBackend::Auto;
     // Reference runs: frames accumulated, whether the tolerance was met
     // (else maxFrames stopped it), and the last relative change measured.

@@ -17,6 +17,7 @@
 #include "scene/animation.h"
 #include "scene/builtin_scenes.h"
 #include "scene/mesh_tools.h"
+#include "scene/procedural_meshes.h"
 
 #include "glint/packing.h"
 
@@ -811,6 +812,44 @@ TEST_CASE("a floor under a 10-degree sun has no acne: every floor pixel outside 
     }
     CHECK(lit > 4000u);
     MESSAGE("floor pixels: " << lit << " lit, " << inside << " in shadow");
+}
+
+TEST_CASE("instances outside the view are not drawn, those outside the shadow map not cast, and the image is the same") {
+    test::GpuTest gpu;
+    scene::Scene scene = floorAndPlateScene(45.0f, 160.0f);
+    // A box behind the camera (outside its frustum, inside the shadow map's
+    // box: it may still cast into the view), and one 300 m away, beyond the
+    // map fitted to the view's 60 m.
+    scene::Mesh box;
+    box.name = "box";
+    box.lods.push_back({{scene::makeBox({1.0f, 1.0f, 1.0f}, 0)}});
+    scene.meshes.push_back(std::move(box));
+    for (const glm::vec3 at : {glm::vec3(0.0f, 1.0f, 20.0f), glm::vec3(300.0f, 1.0f, -3.0f)}) {
+        scene::Instance inst;
+        inst.mesh = uint32_t(scene.meshes.size() - 1);
+        inst.transform = inst.previousTransform = glm::translate(glm::mat4(1.0f), at);
+        scene.instances.push_back(inst);
+    }
+    scene::prepareScene(scene);
+    const scene::Camera camera = shadowTestCamera();
+    passes::GBufferSettings culled, all;
+    all.frustumCulling = false;
+    passes::GBufferStats culledStats, allStats;
+    const GBufferImage a = render(gpu, scene, {camera}, &culledStats, culled);
+    const GBufferImage b = render(gpu, scene, {camera}, &allStats, all);
+    CHECK(culledStats.instancesCulled == 2u);
+    CHECK(culledStats.shadowInstancesCulled == 1u);
+    CHECK(culledStats.draws == 2u);
+    CHECK(culledStats.shadowDraws == 3u);
+    CHECK(allStats.instancesCulled == 0u);
+    CHECK(allStats.draws == 4u);
+    CHECK(allStats.shadowDraws == 4u);
+    // Nothing culled could reach a pixel: every target is bit for bit the same.
+    CHECK(a.depth == b.depth);
+    CHECK(a.normal == b.normal);
+    CHECK(a.albedo == b.albedo);
+    CHECK(a.motion == b.motion);
+    CHECK(a.lit == b.lit);
 }
 
 TEST_CASE("a skinned plate casts the shadow of its skinned pose, not of its bind pose") {

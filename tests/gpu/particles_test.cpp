@@ -135,6 +135,7 @@ struct Frame {
     std::vector<glm::vec4> litBefore, litAfter;  // around the forward pass
     passes::BvhGpuStats bvh;
     bool traced = false;
+    uint32_t forwardDrawn = 0, forwardCulled = 0;  // by the forward pass
 };
 
 class Rig {
@@ -231,6 +232,8 @@ public:
         const passes::ParticleForwardOutputs forward =
             passes::addParticleForwardPass(graph, particles_, {gbuf, scene_.particles, camera_});
         addReadback(graph, forward.lit, 1, resources);
+        f.forwardDrawn = forward.particles;
+        f.forwardCulled = forward.culled;
         uint32_t slot = 2;
         for (const auto& [texture, target] : reads) addReadback(graph, texture, slot++, resources);
 
@@ -531,6 +534,21 @@ TEST_CASE("the forward pass blends particles over the lit colour where the G-buf
     }
     CHECK(changed > 10);
     CHECK(changedFar == 0);
+}
+
+TEST_CASE("the forward pass draws only the particles whose quads reach the view; the trace still sees them all") {
+    test::GpuTest gpu;
+    scene::Scene s = mirrorScene(true);
+    const uint32_t inView = uint32_t(s.particles.size());
+    // Behind the camera (at the origin, looking down -Z), and beside it,
+    // its quad just reaching into the 90-degree view.
+    s.particles.push_back({{0.0f, 0.0f, 3.0f}, 0.2f, {1.0f, 0.0f, 0.0f, 1.0f}});
+    s.particles.push_back({{2.1f, 0.0f, -2.0f}, 0.2f, {0.0f, 1.0f, 0.0f, 1.0f}});
+    Rig rig(gpu.ctx(), s);
+    const Frame f = rig.run(passes::ReflectionMode::Hybrid, passes::RtBackend::Auto);
+    CHECK(f.forwardCulled == 1u);
+    CHECK(f.forwardDrawn == inView + 1u);
+    CHECK(f.bvh.particles == inView + 2u);
 }
 
 TEST_CASE("the plaza's lamp glows get a particle TLAS rebuilt every frame, frames in flight, the camera moving") {
