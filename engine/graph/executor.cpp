@@ -126,6 +126,11 @@ struct Executor::FrameSlot {
     uint64_t endValue[kQueueCount] = {0, 0};  // timeline values that mark this frame done
     std::vector<PassTiming> passes;            // names and queues, in query-pair order
     bool hostTimed = false;                    // passes[].milliseconds are host times already
+    // The TimedSpan: its query pair (after the passes'), whether this frame
+    // had a member, and (host-serial) its time.
+    uint32_t spanPair = 0;
+    bool spanRecorded = false;
+    std::optional<double> spanMilliseconds;
 };
 
 // ---------------------------------------------------------------- Executor
@@ -666,14 +671,37 @@ SubmittedFrame Executor::run(const Plan& plan, const FrameResources& imports) {
     }
     slot.pools[0].reset();
     slot.pools[1].reset();
-    if (slot.timer.pairCount() < plan.passes.size()) {
-        slot.timer = gpu::TimestampQueries(gpu_, std::max<uint32_t>(static_cast<uint32_t>(plan.passes.size()), 32));
+    // One pair per pass, and the span's after them.
+    const uint32_t pairsNeeded = static_cast<uint32_t>(plan.passes.size()) + 1;
+    if (slot.timer.pairCount() < pairsNeeded) {
+        slot.timer = gpu::TimestampQueries(gpu_, std::max<uint32_t>(pairsNeeded, 32));
     }
     slot.timer.reset();
     slot.passes.clear();
     slot.frame = frame_;
     slot.used = true;
     slot.hostTimed = passTimer_ == PassTimer::HostSerial;
+    slot.spanPair = pairsNeeded - 1;
+    slot.spanRecorded = false;
+    slot.spanMilliseconds.reset();
+
+    // The span's first and last member passes, in submission order.
+    const PlannedPass* spanFirst = nullptr;
+    const PlannedPass* spanLast = nullptr;
+    if (span_) {
+        for (const Batch& batch : plan.batches) {
+            for (const PlannedPass& p : plan.passesOf(batch)) {
+                if (!span_->member(plan.passName(p))) continue;
+                if (spanFirst && p.queue != spanFirst->queue) {
+                    throw gpu::GpuError("render graph: timed span '" + span_->name + "' has passes on two queues ('" +
+                                        std::string(plan.passName(*spanFirst)) + "' and '" + std::string(plan.passName(p)) + "')");
+                }
+                if (!spanFirst) spanFirst = &p;
+                spanLast = &p;
+            }
+        }
+    }
+    const bool perPass = perPassTiming_ || !spanFirst;
 
     prepareTransients(plan);
     prepareHistory(plan);
@@ -689,6 +717,11 @@ SubmittedFrame Executor::run(const Plan& plan, const FrameResources& imports) {
     PassContext ctx(*this, gpu_);
     ctx.frame_ = frame_;
     const bool hostTimed = passTimer_ == PassTimer::HostSerial;
+    // A host-timed span: between its first pass and its last, and when its
+    // commands were first submitted.
+    bool inSpan = false;
+    bool spanSubmitted = false;
+    std::chrono::steady_clock::time_point spanStart;
     for (uint32_t batchIndex = 0; batchIndex < plan.batches.size(); ++batchIndex) {
         const Batch& batch = plan.batches[batchIndex];
         const uint32_t qi = static_cast<uint32_t>(batch.queue);
@@ -727,7 +760,9 @@ SubmittedFrame Executor::run(const Plan& plan, const FrameResources& imports) {
         }
 
         // One command buffer per batch; with host-timed passes, one per pass
-        // (the batch's waits on the first, its signal on the last).
+        // (the batch's waits on the first, its signal on the last), or with
+        // a host-timed span and no per-pass times, one before the span, one
+        // for its part in this batch and one after it.
         VkCommandBuffer cmd = VK_NULL_HANDLE;
         bool first = true;
         const auto begin = [&] {
@@ -752,21 +787,34 @@ SubmittedFrame Executor::run(const Plan& plan, const FrameResources& imports) {
                 info.signalSemaphoreInfoCount = static_cast<uint32_t>(signals.size());
                 info.pSignalSemaphoreInfos = signals.data();
             }
+            if (inSpan && !spanSubmitted) {
+                spanStart = std::chrono::steady_clock::now();
+                spanSubmitted = true;
+            }
             gpu::check(vkQueueSubmit2(queue, 1, &info, VK_NULL_HANDLE),
                        "vkQueueSubmit2 (render graph, " + std::string(toString(batch.queue)) + " batch " +
                            std::to_string(batch.ordinal) + ")");
             first = false;
         };
 
-        if (!hostTimed) {
+        // Host-serial passes submitted alone, each waited for.
+        const bool alone = hostTimed && perPass;
+        if (!alone) {
             begin();
         }
         const auto batchPasses = plan.passesOf(batch);
         for (size_t k = 0; k < batchPasses.size(); ++k) {
             const PlannedPass& p = batchPasses[k];
             const bool lastPass = k + 1 == batchPasses.size();
-            if (hostTimed) {
+            if (alone) {
                 begin();
+            } else if (hostTimed && &p == spanFirst) {
+                // The span starts on an idle queue: what precedes it goes first.
+                submit(false);
+                gpu::check(vkQueueWaitIdle(queue), "vkQueueWaitIdle (render graph, before timed span '" +
+                                                       span_->name + "')");
+                begin();
+                inSpan = true;
             }
             recordBarriers(cmd, plan, plan.barriersBefore(p));
             ctx.name_ = plan.passName(p);
@@ -784,17 +832,42 @@ SubmittedFrame Executor::run(const Plan& plan, const FrameResources& imports) {
                 // when the command processor reached it while earlier passes
                 // were still draining (a TOP_OF_PIPE start charges their tail
                 // to this pass: a 2 MB clear read 0.8 ms on an H200).
-                if (!hostTimed) {
+                if (!hostTimed && &p == spanFirst) {
+                    slot.timer.begin(cmd, slot.spanPair, VK_PIPELINE_STAGE_2_ALL_COMMANDS_BIT);
+                    slot.spanRecorded = true;
+                }
+                if (!hostTimed && perPass) {
                     slot.timer.begin(cmd, pair, VK_PIPELINE_STAGE_2_ALL_COMMANDS_BIT);
                 }
                 if (const ExecuteFn& execute = plan.execute(p)) {
                     execute(ctx);
                 }
-                if (!hostTimed) {
+                if (!hostTimed && perPass) {
                     slot.timer.end(cmd, pair);
                 }
+                if (!hostTimed && &p == spanLast) {
+                    slot.timer.end(cmd, slot.spanPair);
+                }
             }
-            if (hostTimed) {
+            if (hostTimed && !alone && &p == spanLast) {
+                // The span's last commands: submitted and waited for; the
+                // span ran from its first submission to here.
+                if (lastPass) {
+                    recordBarriers(cmd, plan, plan.barriersAfter(batch));
+                }
+                submit(lastPass);
+                gpu::check(vkQueueWaitIdle(queue), "vkQueueWaitIdle (render graph, timed span '" + span_->name + "')");
+                slot.spanMilliseconds =
+                    std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - spanStart).count();
+                slot.spanRecorded = true;
+                inSpan = false;
+                if (!lastPass) {
+                    begin();
+                } else {
+                    cmd = VK_NULL_HANDLE;
+                }
+            }
+            if (alone) {
                 if (lastPass) {
                     recordBarriers(cmd, plan, plan.barriersAfter(batch));
                 }
@@ -809,10 +882,10 @@ SubmittedFrame Executor::run(const Plan& plan, const FrameResources& imports) {
                 slot.passes[pair].cpuMilliseconds = processCpuMilliseconds() - cpuStart;
             }
         }
-        if (!hostTimed) {
+        if (!alone && cmd != VK_NULL_HANDLE) {
             recordBarriers(cmd, plan, plan.barriersAfter(batch));
             submit(true);
-        } else if (batchPasses.empty()) {
+        } else if (alone && batchPasses.empty()) {
             begin();
             recordBarriers(cmd, plan, plan.barriersAfter(batch));
             submit(true);
@@ -842,7 +915,23 @@ SubmittedFrame Executor::run(const Plan& plan, const FrameResources& imports) {
     return submitted;
 }
 
-std::vector<PassTiming> Executor::timings() const {
+void Executor::setTimedSpan(std::optional<TimedSpan> span, bool perPass) {
+    if (span && !span->member) {
+        throw gpu::GpuError("render graph: timed span '" + span->name + "' has no member test");
+    }
+    span_ = std::move(span);
+    perPassTiming_ = perPass;
+}
+
+std::optional<double> Executor::spanTiming() const {
+    const FrameSlot* slot = lastCompletedSlot();
+    if (!slot || !slot->spanRecorded) return std::nullopt;
+    if (slot->hostTimed) return slot->spanMilliseconds;
+    const auto ms = slot->timer.readMilliseconds();
+    return slot->spanPair < ms.size() ? ms[slot->spanPair] : std::nullopt;
+}
+
+const Executor::FrameSlot* Executor::lastCompletedSlot() const {
     // The newest slot whose frame is complete on every queue.
     const FrameSlot* best = nullptr;
     for (const auto& s : slots_) {
@@ -855,6 +944,11 @@ std::vector<PassTiming> Executor::timings() const {
             best = s.get();
         }
     }
+    return best;
+}
+
+std::vector<PassTiming> Executor::timings() const {
+    const FrameSlot* best = lastCompletedSlot();
     if (!best) {
         return {};
     }

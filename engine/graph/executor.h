@@ -59,10 +59,12 @@
 #include "gpu/resources.h"
 #include "gpu/timestamps.h"
 
+#include <functional>
 #include <map>
 #include <memory>
 #include <optional>
 #include <string>
+#include <string_view>
 #include <vector>
 
 namespace glint::rg {
@@ -176,6 +178,18 @@ struct PassTiming {
 //   overhead (tens of microseconds) to every pass.
 enum class PassTimer : uint8_t { GpuTimestamps, HostSerial };
 
+// A chain of passes timed as one: from the start of the first pass (in
+// submission order) whose name `member` accepts to the end of the last one,
+// everything between included (barriers, idle gaps, passes that are not
+// members). All members must run on one queue. With GPU timestamps it is
+// one timestamp pair; host-serial, the host's wall time from the first
+// submission of the span's commands to the queue's idle after its last
+// (the span's passes are then submitted together, per batch, not alone).
+struct TimedSpan {
+    std::string name;
+    std::function<bool(std::string_view pass)> member;
+};
+
 struct ExecutorStats {
     uint64_t frames = 0;
     uint32_t transientRebuilds = 0;  // times the transient memory was (re)created
@@ -210,6 +224,14 @@ public:
     const ExecutorStats& stats() const { return stats_; }
     void setPassTimer(PassTimer timer) { passTimer_ = timer; }
     PassTimer passTimer() const { return passTimer_; }
+    // Times `span` in every frame run from now on (none: no span). With
+    // `perPass` false the passes themselves are not timed (timings() then
+    // gives no milliseconds): per-pass timestamps add a drain of the queue
+    // at every pass boundary, which the span should not pay.
+    void setTimedSpan(std::optional<TimedSpan> span, bool perPass = true);
+    // The span's time in the frame timings() reads (none: no span, no
+    // member pass in that frame, or no timestamps on the queue).
+    std::optional<double> spanTiming() const;
 
 private:
     friend class PassContext;
@@ -245,8 +267,12 @@ private:
     // Per declaration resource of the plan being run.
     std::vector<Physical> physical_;
     std::vector<std::string> resourceNames_;
+    const FrameSlot* lastCompletedSlot() const;
+
     ExecutorStats stats_;
     PassTimer passTimer_ = PassTimer::GpuTimestamps;
+    std::optional<TimedSpan> span_;
+    bool perPassTiming_ = true;
 };
 
 }  // namespace glint::rg

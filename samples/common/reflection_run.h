@@ -77,6 +77,9 @@ struct ReflectionRunResult {
     std::vector<PassTime> passes;
     rg::PassTimer passTimer = rg::PassTimer::GpuTimestamps;  // how `passes` were timed
     std::optional<double> reflectionMs;  // median per-frame sum of the reflection passes
+    // Median of the reflection chain (its first pass to its last) timed as
+    // one span with no per-pass timestamps: the other half of the frames.
+    std::optional<double> reflectionSpanMs;
     std::optional<double> totalMs;       // median per-frame sum of all passes
     std::optional<double> reflectionCpuMs;  // host-serial timing only: as reflectionMs, in process CPU time
     uint32_t framesTimed = 0;

@@ -194,9 +194,11 @@ int main(int argc, char** argv) {
                          p.queue == rg::Queue::AsyncCompute ? " (async compute)" : "");
         }
         if (result.reflectionMs) {
-            spdlog::info("reflections {:.3f} ms, frame {:.3f} ms {}, {:.3f} ms wall (median of {} frames); rays: {} "
+            const std::string span =
+                result.reflectionSpanMs ? fmt::format(" ({:.3f} ms as one span)", *result.reflectionSpanMs) : "";
+            spdlog::info("reflections {:.3f} ms{}, frame {:.3f} ms {}, {:.3f} ms wall (median of {} frames); rays: {} "
                          "SSLR, {} RT",
-                         *result.reflectionMs, *result.totalMs,
+                         *result.reflectionMs, span, *result.totalMs,
                          result.passTimer == rg::PassTimer::HostSerial ? "host (passes submitted alone)" : "GPU",
                          result.frameWallMs.value_or(0.0), result.framesTimed,
                          result.sslrRays, result.rtRays);

@@ -84,10 +84,27 @@ TEST_CASE("a multi-pass compute graph with aliased transients computes the right
     rg::Executor executor(ctx);
     // Host-serial timing submits every pass alone: the same plan, split
     // into more submissions, must give the same values and time each pass.
+    // A timed span (three consecutive graphics passes) with per-pass times
+    // off submits the span's passes together, split from the rest of the
+    // frame on the host: the values must not change either.
     rg::PassTimer timer = rg::PassTimer::GpuTimestamps;
+    bool span = false, perPass = true;
     SUBCASE("passes timed by GPU timestamps") {}
     SUBCASE("passes submitted alone and timed on the host") { timer = rg::PassTimer::HostSerial; }
+    SUBCASE("GPU timestamps around the passes and a span") { span = true; }
+    SUBCASE("GPU timestamps around a span alone") { span = true, perPass = false; }
+    SUBCASE("a span alone timed on the host") {
+        timer = rg::PassTimer::HostSerial;
+        span = true, perPass = false;
+    }
     executor.setPassTimer(timer);
+    const std::set<std::string> members = {"double", "to-image", "from-image"};
+    if (span) {
+        executor.setTimedSpan(rg::TimedSpan{"middle", [&](std::string_view pass) {
+                                                return members.count(std::string(pass)) != 0;
+                                            }},
+                              perPass);
+    }
     gpu::Buffer results[2] = {readbackTarget(ctx, "results0"), readbackTarget(ctx, "results1")};
 
     for (uint32_t frame = 0; frame < 4; ++frame) {
@@ -169,9 +186,14 @@ TEST_CASE("a multi-pass compute graph with aliased transients computes the right
     const auto timings = executor.timings();
     REQUIRE(timings.size() == 7);
     std::set<std::string> names;
+    const std::optional<double> spanMs = executor.spanTiming();
+    CHECK(spanMs.has_value() == (span && (timer == rg::PassTimer::HostSerial || ctx.caps().timestamps)));
+    if (spanMs) CHECK(*spanMs > 0.0);
     for (const auto& t : timings) {
         names.insert(t.name);
-        if (timer == rg::PassTimer::HostSerial) {
+        if (!perPass) {
+            CHECK_FALSE(t.milliseconds.has_value());
+        } else if (timer == rg::PassTimer::HostSerial) {
             REQUIRE(t.milliseconds.has_value());
             REQUIRE(t.cpuMilliseconds.has_value());
             CHECK(*t.milliseconds > 0.0);

@@ -1,5 +1,5 @@
 # Runs glint-render with ARGS and checks the stats JSON it writes (STATS):
-# the keys issue 5 names are there, every pass has a finite time, and the
+# the keys of the stats are there (both reflection times numbers), every pass has a finite time, and the
 # mode's work happened (RT rays in rt mode, none in ssr mode, SSLR rays
 # outside rt mode).
 cmake_policy(SET CMP0054 NEW)  # quoted arguments are strings, never variables
@@ -8,10 +8,17 @@ if(NOT rc EQUAL 0)
   message(FATAL_ERROR "glint-render exited with ${rc}")
 endif()
 file(READ ${STATS} json)
-foreach(key device mode size frames passes reflection_ms rays pixel_classes bvh)
+foreach(key device mode size frames passes reflection_ms reflection_span_ms rays pixel_classes bvh raster)
   string(JSON value ERROR_VARIABLE err GET "${json}" ${key})
   if(err)
     message(FATAL_ERROR "${STATS}: no '${key}': ${err}")
+  endif()
+endforeach()
+# Both reflection times measured: the per-pass sum and the chain as one span.
+foreach(key reflection_ms reflection_span_ms)
+  string(JSON type TYPE "${json}" ${key})
+  if(NOT type STREQUAL "NUMBER")
+    message(FATAL_ERROR "${STATS}: ${key} is ${type}, not a number")
   endif()
 endforeach()
 string(JSON mode GET "${json}" mode)
