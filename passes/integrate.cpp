@@ -123,7 +123,7 @@ IntegrateOutputs addIntegratePass(rg::Graph& graph, IntegratePipelines& pipeline
     constants.lighting = inputs.lighting;
     constants.size = {gbuf.width, gbuf.height};
     constants.tiles = {tilesX, tilesY};
-    constants.confidenceThreshold = settings.confidenceThreshold;
+    constants.confidenceThreshold = sslrStoredThreshold(settings.confidenceThreshold);
     constants.particlesBound = hasParticles ? 1u : 0u;
 
     // The constants outgrow push constants (glint/integrate_shared.h); a

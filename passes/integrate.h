@@ -80,8 +80,10 @@ struct IntegrateInputs {
 struct IntegrateSettings {
     // SSLR confidence at which SSLR alone is trusted, and at which a traced
     // ray counts as a hit in the feedback counters: the Far Cry 6 talk's 0.9
-    // (DESIGN.md section 3). Keep it equal to SslrSettings's, which lists
-    // the hybrid rays below it for the ray tracer.
+    // (DESIGN.md section 3). It must equal SslrSettings's, which lists the
+    // hybrid rays below it for the ray tracer: the RT outputs are read only
+    // where the stored SSLR confidence is below it (compared, as SSLR does,
+    // at sslrStoredThreshold), since nothing clears the traces' outputs.
     float confidenceThreshold = 0.9f;
 };
 

@@ -183,7 +183,7 @@ ParticleTraceOutputs addParticleTracePass(rg::Graph& graph, ParticlePipelines& p
     constants.inverseViewProjection = glm::inverse(inputs.camera.viewProjection());
     constants.cameraPosition = glm::vec4(inputs.camera.position, 1.0f);
     constants.size = {gbuf.width, gbuf.height};
-    constants.confidenceThreshold = settings.confidenceThreshold;
+    constants.confidenceThreshold = sslrStoredThreshold(settings.confidenceThreshold);
     constants.maxDistance = settings.maxDistance;
     constants.sslrBound = hasSslr ? 1u : 0u;
     constants.rtBound = hasRt ? 1u : 0u;

@@ -5,6 +5,7 @@
 #include "graph/executor.h"
 
 #include "glint/ray_generation_shared.h"
+#include "glint/sslr_shared.h"
 
 #include <array>
 
@@ -67,14 +68,19 @@ RayGenerationOutputs addRayGenerationPass(rg::Graph& graph, RayGenerationPipelin
     const ClearData& clear = graph.addPass<ClearData>(
         "ray_generation.clear_args", rg::Queue::Graphics,
         [&](rg::Builder& b, ClearData& d) {
-            d.sslrArgs = b.write(b.createBuffer("ray_generation.sslr_args", {shader::kRayListArgsWords * 4u}),
+            d.sslrArgs = b.write(b.createBuffer("ray_generation.sslr_args", {shader::kSslrArgsWords * 4u}),
                                  rg::Access::TransferDst);
             d.rtArgs = b.write(b.createBuffer("ray_generation.rt_args", {shader::kRayListArgsWords * 4u}),
                                rg::Access::TransferDst);
         },
-        [](const ClearData& d, rg::PassContext& pc) {
+        [size = glm::uvec2(gbuf.width, gbuf.height)](const ClearData& d, rg::PassContext& pc) {
             const std::array<uint32_t, shader::kRayListArgsWords> initial = {0, 1, 1, 0, 1, 1};
-            vkCmdUpdateBuffer(pc.cmd(), pc.buffer(d.sslrArgs).handle(), 0, sizeof(initial), initial.data());
+            // SSLR's pyramid passes: their groups, closed (z = 0) until a
+            // ray that cone-traces is listed.
+            const glm::uvec2 base = shader::sslrPyramidGroups(size, 0), down = shader::sslrPyramidGroups(size, 1);
+            const std::array<uint32_t, shader::kSslrArgsWords> sslr = {0, 1, 1, 0, 1, 1, base.x, base.y, 0,
+                                                                       down.x, down.y, 0};
+            vkCmdUpdateBuffer(pc.cmd(), pc.buffer(d.sslrArgs).handle(), 0, sizeof(sslr), sslr.data());
             vkCmdUpdateBuffer(pc.cmd(), pc.buffer(d.rtArgs).handle(), 0, sizeof(initial), initial.data());
         });
 
@@ -89,9 +95,9 @@ RayGenerationOutputs addRayGenerationPass(rg::Graph& graph, RayGenerationPipelin
     constants.reuseRoughness = settings.reuseRoughness;
     constants.rtMaxDistance = settings.rtMaxDistance;
     constants.sslrMinDistance = settings.sslrMinDistance;
-    constants.reuseEnabled = settings.reuse ? 1u : 0u;
-    constants.mode = uint32_t(settings.mode);
-    constants.tileModesEnabled = inputs.tileModes.valid() ? 1u : 0u;
+    constants.flags = uint32_t(settings.mode) | (settings.reuse ? shader::kRayGenReuse : 0u) |
+                      (inputs.tileModes.valid() ? shader::kRayGenTileModes : 0u);
+    constants.coneRoughness = settings.coneRoughness;
     constants.rtToHybridShare = settings.rtToHybridShare;
     constants.tilesX = out.tilesX;
 

@@ -73,6 +73,16 @@ struct RayGenerationSettings {
     // 100 around the camera (Far Cry 6 talk, DESIGN.md section 3).
     float sslrMinDistance = 100.0f;
     ReflectionMode mode = ReflectionMode::Hybrid;
+    // SSLR and hybrid pixels at least this rough (perceptual) cone-trace in
+    // SSLR: they march the mirror direction and sample a box-filtered
+    // pyramid of the lit colour at the GGX lobe's footprint, noise-free,
+    // instead of the lit colour at one stochastic ray's hit (the talk's
+    // "fast cone trace for rough tiles"; SslrSettings::coneTrace turns it
+    // off). Ray generation marks those rays (kRayCone) and opens SSLR's
+    // pyramid passes only when it lists one, so a frame without builds no
+    // pyramid. Glint's starting value: where quads start sharing one ray
+    // (reuseRoughness).
+    float coneRoughness = 0.1f;
     // Share of the hybrid-band pixels of a tile the feedback sends to RT that
     // stay hybrid (tried with SSLR first) this frame, so that the tile's
     // counters keep seeing SSLR and it can return to SSLR (Far Cry 6 talk,
@@ -84,7 +94,7 @@ struct RayGenerationOutputs {
     rg::Buffer rays;          // shader::PackedRay per pixel
     rg::Buffer classes;       // uint per pixel: shader::kPixel*
     rg::Buffer sslrRays;      // SSLR ray list: shader::PackedRay per SSLR/hybrid ray leader (capacity: one per pixel)
-    rg::Buffer sslrArgs;      // shader::kRayListArgsWords: dispatch at kRayListDispatchArgsBytes
+    rg::Buffer sslrArgs;      // shader::kSslrArgsWords: dispatch at kRayListDispatchArgsBytes, SSLR's pyramid after it
     rg::Buffer rtRays;        // RT ray list: shader::PackedRay per RT ray leader (capacity: one per pixel)
     rg::Buffer rtArgs;        // shader::kRayListArgsWords: dispatch at kRayListDispatchArgsBytes, trace at kRayListTraceArgsBytes
     rg::Texture classDebug;   // kRayClassDebugFormat: a colour per class (debug view "ray_classes")

@@ -127,6 +127,7 @@ void ReflectionRenderer::bind(rg::FrameResources& resources, const ReflectionFra
 ReflectionFrame ReflectionRenderer::addFrame(rg::Graph& graph, const scene::Camera& camera,
                                              const ReflectionFrameSettings& settings) {
     const ReflectionMode mode = settings.mode;
+    const std::string_view view = settings.debugView;
     const uint64_t frameIndex = camera.frameIndex;
     const bool traces = mode != ReflectionMode::Ssr;
     const bool screenSpace = mode != ReflectionMode::Rt;
@@ -158,13 +159,19 @@ ReflectionFrame ReflectionRenderer::addFrame(rg::Graph& graph, const scene::Came
     // 2. Ray generation and tile classification.
     RayGenerationSettings raySettings = settings.rays;
     raySettings.mode = mode;
+    // The traces write only their rays' pixels; a debug view of their raw
+    // outputs shows the rest cleared rather than stale.
+    const bool viewsSslr = view.substr(0, 5) == "sslr_" || view == "lit_pyramid";
+    const bool viewsRt = view.substr(0, 3) == "rt_";
     f.rays = addRayGenerationPass(graph, rays_, rayInputs, raySettings);
     // 3. SSLR, extending the RT list with what it cannot resolve.
     rg::Buffer rtList = f.rays.rtRays;
     rg::Buffer rtArgs = f.rays.rtArgs;
     if (screenSpace) {
+        SslrSettings sslrSettings = settings.sslr;
+        sslrSettings.clearUntraced = sslrSettings.clearUntraced || viewsSslr;
         f.sslr = addSslrPass(graph, sslr_, {f.gbuffer, f.rays, frameIndex, camera.view, camera.projection},
-                             settings.sslr);
+                             sslrSettings);
         rtList = f.sslr->rtRayList;
         rtArgs = f.sslr->rtArgs;
     }
@@ -179,7 +186,9 @@ ReflectionFrame ReflectionRenderer::addFrame(rg::Graph& graph, const scene::Came
         rtInputs.environment = f.environment;
         rtInputs.camera = camera;
         rtInputs.frameIndex = frameIndex;
-        f.rt = addRtTracePass(graph, rt_, rtInputs, settings.rt);
+        RtTraceSettings rtSettings = settings.rt;
+        rtSettings.clearUntraced = rtSettings.clearUntraced || viewsRt;
+        f.rt = addRtTracePass(graph, rt_, rtInputs, rtSettings);
     }
     // 5'. Particles seen in the reflections, cut at each ray's reflected
     // surface (the particle TLAS exists only when the scene has particles).
@@ -277,7 +286,6 @@ ReflectionFrame ReflectionRenderer::addFrame(rg::Graph& graph, const scene::Came
     // 8. Composite and tonemap, or the debug view in its place. The
     // particles are drawn into the lit colour only now: SSLR (and its cone
     // pyramid) must not see them, or they would be reflected twice.
-    const std::string_view view = settings.debugView;
     if (view.empty() || view == "final") {
         GBufferOutputs composited = f.gbuffer;
         composited.lit = addParticleForwardPass(graph, particles_, {f.gbuffer, scene_.particles, camera}).lit;

@@ -213,31 +213,44 @@ RtTraceOutputs addRtTracePass(rg::Graph& graph, RtTracePipelines& pipelines, con
     constants.shadows = settings.shadows ? 1u : 0u;
     constants.instanceMask = settings.instanceMask & 0xFFu;
 
-    // Every frame starts from zero outputs (only listed pixels are written;
-    // later passes read the rest as "not traced") and this frame's
-    // constants, which are larger than push constants guarantee.
-    struct ClearData {
-        rg::Texture radiance, hitDistance;
+    // This frame's constants, which are larger than push constants
+    // guarantee. The outputs are written at the listed rays' pixels only,
+    // and read nowhere else (passes/integrate.h): no clear, unless asked for.
+    struct ConstantsData {
         rg::Buffer constants;
     };
-    const ClearData& clear = graph.addPass<ClearData>(
-        "rt_trace.clear", rg::Queue::Graphics,
-        [&](rg::Builder& b, ClearData& d) {
-            const auto texture = [&](const char* name, VkFormat format) {
-                return b.write(b.createTexture(name, {.width = gbuf.width, .height = gbuf.height, .format = format}),
-                               rg::Access::StorageWrite);
-            };
-            d.radiance = texture("rt_trace.radiance", kRtRadianceFormat);
-            d.hitDistance = texture("rt_trace.hit_distance", kRtHitDistanceFormat);
+    const ConstantsData& upload = graph.addPass<ConstantsData>(
+        "rt_trace.constants", rg::Queue::Graphics,
+        [&](rg::Builder& b, ConstantsData& d) {
             d.constants = b.write(b.createBuffer("rt_trace.constants", {sizeof(shader::RtTraceConstants)}),
                                   rg::Access::TransferDst);
         },
-        [&pipelines, constants](const ClearData& d, rg::PassContext& pc) {
+        [constants](const ConstantsData& d, rg::PassContext& pc) {
             vkCmdUpdateBuffer(pc.cmd(), pc.buffer(d.constants).handle(), 0, sizeof(constants), &constants);
-            for (const rg::Texture t : {d.radiance, d.hitDistance}) {
-                pipelines.clearer_.clear(pc, t);
-            }
         });
+    const auto texture = [&](const char* name, VkFormat format) {
+        return graph.createTexture(name, {.width = gbuf.width, .height = gbuf.height, .format = format});
+    };
+    rg::Texture radiance = texture("rt_trace.radiance", kRtRadianceFormat);
+    rg::Texture hitDistance = texture("rt_trace.hit_distance", kRtHitDistanceFormat);
+    if (settings.clearUntraced) {
+        struct ClearData {
+            rg::Texture radiance, hitDistance;
+        };
+        const ClearData& clear = graph.addPass<ClearData>(
+            "rt_trace.clear", rg::Queue::Graphics,
+            [&](rg::Builder& b, ClearData& d) {
+                d.radiance = b.write(radiance, rg::Access::StorageWrite);
+                d.hitDistance = b.write(hitDistance, rg::Access::StorageWrite);
+            },
+            [&pipelines](const ClearData& d, rg::PassContext& pc) {
+                for (const rg::Texture t : {d.radiance, d.hitDistance}) {
+                    pipelines.clearer_.clear(pc, t);
+                }
+            });
+        radiance = clear.radiance;
+        hitDistance = clear.hitDistance;
+    }
 
     struct TraceData {
         rg::Texture depth, normal, roughnessMetal;
@@ -264,11 +277,11 @@ RtTraceOutputs addRtTracePass(rg::Graph& graph, RtTracePipelines& pipelines, con
             d.pool = b.read(inputs.bvh.primitivePool, rg::Access::StorageRead);
             d.offsets = b.read(inputs.bvh.primitiveOffsets, rg::Access::StorageRead);
             d.emission = b.read(inputs.bvh.emission, rg::Access::StorageRead);
-            d.constants = b.read(clear.constants, rg::Access::StorageRead);
+            d.constants = b.read(upload.constants, rg::Access::StorageRead);
             d.out.width = gbuf.width;
             d.out.height = gbuf.height;
-            d.out.radiance = b.write(clear.radiance, rg::Access::StorageWrite);
-            d.out.hitDistance = b.write(clear.hitDistance, rg::Access::StorageWrite);
+            d.out.radiance = b.write(radiance, rg::Access::StorageWrite);
+            d.out.hitDistance = b.write(hitDistance, rg::Access::StorageWrite);
         },
         [&pipelines, backend](const TraceData& d, rg::PassContext& pc) {
             const gpu::Pipeline& pipeline = backend == RtBackend::RayQuery ? *pipelines.query_ : *pipelines.pipeline_;

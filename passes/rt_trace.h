@@ -99,14 +99,19 @@ struct RtTraceSettings {
     float originOffsetScale = 1.0f;
     // TLAS instance groups the rays see (glint/packing.h kInstanceMask*).
     uint32_t instanceMask = 0xFFu;
+    // Zero the outputs before the trace, so that pixels it does not trace
+    // read as "not traced" (debug views). Integrate and the particle trace
+    // read only the pixels whose rays were listed and need no clear.
+    bool clearUntraced = false;
 };
 
 struct RtTraceOutputs {
     // kRtRadianceFormat: rgb radiance along the ray (the hit lit, or the
-    // environment on a miss), a = 1 at pixels whose ray was traced; 0 elsewhere.
+    // environment on a miss), a = 1, at the pixels of the listed rays; the
+    // rest is left as the memory held it (zero with clearUntraced).
     rg::Texture radiance;
     // kRtHitDistanceFormat: world distance to the hit; kMissHitDistance
-    // (glint/ray_generation_shared.h) on a miss; 0 where nothing was traced.
+    // (glint/ray_generation_shared.h) on a miss; at the listed rays' pixels.
     rg::Texture hitDistance;
     uint32_t width = 0;
     uint32_t height = 0;

@@ -7,6 +7,8 @@
 #include "glint/ray_generation_shared.h"
 #include "glint/sslr_shared.h"
 
+#include <glm/gtc/packing.hpp>
+
 #include <algorithm>
 #include <array>
 #include <bit>
@@ -29,7 +31,15 @@ std::vector<gpu::Binding> traceBindings() {
     return bindings;
 }
 
-uint32_t groupsOf(uint32_t n) { return (n + 7) / 8; }
+// pyramid.glsl: the source (the lit colour through a sampler, whose reads
+// are texelFetch, or level 5 as a storage image), then the levels written.
+std::vector<gpu::Binding> pyramidBindings(VkDescriptorType source) {
+    std::vector<gpu::Binding> bindings = {{0, source, VK_SHADER_STAGE_COMPUTE_BIT}};
+    for (uint32_t o = 0; o < shader::kSslrPyramidOutputs; ++o) {
+        bindings.push_back({1 + o, VK_DESCRIPTOR_TYPE_STORAGE_IMAGE, VK_SHADER_STAGE_COMPUTE_BIT});
+    }
+    return bindings;
+}
 
 // The trace inverts the projection from P00, P11, P22 and P32 alone
 // (glint/sslr_shared.h); anything else (an off-centre or orthographic
@@ -48,25 +58,22 @@ SslrPipelines::SslrPipelines(gpu::Context& ctx)
     : ctx_(ctx),
       trace_(gpu::createComputePipeline(
           ctx, {"sslr/trace.comp", traceBindings(), uint32_t(sizeof(shader::SslrConstants)), "sslr.trace"})),
-      // Every read is a texelFetch; the sampler only completes the combined
-      // descriptor.
       pyramidBase_(gpu::createComputePipeline(
-          ctx, {"sslr/pyramid_base.comp",
-                {{0, VK_DESCRIPTOR_TYPE_COMBINED_IMAGE_SAMPLER, VK_SHADER_STAGE_COMPUTE_BIT},
-                 {1, VK_DESCRIPTOR_TYPE_STORAGE_IMAGE, VK_SHADER_STAGE_COMPUTE_BIT}},
-                uint32_t(sizeof(glm::uvec2)),
-                "sslr.pyramid_base"})),
+          ctx, {"sslr/pyramid_base.comp", pyramidBindings(VK_DESCRIPTOR_TYPE_COMBINED_IMAGE_SAMPLER),
+                uint32_t(sizeof(shader::SslrPyramidConstants)), "sslr.pyramid_base"})),
       pyramidDown_(gpu::createComputePipeline(
-          ctx, {"sslr/pyramid_down.comp",
-                {{0, VK_DESCRIPTOR_TYPE_STORAGE_IMAGE, VK_SHADER_STAGE_COMPUTE_BIT},
-                 {1, VK_DESCRIPTOR_TYPE_STORAGE_IMAGE, VK_SHADER_STAGE_COMPUTE_BIT}},
-                uint32_t(sizeof(shader::SslrPyramidConstants)),
-                "sslr.pyramid_down"})),
+          ctx, {"sslr/pyramid_down.comp", pyramidBindings(VK_DESCRIPTOR_TYPE_STORAGE_IMAGE),
+                uint32_t(sizeof(shader::SslrPyramidConstants)), "sslr.pyramid_down"})),
       nearest_(ctx, {VK_FILTER_NEAREST, VK_SAMPLER_MIPMAP_MODE_NEAREST, VK_SAMPLER_ADDRESS_MODE_CLAMP_TO_EDGE, 0.0f,
                      "sslr.nearest"}),
       trilinear_(ctx, {VK_FILTER_LINEAR, VK_SAMPLER_MIPMAP_MODE_LINEAR, VK_SAMPLER_ADDRESS_MODE_CLAMP_TO_EDGE,
                        VK_LOD_CLAMP_NONE, "sslr.trilinear"}),
       clearer_(ctx) {}
+
+float sslrStoredThreshold(float threshold) {
+    // Round to the nearest half float, as the confidence image stores.
+    return glm::unpackHalf1x16(glm::packHalf1x16(threshold));
+}
 
 SslrOutputs addSslrPass(rg::Graph& graph, SslrPipelines& pipelines, const SslrInputs& inputs,
                         const SslrSettings& settings) {
@@ -84,87 +91,104 @@ SslrOutputs addSslrPass(rg::Graph& graph, SslrPipelines& pipelines, const SslrIn
     out.width = gbuf.width;
     out.height = gbuf.height;
 
-    // Every frame starts from zero radiance and confidence: only listed
-    // tiles' leaders are written, and later passes read the rest as "no
-    // reflection yet".
-    struct ClearData {
-        rg::Texture radiance, confidence, hitDebug;
+    // The trace writes its ray leaders' pixels only, and its readers read
+    // nothing else (glint/sslr_shared.h): no clear, unless asked for.
+    const auto texture = [&](const char* name, VkFormat format) {
+        return graph.createTexture(name, {.width = gbuf.width, .height = gbuf.height, .format = format});
     };
-    const ClearData& clear = graph.addPass<ClearData>(
-        "sslr.clear", rg::Queue::Graphics,
-        [&](rg::Builder& b, ClearData& d) {
-            const auto texture = [&](const char* name, VkFormat format) {
-                return b.write(b.createTexture(name, {.width = gbuf.width, .height = gbuf.height, .format = format}),
-                               rg::Access::StorageWrite);
-            };
-            d.radiance = texture("sslr.radiance", kSslrRadianceFormat);
-            d.confidence = texture("sslr.confidence", kSslrConfidenceFormat);
-            d.hitDebug = texture("sslr.hit_debug", kSslrHitDebugFormat);
-        },
-        [&pipelines](const ClearData& d, rg::PassContext& pc) {
-            for (const rg::Texture t : {d.radiance, d.confidence, d.hitDebug}) {
-                pipelines.clearer_.clear(pc, t);
-            }
-        });
+    rg::Texture radiance = texture("sslr.radiance", kSslrRadianceFormat);
+    rg::Texture confidence = texture("sslr.confidence", kSslrConfidenceFormat);
+    rg::Texture hitDebug = texture("sslr.hit_debug", kSslrHitDebugFormat);
+    if (settings.clearUntraced) {
+        struct ClearData {
+            rg::Texture radiance, confidence, hitDebug;
+        };
+        const ClearData& clear = graph.addPass<ClearData>(
+            "sslr.clear", rg::Queue::Graphics,
+            [&](rg::Builder& b, ClearData& d) {
+                d.radiance = b.write(radiance, rg::Access::StorageWrite);
+                d.confidence = b.write(confidence, rg::Access::StorageWrite);
+                d.hitDebug = b.write(hitDebug, rg::Access::StorageWrite);
+            },
+            [&pipelines](const ClearData& d, rg::PassContext& pc) {
+                for (const rg::Texture t : {d.radiance, d.confidence, d.hitDebug}) {
+                    pipelines.clearer_.clear(pc, t);
+                }
+            });
+        radiance = clear.radiance;
+        confidence = clear.confidence;
+        hitDebug = clear.hitDebug;
+    }
 
-    // The cone trace's colour pyramid: level 0 is the lit colour, each
-    // further level the 2x2 mean of the one above, one graph pass per level
-    // (each reads the level above and writes its own: the graph orders
-    // them by subresource).
+    // The cone trace's colour pyramid (glint/sslr_shared.h): two passes,
+    // each five levels, dispatched from the SSLR list's args, which give
+    // them no groups unless ray generation listed a ray that cone-traces.
     uint32_t pyramidMips = 0;
     rg::Texture pyramid;
     if (settings.coneTrace) {
         pyramidMips = std::min(shader::kSslrPyramidMaxMips, uint32_t(std::bit_width(std::max(gbuf.width, gbuf.height))));
-        struct BaseData {
-            rg::Texture lit, pyramid;
-        };
+        pyramid = graph.createTexture("sslr.lit_pyramid", {.width = gbuf.width,
+                                                            .height = gbuf.height,
+                                                            .mips = pyramidMips,
+                                                            .format = kSslrRadianceFormat});
         const glm::uvec2 size{gbuf.width, gbuf.height};
-        const BaseData& base = graph.addPass<BaseData>(
-            "sslr.pyramid", rg::Queue::Graphics,
-            [&](rg::Builder& b, BaseData& d) {
-                d.lit = b.read(gbuf.lit, rg::Access::SampledRead);
-                d.pyramid = b.write(b.createTexture("sslr.lit_pyramid", {.width = gbuf.width,
-                                                                        .height = gbuf.height,
-                                                                        .mips = pyramidMips,
-                                                                        .format = kSslrRadianceFormat}),
-                                    rg::Access::StorageWrite, rg::Subresource::mip(0));
-            },
-            [&pipelines, size](const BaseData& d, rg::PassContext& pc) {
-                const gpu::Pipeline& pipeline = pipelines.pyramidBase_;
-                pipeline.bind(pc.cmd());
-                gpu::PushDescriptors(pipeline)
-                    .sampledImage(0, pc.view(d.lit), pipelines.nearest_.handle(), pc.layout(d.lit))
-                    .storageImage(1, pc.image(d.pyramid).mipView(0))
-                    .push(pipelines.ctx_, pc.cmd());
-                pipeline.pushConstants(pc.cmd(), size);
-                pc.dispatch(pipeline, groupsOf(size.x), groupsOf(size.y));
-            });
-        pyramid = base.pyramid;
-        for (uint32_t m = 1; m < pyramidMips; ++m) {
-            struct DownData {
-                rg::Texture pyramid;
-                uint32_t mip = 0;
+        for (uint32_t pass = 0; pass < 2; ++pass) {
+            // Pass 0 writes levels 0-5 (the copy and five means), pass 1 the
+            // levels from 6 on, from level 5.
+            const uint32_t first = pass == 0 ? 0 : shader::kSslrPyramidLevelsPerPass + 1;
+            const uint32_t end = std::min(pyramidMips, pass == 0 ? shader::kSslrPyramidOutputs
+                                                                 : first + shader::kSslrPyramidLevelsPerPass);
+            if (first >= end) break;
+            shader::SslrPyramidConstants constants{};
+            constants.sourceSize = shader::sslrMipSize(size, pass * shader::kSslrPyramidLevelsPerPass);
+            constants.outputs = end - first;
+            for (uint32_t o = 0; o < constants.outputs; ++o) {
+                constants.outputSize[o] = shader::sslrMipSize(size, first + o);
+            }
+            struct PyramidData {
+                rg::Texture source, pyramid;
+                rg::Buffer args;
+                uint32_t first = 0, outputs = 0;
+                bool fromLit = false;
             };
-            shader::SslrPyramidConstants down{};
-            down.sourceSize = {std::max(1u, gbuf.width >> (m - 1)), std::max(1u, gbuf.height >> (m - 1))};
-            down.targetSize = {std::max(1u, gbuf.width >> m), std::max(1u, gbuf.height >> m)};
-            const DownData& level = graph.addPass<DownData>(
+            const PyramidData& level = graph.addPass<PyramidData>(
                 "sslr.pyramid", rg::Queue::Graphics,
-                [&](rg::Builder& b, DownData& d) {
-                    const rg::Texture above = b.read(pyramid, rg::Access::StorageRead, rg::Subresource::mip(m - 1));
-                    d.pyramid = b.write(above, rg::Access::StorageWrite, rg::Subresource::mip(m));
-                    d.mip = m;
+                [&](rg::Builder& b, PyramidData& d) {
+                    d.args = b.read(rays.sslrArgs, rg::Access::IndirectArgs);
+                    d.fromLit = pass == 0;
+                    // Level 5 is read and the levels below it written through
+                    // the handle the read returns (the graph orders both by
+                    // subresource).
+                    rg::Texture target = pyramid;
+                    if (d.fromLit) {
+                        d.source = b.read(gbuf.lit, rg::Access::SampledRead);
+                    } else {
+                        d.source = target = b.read(pyramid, rg::Access::StorageRead,
+                                                   rg::Subresource::mip(shader::kSslrPyramidLevelsPerPass));
+                    }
+                    d.pyramid = b.write(target, rg::Access::StorageWrite,
+                                        rg::Subresource{first, end - first, 0, rg::Subresource::kAll});
+                    d.first = first;
+                    d.outputs = end - first;
                 },
-                [&pipelines, down](const DownData& d, rg::PassContext& pc) {
-                    const gpu::Pipeline& pipeline = pipelines.pyramidDown_;
+                [&pipelines, constants, pass](const PyramidData& d, rg::PassContext& pc) {
+                    const gpu::Pipeline& pipeline = d.fromLit ? pipelines.pyramidBase_ : pipelines.pyramidDown_;
                     const gpu::Image& image = pc.image(d.pyramid);
                     pipeline.bind(pc.cmd());
-                    gpu::PushDescriptors(pipeline)
-                        .storageImage(0, image.mipView(d.mip - 1))
-                        .storageImage(1, image.mipView(d.mip))
-                        .push(pipelines.ctx_, pc.cmd());
-                    pipeline.pushConstants(pc.cmd(), down);
-                    pc.dispatch(pipeline, groupsOf(down.targetSize.x), groupsOf(down.targetSize.y));
+                    gpu::PushDescriptors push(pipeline);
+                    if (d.fromLit) {
+                        push.sampledImage(0, pc.view(d.source), pipelines.nearest_.handle(), pc.layout(d.source));
+                    } else {
+                        push.storageImage(0, image.mipView(shader::kSslrPyramidLevelsPerPass));
+                    }
+                    // Bindings past the levels written repeat the last one (never stored to).
+                    for (uint32_t o = 0; o < shader::kSslrPyramidOutputs; ++o) {
+                        push.storageImage(1 + o, image.mipView(d.first + std::min(o, d.outputs - 1)));
+                    }
+                    push.push(pipelines.ctx_, pc.cmd());
+                    pipeline.pushConstants(pc.cmd(), constants);
+                    pc.dispatchIndirect(pipeline, d.args,
+                                        (shader::kSslrArgsPyramidOffset + 3 * pass) * sizeof(uint32_t));
                 });
             pyramid = level.pyramid;
         }
@@ -182,8 +206,7 @@ SslrOutputs addSslrPass(rg::Graph& graph, SslrPipelines& pipelines, const SslrIn
     constants.thickness = settings.thickness;
     constants.maxDistance = settings.maxDistance;
     constants.edgeFade = settings.edgeFade;
-    constants.confidenceThreshold = settings.confidenceThreshold;
-    constants.coneRoughness = settings.coneRoughness;
+    constants.confidenceThreshold = sslrStoredThreshold(settings.confidenceThreshold);
     constants.pyramidMips = pyramidMips;
 
     struct TraceData {
@@ -206,9 +229,9 @@ SslrOutputs addSslrPass(rg::Graph& graph, SslrPipelines& pipelines, const SslrIn
             d.sslrArgs = b.read(rays.sslrArgs, rg::Access::IndirectArgs);
             b.read(rays.sslrArgs, rg::Access::StorageRead);
             d.out = out;
-            d.out.radiance = b.write(clear.radiance, rg::Access::StorageWrite);
-            d.out.confidence = b.write(clear.confidence, rg::Access::StorageWrite);
-            d.out.hitDebug = b.write(clear.hitDebug, rg::Access::StorageWrite);
+            d.out.radiance = b.write(radiance, rg::Access::StorageWrite);
+            d.out.confidence = b.write(confidence, rg::Access::StorageWrite);
+            d.out.hitDebug = b.write(hitDebug, rg::Access::StorageWrite);
             // Appends after ray generation's RT rays.
             d.out.rtRayList = b.write(rays.rtRays, rg::Access::StorageReadWrite);
             d.out.rtArgs = b.write(rays.rtArgs, rg::Access::StorageReadWrite);

@@ -1,13 +1,17 @@
 #pragma once
 // Pass 3 of the reflection pipeline (issue 5): screen-space reflections.
 // One compute pass, dispatched indirectly over ray generation's SSLR ray
-// list (one invocation per ray), traces each ray leader of the SSLR and hybrid pixels
-// across the depth buffer: a linear march of large steps with a per-pixel
+// list (one invocation per ray: no work for an empty list), traces each ray
+// leader of the SSLR and hybrid pixels across the depth buffer: a linear march of large steps with a per-pixel
 // random start offset, then binary refinement (Far Cry 6 talk, DESIGN.md
 // section 3). It writes the lit colour at the hit and a confidence in
 // [0, 1], and lists the hybrid rays below the confidence threshold, with
 // indirect args, for the ray-traced pass: it appends them to ray
-// generation's RT ray list. Layouts: glint/sslr_shared.h.
+// generation's RT ray list. The rays ray generation marks for the cone
+// trace sample a box-filtered pyramid of the lit colour, built by two
+// passes before the trace that run no groups unless such a ray is listed.
+// Nothing is cleared: only traced pixels are written, and read.
+// Layouts: glint/sslr_shared.h.
 //
 //   passes::SslrPipelines sslrPipelines(ctx);           // once
 //   each frame, after the ray generation:
@@ -61,17 +65,25 @@ struct SslrSettings {
     // SSSR's hit validation fades the same way). Glint's starting value.
     float edgeFade = 0.05f;
     // Hybrid rays below this confidence go to the ray tracer: the Far Cry 6
-    // talk's 0.9 (DESIGN.md section 3).
+    // talk's 0.9 (DESIGN.md section 3). Compared as the confidence image
+    // stores it (sslrStoredThreshold); integrate and the particle trace
+    // compare with the same value.
     float confidenceThreshold = 0.9f;
-    // Pixels at least this rough (perceptual) cone-trace: they march the
-    // mirror direction and sample a box-filtered pyramid of the lit colour
-    // at the GGX lobe's footprint, noise-free, instead of the lit colour at
-    // one stochastic ray's hit (issue 5's "fast cone trace for rough
-    // tiles"). Glint's starting value: where ray generation starts sharing
-    // one ray per quad (RayGenerationSettings::reuseRoughness).
-    float coneRoughness = 0.1f;
+    // The rays ray generation marks (RayGenerationSettings::coneRoughness)
+    // cone-trace over a pyramid of the lit colour; off, every ray marches
+    // its own GGX direction and no pyramid is declared.
     bool coneTrace = true;
+    // Zero the radiance, confidence and hit images before the trace, so
+    // that pixels it does not write read as "no hit" (debug views). The
+    // frame's own readers look only at traced pixels and need no clear.
+    bool clearUntraced = false;
 };
+
+// The confidence threshold as SSLR compares it: the nearest value the
+// confidence image (half float) holds. A reader that finds a hybrid ray's
+// stored confidence below it knows SSLR handed the ray to the ray tracer
+// (glint/sslr_shared.h).
+float sslrStoredThreshold(float threshold);
 
 struct SslrOutputs {
     rg::Texture radiance;    // kSslrRadianceFormat: lit colour at the hit, a = hit
@@ -79,7 +91,7 @@ struct SslrOutputs {
     rg::Texture hitDebug;    // kSslrHitDebugFormat: hit uv, confidence, hit (debug view "sslr_hits")
     rg::Buffer rtRayList;    // ray generation's RT ray list with the unresolved hybrid rays appended
     rg::Buffer rtArgs;       // its args (glint/ray_generation_shared.h kRayList*)
-    rg::Texture litPyramid;  // the cone trace's colour pyramid (invalid without cone trace)
+    rg::Texture litPyramid;  // the cone trace's colour pyramid (invalid without cone trace; unbuilt without cone rays)
     uint32_t width = 0;
     uint32_t height = 0;
 };

@@ -112,10 +112,16 @@ Reflection integratePixel(uvec2 pixel) {
     float confidence = 0.0;
     vec3 sslrRadiance = vec3(0.0);
     vec2 sslrHitUv = vec2(0.0);
+    // The traces write their rays' pixels only (nothing is cleared): the RT
+    // outputs hold this ray's result at RT pixels and at the hybrid pixels
+    // SSLR handed on, those whose stored confidence is not at least the
+    // threshold (glint/sslr_shared.h).
+    bool handedToRt = pixelClass == kPixelRt || pixelClass == kPixelHybrid;
 #if GLINT_INTEGRATE_SSLR
     if (traced && (pixelClass == kPixelSslr || pixelClass == kPixelHybrid)) {
         const vec4 radiance = texelFetch(sslrRadianceTexture, leader, 0);
         const float c = texelFetch(sslrConfidenceTexture, leader, 0).x;
+        handedToRt = pixelClass == kPixelHybrid && !(c >= C.confidenceThreshold);
         const vec2 hitUv = texelFetch(sslrHitTexture, leader, 0).xy;
         // A non-finite result is no hit: the pixel falls through to the
         // next source rather than carrying NaN into temporal accumulation.
@@ -139,7 +145,7 @@ Reflection integratePixel(uvec2 pixel) {
     vec3 rtRadiance = vec3(0.0);
     float rtHitDistance = kMissHitDistance;
 #if GLINT_INTEGRATE_RT
-    if (traced && (pixelClass == kPixelHybrid || pixelClass == kPixelRt)) {
+    if (traced && handedToRt) {
         const vec4 radiance = texelFetch(rtRadianceTexture, leader, 0);
         const float d = texelFetch(rtHitDistanceTexture, leader, 0).x;
         rtTraced = radiance.a > 0.5 && isFinite(radiance.rgb);

@@ -4,7 +4,8 @@
 // hybrid, RT), draws one GGX visible-normal reflection ray, and rough
 // pixels of a 2x2 quad share the quad leader's ray; the tile then appends
 // its SSLR and hybrid pixels' ray leaders to the SSLR ray list and its RT
-// pixels' leaders to the RT ray list, counting both in their args.
+// pixels' leaders to the RT ray list, counting both in their args, and
+// opens SSLR's colour pyramid passes when a listed ray cone-traces.
 #extension GL_GOOGLE_include_directive : require
 #extension GL_EXT_scalar_block_layout : require
 
@@ -37,6 +38,7 @@ shared uint sharedSslrCount;  // SSLR and hybrid ray leaders of the tile
 shared uint sharedSslrBase;   // their first slot in the SSLR list
 shared uint sharedRtCount;    // RT ray leaders of the tile
 shared uint sharedRtBase;     // their first slot in the RT list
+shared uint sharedCone;       // 1: an SSLR ray leader of the tile cone-traces
 
 // Colours of the classes for the debug view: black sky, grey env, blue
 // SSLR, purple hybrid, red RT.
@@ -49,13 +51,14 @@ const vec4 kClassColours[5] = vec4[5](vec4(0.0, 0.0, 0.0, 1.0), vec4(0.5, 0.5, 0
 // random share of an RT tile's pixels stays hybrid, so SSLR keeps being
 // tried there and the tile can come back to it when SSLR starts to hit.
 uint applyMode(uint pixelClass, uvec2 pixel) {
-    if (pc.mode == kModeSsr) {
+    const uint mode = pc.flags & kRayGenModeMask;
+    if (mode == kModeSsr) {
         return kPixelSslr;
     }
-    if (pc.mode == kModeRt) {
+    if (mode == kModeRt) {
         return kPixelRt;
     }
-    if (pixelClass != kPixelHybrid || pc.tileModesEnabled == 0u) {
+    if (pixelClass != kPixelHybrid || (pc.flags & kRayGenTileModes) == 0u) {
         return pixelClass;
     }
     const uint tileMode = tileModes[(pixel.y / kTileSize) * pc.tilesX + pixel.x / kTileSize];
@@ -78,11 +81,13 @@ void main() {
     if (lane == 0u) {
         sharedSslrCount = 0u;
         sharedRtCount = 0u;
+        sharedCone = 0u;
     }
 
     uint pixelClass = kPixelSky;
     uint direction = 0u;
     bool rough = false;
+    bool cone = false;
     if (inside) {
         const ivec2 p = ivec2(pixel);
         const float depth = texelFetch(depthTexture, p, 0).x;
@@ -106,7 +111,8 @@ void main() {
                 const vec2 u = frameNoise(pixel, pc.frame);
                 const vec3 l = sampleReflection(normalize(normal.xyz), toCamera / distance, roughness, u);
                 direction = packRayDirection(l);
-                rough = pc.reuseEnabled != 0u && roughness >= pc.reuseRoughness;
+                rough = (pc.flags & kRayGenReuse) != 0u && roughness >= pc.reuseRoughness;
+                cone = roughness >= pc.coneRoughness;
             }
         }
     }
@@ -155,6 +161,9 @@ void main() {
         localSlot = atomicAdd(sharedRtCount, 1u);
     } else if (sslrLeader) {
         localSlot = atomicAdd(sharedSslrCount, 1u);
+        if (cone) {
+            atomicOr(sharedCone, 1u);
+        }
     }
     barrier();
 
@@ -164,6 +173,12 @@ void main() {
             sharedSslrBase = base;
             const uint end = base + sharedSslrCount;
             atomicMax(sslrArgs[kRayListDispatchOffset], (end + kRayListGroupSize - 1u) / kRayListGroupSize);
+        }
+        // A ray that cone-traces needs SSLR's colour pyramid: its two passes'
+        // dispatches get their z (glint/ray_generation_shared.h).
+        if (sharedCone != 0u) {
+            atomicMax(sslrArgs[kSslrArgsPyramidOffset + 2u], 1u);
+            atomicMax(sslrArgs[kSslrArgsPyramidOffset + 5u], 1u);
         }
         if (sharedRtCount != 0u) {
             const uint base = atomicAdd(rtArgs[kRayListCountOffset], sharedRtCount);
@@ -180,6 +195,7 @@ void main() {
         if (rtLeader) {
             rtRays[sharedRtBase + localSlot] = ray;
         } else {
+            ray.pixelFlags |= cone ? kRayCone : 0u;
             sslrRays[sharedSslrBase + localSlot] = ray;
         }
     }

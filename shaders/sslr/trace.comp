@@ -104,7 +104,9 @@ void main() {
     // instead of one stochastic GGX direction per frame: the result is
     // noise-free where it hits. (The RT list keeps the stochastic ray.)
     const float roughness = texelFetch(roughnessMetalTexture, p, 0).x;
-    const bool cone = pc.pyramidMips > 0u && roughness >= pc.coneRoughness;
+    // Ray generation marks the rays that cone-trace, and opens the
+    // pyramid's passes only when it marks one.
+    const bool cone = pc.pyramidMips > 0u && (ray.pixelFlags & kRayCone) != 0u;
     if (cone) {
         const vec3 normalView = normalize(mat3(pc.view) * texelFetch(normalTexture, p, 0).xyz);
         const vec3 mirror = reflect(normalize(origin), normalView);
@@ -232,10 +234,15 @@ void main() {
 
     // Only hybrid rays go on: SSLR-class pixels lie beyond the BVH's reach
     // (DESIGN.md section 3), where the ray tracer could find nothing better.
-    if (pixelClass == kPixelHybrid && confidence < pc.confidenceThreshold) {
+    // "Not at least the threshold", so a NaN goes on too: readers find the
+    // ray traced wherever the stored confidence is not at least the
+    // threshold (glint/sslr_shared.h).
+    if (pixelClass == kPixelHybrid && !(confidence >= pc.confidenceThreshold)) {
         // Appended after ray generation's RT rays (glint/ray_generation_shared.h).
         const uint slot = atomicAdd(rtArgs[kRayListCountOffset], 1u);
-        rtRays[slot] = ray;
+        PackedRay handed = ray;
+        handed.pixelFlags &= ~kRayCone;  // a mark for SSLR alone
+        rtRays[slot] = handed;
         atomicMax(rtArgs[kRayListDispatchOffset], slot / kRayListGroupSize + 1u);
     }
 }

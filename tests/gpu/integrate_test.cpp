@@ -447,17 +447,23 @@ Expected expect(const Frame& f, const Traces& t, const Presence& present, const 
     const bool traced = ray.pixelFlags != shader::kNoRay;
     const glm::uvec2 leader = traced ? shader::unpackRayPixel(ray.pixelFlags) : glm::uvec2(x, y);
     const size_t li = at(leader.x, leader.y);
+    // Compared as SSLR compares (the nearest half float).
+    threshold = passes::sslrStoredThreshold(threshold);
     float confidence = 0.0f;
+    // The RT outputs are read only where SSLR handed the ray on: nothing
+    // clears them in the frame (the stored confidence is a half already).
+    bool handedToRt = cls == shader::kPixelHybrid || cls == shader::kPixelRt;
     if (present.sslr && traced && (cls == shader::kPixelSslr || cls == shader::kPixelHybrid)) {
         const glm::vec4 r = t.sslrRadiance[li];
         const float c = t.sslrConfidence[li];
+        handedToRt = cls == shader::kPixelHybrid && !(c >= threshold);
         if (r.a > 0.5f && finite(glm::vec3(r)) && std::isfinite(c) && std::isfinite(t.sslrHit[li].x) &&
             std::isfinite(t.sslrHit[li].y)) {
             confidence = glm::clamp(c, 0.0f, 1.0f);
         }
     }
-    const bool rtTraced = present.rt && traced && (cls == shader::kPixelHybrid || cls == shader::kPixelRt) &&
-                          t.rtRadiance[li].a > 0.5f && finite(glm::vec3(t.rtRadiance[li]));
+    const bool rtTraced = present.rt && traced && handedToRt && t.rtRadiance[li].a > 0.5f &&
+                          finite(glm::vec3(t.rtRadiance[li]));
     bool useSslr = false;
     if (confidence >= threshold) {
         useSslr = true;
@@ -503,7 +509,7 @@ glm::uvec2 tileCounts(const Frame& f, const Traces& t, float threshold, uint32_t
             const float c = t.sslrConfidence[i];
             const bool valid = r.a > 0.5f && finite(glm::vec3(r)) && std::isfinite(c) &&
                                std::isfinite(t.sslrHit[i].x) && std::isfinite(t.sslrHit[i].y);
-            const bool hit = valid && glm::clamp(c, 0.0f, 1.0f) >= threshold;
+            const bool hit = valid && glm::clamp(c, 0.0f, 1.0f) >= passes::sslrStoredThreshold(threshold);
             ++counts[hit ? 0 : 1];
         }
     }

@@ -1001,7 +1001,11 @@ TEST_CASE("only listed rays are traced; entries past the count, without a surfac
         const std::string name = passes::rtBackendName(backend);
         CAPTURE(name);
         passes::RtTracePipelines pipelines(gpu.ctx(), backend);
-        const RtFrame f = rig.trace(pipelines, list, sunAndSky(), settingsFor(backend));
+        // Cleared first, so that what the trace leaves alone reads zero (the
+        // frame itself clears nothing: its readers read listed pixels only).
+        passes::RtTraceSettings settings = settingsFor(backend);
+        settings.clearUntraced = true;
+        const RtFrame f = rig.trace(pipelines, list, sunAndSky(), settings);
         uint32_t traced = 0;
         for (size_t i = 0; i < listed.size(); ++i) {
             CAPTURE(i);
@@ -1019,7 +1023,7 @@ TEST_CASE("only listed rays are traced; entries past the count, without a surfac
         // the list holds.
         RayList empty = list;
         empty.count = 0;
-        const RtFrame none = rig.trace(pipelines, empty, sunAndSky(), settingsFor(backend));
+        const RtFrame none = rig.trace(pipelines, empty, sunAndSky(), settings);
         size_t touched = 0;
         for (size_t i = 0; i < listed.size(); ++i) touched += none.untouched(i) ? 0 : 1;
         CHECK(touched == 0);

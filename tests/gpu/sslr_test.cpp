@@ -21,7 +21,9 @@
 
 #include <glm/gtc/packing.hpp>
 
+#include <algorithm>
 #include <array>
+#include <bit>
 #include <cmath>
 #include <cstring>
 #include <set>
@@ -139,10 +141,17 @@ public:
         f.hitDebug.resize(n);
         f.lit.resize(n);
         for (size_t i = 0; i < n; ++i) {
+            f.lit[i] = halves(buffers_[7], i, 4);
+            // SSLR writes its ray leaders' pixels only (SSLR and hybrid
+            // pixels with a ray of their own), and nothing clears the rest:
+            // those read as zero here, as "no hit" to every reader.
+            const uint32_t flags = f.rays[i].pixelFlags;
+            const bool leader = flags != shader::kNoRay && (flags & shader::kRayReused) == 0u &&
+                                (f.classes[i] == shader::kPixelSslr || f.classes[i] == shader::kPixelHybrid);
+            if (!leader) continue;
             f.radiance[i] = halves(buffers_[4], i, 4);
             f.confidence[i] = halves(buffers_[5], i, 1).x;
             f.hitDebug[i] = halves(buffers_[6], i, 4);
-            f.lit[i] = halves(buffers_[7], i, 4);
         }
         return f;
     }
@@ -438,4 +447,181 @@ TEST_CASE("rough pixels cone-trace: their reflection of thin stripes is the stri
     CHECK(coneRough > 0.8);
     CHECK(plainRough < 0.4);
     CHECK(mirror < 0.4);
+}
+
+namespace {
+
+// The colour pyramid of one frame, every level read back, with the lit
+// colour it was built from and the SSLR list's args.
+struct PyramidFrame {
+    glm::uvec2 size{0};
+    std::vector<glm::vec4> lit;
+    std::vector<std::vector<glm::vec4>> levels;
+    std::array<uint32_t, shader::kSslrArgsWords> sslrArgs{};
+};
+
+PyramidFrame buildPyramid(test::GpuTest& gpu, const scene::Scene& scene, glm::uvec2 size) {
+    auto& ctx = gpu.ctx();
+    rg::Executor executor(ctx);
+    passes::GBufferRenderer renderer(ctx, scene);
+    passes::RayGenerationPipelines rayPipelines(ctx);
+    passes::SslrPipelines sslrPipelines(ctx);
+    scene::Camera camera = testCamera();
+    camera.resolution = size;
+    camera.reset({glm::vec3(0.0f), glm::vec3(0, 0, -1), {0, 1, 0}}, 0);
+    passes::RayGenerationSettings raySettings;
+    raySettings.rtMaxDistance = 0.0f;
+    raySettings.sslrMinDistance = 1e9f;
+    raySettings.roughnessCutoff = 0.5f;
+    rg::Graph graph(executor.queueCaps());
+    rg::FrameResources resources;
+    const passes::GBufferOutputs gbuf = passes::addGBufferPass(graph, renderer, {camera});
+    const passes::RayGenerationOutputs rays =
+        passes::addRayGenerationPass(graph, rayPipelines, {gbuf, 1, camera}, raySettings);
+    const passes::SslrOutputs sslr =
+        passes::addSslrPass(graph, sslrPipelines, {gbuf, rays, 1, camera.view, camera.projection}, {});
+    REQUIRE(sslr.litPyramid.valid());
+
+    PyramidFrame out;
+    out.size = size;
+    const uint32_t mips = std::min(shader::kSslrPyramidMaxMips, uint32_t(std::bit_width(std::max(size.x, size.y))));
+    uint64_t texels = 0;
+    for (uint32_t m = 0; m < mips; ++m) {
+        const glm::uvec2 s = shader::sslrMipSize(size, m);
+        texels += uint64_t(s.x) * s.y;
+    }
+    const uint64_t pixels = uint64_t(size.x) * size.y;
+    gpu::Buffer pyramid(ctx, {texels * 8, VK_BUFFER_USAGE_TRANSFER_DST_BIT, gpu::MemoryUsage::Readback, "pyramid"});
+    gpu::Buffer lit(ctx, {pixels * 8, VK_BUFFER_USAGE_TRANSFER_DST_BIT, gpu::MemoryUsage::Readback, "lit"});
+    gpu::Buffer args(ctx, {shader::kSslrArgsWords * 4, VK_BUFFER_USAGE_TRANSFER_DST_BIT, gpu::MemoryUsage::Readback,
+                           "sslr_args"});
+    const rg::BoundaryState copy = rg::BoundaryState::of(rg::Access::TransferDst);
+    const std::array<rg::Buffer, 3> targets = {graph.importBuffer("pyramid", {{pyramid.size()}, copy, kHostRead}),
+                                               graph.importBuffer("lit", {{lit.size()}, copy, kHostRead}),
+                                               graph.importBuffer("args", {{args.size()}, copy, kHostRead})};
+    resources.bind(targets[0], pyramid);
+    resources.bind(targets[1], lit);
+    resources.bind(targets[2], args);
+    struct Data {
+        rg::Texture pyramid, lit;
+        rg::Buffer args;
+        std::array<rg::Buffer, 3> targets;
+    };
+    const Data& data = graph.addPass<Data>(
+        "readback", rg::Queue::Graphics,
+        [&](rg::Builder& b, Data& d) {
+            d.pyramid = b.read(sslr.litPyramid, rg::Access::TransferSrc);
+            d.lit = b.read(gbuf.lit, rg::Access::TransferSrc);
+            d.args = b.read(rays.sslrArgs, rg::Access::TransferSrc);
+            for (size_t i = 0; i < targets.size(); ++i) d.targets[i] = b.write(targets[i], rg::Access::TransferDst);
+        },
+        [size, mips](const Data& d, rg::PassContext& pc) {
+            std::vector<VkBufferImageCopy> regions;
+            VkDeviceSize offset = 0;
+            for (uint32_t m = 0; m < mips; ++m) {
+                const glm::uvec2 s = shader::sslrMipSize(size, m);
+                VkBufferImageCopy region{};
+                region.bufferOffset = offset;
+                region.imageSubresource = {VK_IMAGE_ASPECT_COLOR_BIT, m, 0, 1};
+                region.imageExtent = {s.x, s.y, 1};
+                regions.push_back(region);
+                offset += VkDeviceSize(s.x) * s.y * 8;
+            }
+            vkCmdCopyImageToBuffer(pc.cmd(), pc.image(d.pyramid).handle(), VK_IMAGE_LAYOUT_TRANSFER_SRC_OPTIMAL,
+                                   pc.buffer(d.targets[0]).handle(), uint32_t(regions.size()), regions.data());
+            VkBufferImageCopy region{};
+            region.imageSubresource = {VK_IMAGE_ASPECT_COLOR_BIT, 0, 0, 1};
+            region.imageExtent = {size.x, size.y, 1};
+            vkCmdCopyImageToBuffer(pc.cmd(), pc.image(d.lit).handle(), VK_IMAGE_LAYOUT_TRANSFER_SRC_OPTIMAL,
+                                   pc.buffer(d.targets[1]).handle(), 1, &region);
+            const VkBufferCopy words{0, 0, shader::kSslrArgsWords * 4};
+            vkCmdCopyBuffer(pc.cmd(), pc.buffer(d.args).handle(), pc.buffer(d.targets[2]).handle(), 1, &words);
+        });
+    for (const rg::Buffer& written : data.targets) graph.markOutput(written);
+    const rg::Plan plan = graph.compile(executor.compileOptions());
+    const auto report = rg::verify(plan);
+    REQUIRE_MESSAGE(report.ok(), report.text());
+    executor.run(plan, resources);
+    executor.waitIdle();
+
+    const auto unpack = [](const gpu::Buffer& b, uint64_t first, uint64_t count) {
+        std::vector<glm::vec4> v(count);
+        const uint16_t* h = reinterpret_cast<const uint16_t*>(b.mapped()) + first * 4;
+        for (uint64_t i = 0; i < count; ++i) {
+            for (int c = 0; c < 4; ++c) v[i][c] = glm::unpackHalf1x16(h[i * 4 + c]);
+        }
+        return v;
+    };
+    out.lit = unpack(lit, 0, pixels);
+    uint64_t first = 0;
+    for (uint32_t m = 0; m < mips; ++m) {
+        const glm::uvec2 s = shader::sslrMipSize(size, m);
+        out.levels.push_back(unpack(pyramid, first, uint64_t(s.x) * s.y));
+        first += uint64_t(s.x) * s.y;
+    }
+    std::memcpy(out.sslrArgs.data(), args.mapped(), sizeof(out.sslrArgs));
+    return out;
+}
+
+} // namespace
+
+TEST_CASE("the cone pyramid is the lit colour's 2x2 means level by level, built only when a listed ray cone-traces") {
+    test::GpuTest gpu;
+    for (const glm::uvec2 size : {glm::uvec2(64, 64), glm::uvec2(150, 40)}) {
+        CAPTURE(size.x);
+        CAPTURE(size.y);
+        // A rough floor (0.4, traced: the cutoff is raised) cone-traces.
+        const PyramidFrame f = buildPyramid(gpu, stripedScene(0.4f), size);
+        for (uint32_t pass = 0; pass < 2; ++pass) {
+            const glm::uvec2 groups = shader::sslrPyramidGroups(size, pass);
+            const uint32_t* command = &f.sslrArgs[shader::kSslrArgsPyramidOffset + 3 * pass];
+            CHECK(command[0] == groups.x);
+            CHECK(command[1] == groups.y);
+            CHECK(command[2] == 1u);  // open: the floor's rays cone-trace
+        }
+        // The expectation on the CPU: level 0 is the lit colour; each next
+        // level's texel the mean of its 2x2 children in the level above,
+        // clamped to that level (a level one texel across halves to itself).
+        std::vector<glm::vec3> above(f.lit.size());
+        for (size_t i = 0; i < above.size(); ++i) above[i] = glm::vec3(f.lit[i]);
+        glm::uvec2 aboveSize = size;
+        for (uint32_t m = 0; m < f.levels.size(); ++m) {
+            CAPTURE(m);
+            const glm::uvec2 s = shader::sslrMipSize(size, m);
+            std::vector<glm::vec3> expected(size_t(s.x) * s.y);
+            for (uint32_t y = 0; y < s.y; ++y) {
+                for (uint32_t x = 0; x < s.x; ++x) {
+                    if (m == 0) {
+                        expected[size_t(y) * s.x + x] = above[size_t(y) * s.x + x];
+                        continue;
+                    }
+                    glm::vec3 sum(0.0f);
+                    for (uint32_t dy = 0; dy < 2; ++dy) {
+                        for (uint32_t dx = 0; dx < 2; ++dx) {
+                            const uint32_t cx = std::min(2 * x + dx, aboveSize.x - 1);
+                            const uint32_t cy = std::min(2 * y + dy, aboveSize.y - 1);
+                            sum += above[size_t(cy) * aboveSize.x + cx];
+                        }
+                    }
+                    expected[size_t(y) * s.x + x] = 0.25f * sum;
+                }
+            }
+            uint32_t wrong = 0;
+            for (size_t i = 0; i < expected.size(); ++i) {
+                const glm::vec3 got(f.levels[m][i]);
+                // Half floats per stored level (levels 0-5 are reduced in
+                // fp32 by one pass, 6 on from the stored level 5).
+                const float tolerance = 2e-3f * glm::length(expected[i]) + 1e-4f;
+                if (glm::length(got - expected[i]) > tolerance || f.levels[m][i].a != 1.0f) ++wrong;
+            }
+            CHECK(wrong == 0u);
+            above = expected;
+            aboveSize = s;
+        }
+    }
+    // A mirror floor (below the cone roughness): no listed ray cone-traces,
+    // so the pyramid's passes run no groups.
+    const PyramidFrame mirror = buildPyramid(gpu, stripedScene(0.0f), {64, 64});
+    CHECK(mirror.sslrArgs[shader::kSslrArgsPyramidOffset + 2] == 0u);
+    CHECK(mirror.sslrArgs[shader::kSslrArgsPyramidOffset + 5] == 0u);
 }

@@ -124,9 +124,12 @@ vec3 particleWorldPosition(vec2 pixelPosition, float depth) {
 float particleReflectionDistance(ivec2 p, uint pixelClass, vec3 position) {
     float confidence = 0.0;
     vec2 sslrHitUv = vec2(0.0);
+    // Where SSLR handed the ray on, as integrate decides it (integrate.glsl).
+    bool handedToRt = pixelClass == kPixelRt || pixelClass == kPixelHybrid;
     if (C.sslrBound != 0u && (pixelClass == kPixelSslr || pixelClass == kPixelHybrid)) {
         const vec4 radiance = texelFetch(sslrRadianceTexture, p, 0);
         const float c = texelFetch(sslrConfidenceTexture, p, 0).x;
+        handedToRt = pixelClass == kPixelHybrid && !(c >= C.confidenceThreshold);
         const vec2 hitUv = texelFetch(sslrHitTexture, p, 0).xy;
         if (radiance.a > 0.5 && particleFinite(radiance.rgb) && particleFinite(c) && particleFinite(hitUv.x) &&
             particleFinite(hitUv.y)) {
@@ -136,7 +139,7 @@ float particleReflectionDistance(ivec2 p, uint pixelClass, vec3 position) {
     }
     bool rtTraced = false;
     float rtHitDistance = kMissHitDistance;
-    if (C.rtBound != 0u && (pixelClass == kPixelHybrid || pixelClass == kPixelRt)) {
+    if (C.rtBound != 0u && handedToRt) {
         const vec4 radiance = texelFetch(rtRadianceTexture, p, 0);
         const float d = texelFetch(rtHitDistanceTexture, p, 0).x;
         rtTraced = radiance.a > 0.5 && particleFinite(radiance.rgb);

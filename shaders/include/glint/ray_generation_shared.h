@@ -33,7 +33,9 @@ GLINT_CONST uint kPixelClassCount = 5u;
 //   pixelFlags: bits 0-14 x, 15-28 y of the pixel whose ray this is (up to
 //               32767 x 16383, as FidelityFX SSSR packs its rays), bit 29
 //               kRayReused: this pixel reuses that (quad leader's) ray,
-//               bits 30-31 unused
+//               bit 30 kRayCone (SSLR list entries only): SSLR cone-traces
+//               it (its roughness is at least the cone roughness), bit 31
+//               unused
 //   direction:  world-space unit direction, octahedral, two 16-bit snorms
 // A leader's own entry has its own pixel; a follower's entry names the
 // leader, so later passes trace leaders only and followers read the
@@ -45,6 +47,7 @@ struct PackedRay {
 
 GLINT_CONST uint kNoRay = 0xFFFFFFFFu;
 GLINT_CONST uint kRayReused = 1u << 29u;
+GLINT_CONST uint kRayCone = 1u << 30u;
 GLINT_CONST uint kRayPixelXMask = 0x7FFFu;
 GLINT_CONST uint kRayPixelYShift = 15u;
 GLINT_CONST uint kRayPixelYMask = 0x3FFFu;
@@ -74,6 +77,11 @@ GLINT_CONST uint kRayListGroupSize = 64u;
 GLINT_CONST uint kRayListDispatchOffset = 0u;
 GLINT_CONST uint kRayListCountOffset = 3u;
 GLINT_CONST uint kRayListArgsWords = 6u;
+// The SSLR list's args go on with the indirect dispatches of SSLR's two
+// colour-pyramid passes (glint/sslr_shared.h): words 6-8 and 9-11, each
+// {groups x, groups y, z}, z = 0 unless a listed ray cone-traces (then 1).
+GLINT_CONST uint kSslrArgsPyramidOffset = 6u;
+GLINT_CONST uint kSslrArgsWords = 12u;
 
 // The hit distance that stands for "at infinity" (a miss, the sky, the
 // environment): finite so that half floats hold it (their largest finite
@@ -90,12 +98,17 @@ struct RayGenerationConstants {
     float reuseRoughness;
     float rtMaxDistance;
     float sslrMinDistance;
-    uint reuseEnabled;
-    uint mode;              // kMode*
-    uint tileModesEnabled;  // 1: hybrid pixels follow the feedback's tile modes
+    uint flags;             // kRayGen*: the mode and what is enabled
+    float coneRoughness;    // SSLR pixels at least this rough cone-trace (kRayCone)
     float rtToHybridShare;  // share of an RT tile's hybrid pixels kept hybrid
     uint tilesX;
+    uint pad0;
 };
+
+// RayGenerationConstants::flags: the mode (kMode*) in the low two bits.
+GLINT_CONST uint kRayGenModeMask = 3u;
+GLINT_CONST uint kRayGenReuse = 1u << 2u;      // rough quads share one ray
+GLINT_CONST uint kRayGenTileModes = 1u << 3u;  // hybrid pixels follow the feedback's tile modes
 
 GLINT_END
 

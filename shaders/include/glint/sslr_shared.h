@@ -2,17 +2,24 @@
 // constants and push constants shared by GLSL and C++. Buffers use scalar
 // layout.
 //
-// Outputs, per pixel p = y * width + x (only ray leaders of SSLR and hybrid
-// pixels are traced; every other pixel keeps the cleared zero):
+// Outputs, per pixel p = y * width + x, written at the ray leaders of the
+// SSLR and hybrid pixels only (the SSLR list's entries): other pixels hold
+// whatever the memory held, unless SslrSettings::clearUntraced zeroes them
+// first (for debug views). Readers look at a pixel's leader, and only for
+// SSLR and hybrid pixels:
 //   radiance    lit colour at the hit, rgb; a = 1 where a hit was found
 //   confidence  [0, 1]: 0 for misses (off screen, sky, too thick, back face)
 //   hitDebug    xy = hit uv, z = confidence, w = 1 on a hit
-// RT hand-off: each hybrid ray whose confidence is below the threshold is
-// appended to ray generation's RT ray list (glint/ray_generation_shared.h,
-// kRayList*), after the RT pixels' rays.
+// RT hand-off: each hybrid ray whose confidence is not at least the
+// threshold (NaN included) is appended to ray generation's RT ray list
+// (glint/ray_generation_shared.h, kRayList*), after the RT pixels' rays.
+// The threshold is one the confidence image holds exactly
+// (passes::sslrStoredThreshold), so a reader that finds the stored
+// confidence below it knows the ray was handed on and its RT result exists.
 #ifndef GLINT_SSLR_SHARED_H
 #define GLINT_SSLR_SHARED_H
 
+#include "glint/packing.h"
 #include "glint/shared.h"
 
 GLINT_BEGIN
@@ -32,26 +39,53 @@ struct SslrConstants {
     float thickness;
     float maxDistance;
     float edgeFade;
-    float confidenceThreshold;
-    float coneRoughness;  // perceptual roughness from which the cone trace runs
-    uint pyramidMips;     // levels of the colour pyramid; 0: no cone trace
+    float confidenceThreshold;  // as stored (passes::sslrStoredThreshold)
+    uint pyramidMips;           // levels of the colour pyramid; 0: no cone trace
     uint pad0;
-};
-
-// Push constants of pyramid_down.comp.
-struct SslrPyramidConstants {
-    uvec2 sourceSize;
-    uvec2 targetSize;
+    uint pad1;
 };
 
 // The pyramid stops at 2^(kSslrPyramidMaxMips - 1) pixels per texel: wider
 // footprints belong to pixels rougher than the cutoff, which trace nothing.
 GLINT_CONST uint kSslrPyramidMaxMips = 8u;
 
+// The colour pyramid is built by two passes of pyramid.glsl, each a 16 x 16
+// workgroup per 32 x 32 texels of its source level that writes the five
+// levels below it (2x2 means, reduced in shared memory): the first reads
+// the lit colour and also writes it as level 0 (levels 0-5), the second
+// reads level 5 (levels 6 and 7). Both are dispatched indirectly from the
+// SSLR list's args (glint/ray_generation_shared.h, kSslrArgsPyramidOffset),
+// whose z is 0, so no group runs, unless ray generation listed a ray that
+// cone-traces.
+GLINT_CONST uint kSslrPyramidGroupTexels = 32u;
+GLINT_CONST uint kSslrPyramidLevelsPerPass = 5u;
+GLINT_CONST uint kSslrPyramidOutputs = 6u;  // the first pass's level 0 and five reductions
+
+// Push constants of pyramid_base.comp and pyramid_down.comp (64 bytes).
+struct SslrPyramidConstants {
+    uvec2 sourceSize;    // texels of the level read
+    uvec2 outputSize[6];  // texels of each written level, in binding order
+    uint outputs;         // levels written (the rest of the bindings are stand-ins)
+    uint pad0;
+};
+
+// Texels of a level of a `size` image (Vulkan's mip chain).
+GLINT_FUNC uvec2 sslrMipSize(uvec2 size, uint level) {
+    return uvec2(max(size.x >> level, 1u), max(size.y >> level, 1u));
+}
+
+// Workgroups of pyramid pass `pass` (0: from the lit colour, 1: from level 5).
+GLINT_FUNC uvec2 sslrPyramidGroups(uvec2 size, uint pass) {
+    const uvec2 source = sslrMipSize(size, pass * kSslrPyramidLevelsPerPass);
+    return uvec2((source.x + kSslrPyramidGroupTexels - 1u) / kSslrPyramidGroupTexels,
+                 (source.y + kSslrPyramidGroupTexels - 1u) / kSslrPyramidGroupTexels);
+}
+
 GLINT_END
 
 #ifdef __cplusplus
 static_assert(sizeof(glint::shader::SslrConstants) == 128);
+static_assert(sizeof(glint::shader::SslrPyramidConstants) == 64);
 #endif
 
 #endif
