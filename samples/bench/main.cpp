@@ -12,7 +12,9 @@
 // because a test configuration's last frame is what is compared and the
 // reference's camera stands still.
 
+#include "bench/measure.h"
 #include "bench/report.h"
+#include "bench/scale.h"
 #include "common/app.h"
 #include "common/reflection_run.h"
 #include "metrics/error_map.h"
@@ -44,6 +46,7 @@ constexpr const char* kUsage =
     "                   [--out-dir DIR] [--csv FILE] [--json FILE] [--plot FILE.png]\n"
     "                   [--time SECONDS] [--ppd N] [--backend auto|query|pipeline]\n"
     "                   [--reference-max-frames N] [--warmup-frames N] [--jitter] [--validate]\n"
+    "                   [--scale N1,N2,...]\n"
     "  Renders the converged reference at the pose of the runs' last frame, then each of --modes with\n"
     "  defaults and the parameter sweeps (in the --sweep-modes where the parameter means something),\n"
     "  N frames (default 16) each, and compares each run's last frame with the reference.\n"
@@ -51,7 +54,10 @@ constexpr const char* kUsage =
     "  a GPU, 0 on a CPU device): untimed frames of each configuration before its measured run.\n"
     "  --csv/--json/--plot default to DIR/<scene>_bench.{csv,json,png}; DIR (default build/bench) also\n"
     "  gets the reference, each mode's default image, its FLIP map, and both reflection terms\n"
-    "  (*_reflections.png, tonemapped as the \"resolved\" debug view).";
+    "  (*_reflections.png, tonemapped as the \"resolved\" debug view).\n"
+    "  --scale: cost against scene size instead: the city (--scene city:triangles=T,seed=S sets its other\n"
+    "  options) at each number of buildings, each with its own reference, every mode with its defaults;\n"
+    "  writes DIR/city_scale.{csv,json,png} (reflection_ms against instanced triangles, log axis).";
 
 // One parameter sweep. Values equal to the default are skipped (the mode's
 // default row has them). `modes` are those where the parameter changes the
@@ -118,73 +124,6 @@ std::string utcNow() {
     return buffer;
 }
 
-// Khronos PBR Neutral, as shaders/composite/tonemap.glsl (the "resolved"
-// debug view's operator): LDR-FLIP, PSNR and SSIM need display values in
-// [0, 1], and these are the ones the debug view shows.
-glm::vec3 tonemapNeutral(glm::vec3 c) {
-    c = glm::max(c, glm::vec3(0.0f));
-    const float startCompression = 0.8f - 0.04f;
-    const float desaturation = 0.15f;
-    const float x = std::min(c.r, std::min(c.g, c.b));
-    const float offset = x < 0.08f ? x - 6.25f * x * x : 0.04f;
-    c -= offset;
-    const float peak = std::max(c.r, std::max(c.g, c.b));
-    if (peak >= startCompression) {
-        const float d = 1.0f - startCompression;
-        const float newPeak = 1.0f - d * d / (peak + d - startCompression);
-        c *= newPeak / peak;
-        const float g = 1.0f - 1.0f / (desaturation * (peak - newPeak) + 1.0f);
-        c = glm::mix(c, glm::vec3(newPeak), g);
-    }
-    return glm::clamp(c, glm::vec3(0.0f), glm::vec3(1.0f));
-}
-
-// The resolved reflection term (RGBA floats) as two images: the linear
-// radiance for relMSE (made for HDR radiance) and its tonemapped display
-// values for FLIP, PSNR and SSIM. Pixels without a reflection are black.
-struct ReflectionTerm {
-    metrics::Image radiance;
-    metrics::Image display;
-};
-
-ReflectionTerm reflectionTerm(const std::vector<float>& rgba, uint32_t width, uint32_t height, float exposure,
-                              const std::string& name) {
-    ReflectionTerm t;
-    t.radiance = {width, height, {}, name + " (reflection radiance)"};
-    t.display = {width, height, {}, name + " (reflection, tonemapped)"};
-    t.radiance.linear.resize(size_t(width) * height);
-    t.display.linear.resize(size_t(width) * height);
-    for (size_t p = 0; p < t.radiance.linear.size(); ++p) {
-        glm::vec3 c(rgba[p * 4], rgba[p * 4 + 1], rgba[p * 4 + 2]);
-        if (!(rgba[p * 4 + 3] > 0.0f) || !std::isfinite(c.r + c.g + c.b)) c = glm::vec3(0.0f);
-        t.radiance.linear[p] = c;
-        t.display.linear[p] = tonemapNeutral(c * exposure);
-    }
-    return t;
-}
-
-// A display image (linear, [0, 1]) as the RGBA8 sRGB that writePng takes.
-std::vector<uint8_t> toSrgb8(const metrics::Image& image) {
-    std::vector<uint8_t> rgba(image.linear.size() * 4, 255);
-    for (size_t p = 0; p < image.linear.size(); ++p) {
-        for (int c = 0; c < 3; ++c) {
-            rgba[p * 4 + c] = uint8_t(std::lround(metrics::linearToSrgb(image.linear[p][c]) * 255.0f));
-        }
-    }
-    return rgba;
-}
-
-bench::ErrorMetrics measure(const metrics::Image& reference, const metrics::Image& test, double ppd,
-                            const metrics::Image* referenceRadiance = nullptr,
-                            const metrics::Image* testRadiance = nullptr) {
-    bench::ErrorMetrics m;
-    m.flipMean = metrics::flip(reference, test, ppd).stats.mean;
-    m.relMse = referenceRadiance ? metrics::relMse(*referenceRadiance, *testRadiance) : metrics::relMse(reference, test);
-    m.psnr = metrics::psnr(reference, test);
-    m.ssim = metrics::ssim(reference, test);
-    return m;
-}
-
 struct Configuration {
     passes::ReflectionMode mode;
     std::string param;  // bench::kDefaultParam or a parameter name
@@ -197,7 +136,7 @@ int main(int argc, char** argv) {
     return app::runMain("glint-bench", [&] {
         const app::Args args(argc, argv, kUsage,
                              {"scene", "frames", "size", "modes", "sweep-modes", "out-dir", "csv", "json", "plot",
-                              "time", "ppd", "backend", "reference-max-frames", "warmup-frames"},
+                              "time", "ppd", "backend", "reference-max-frames", "warmup-frames", "scale"},
                              {"quick", "jitter"});
         const std::string sceneName = args.get("scene", "plaza");
         const uint32_t frames = args.getUint("frames", 16);
@@ -208,17 +147,18 @@ int main(int argc, char** argv) {
         const std::vector<passes::ReflectionMode> sweepModes = parseModes("sweep-modes", args.get("sweep-modes", "hybrid"));
         const double ppd = args.has("ppd") ? parsePositive("ppd", args.get("ppd", ""), false) : metrics::kDefaultPpd;
         const std::filesystem::path outDir = args.get("out-dir", "build/bench");
-        const std::string stem = std::filesystem::path(sceneName).stem().string();
-        const std::filesystem::path csvPath = args.get("csv", (outDir / (stem + "_bench.csv")).string());
-        const std::filesystem::path jsonPath = args.get("json", (outDir / (stem + "_bench.json")).string());
-        const std::filesystem::path plotPath = args.get("plot", (outDir / (stem + "_bench.png")).string());
+        const bool scaleRun = args.has("scale");
+        const std::string stem =
+            scaleRun ? std::string("city") : std::filesystem::path(sceneName).stem().string();
+        const std::string suffix = scaleRun ? "_scale" : "_bench";
+        const std::filesystem::path csvPath = args.get("csv", (outDir / (stem + suffix + ".csv")).string());
+        const std::filesystem::path jsonPath = args.get("json", (outDir / (stem + suffix + ".json")).string());
+        const std::filesystem::path plotPath = args.get("plot", (outDir / (stem + suffix + ".png")).string());
 
         gpu::Context ctx(args.contextOptions());
         const bool cpuDevice = ctx.caps().deviceType == VK_PHYSICAL_DEVICE_TYPE_CPU;
         const auto [width, height] =
             app::parseSize(args.get("size", cpuDevice ? "256x256" : "1920x1080"));
-        scene::Scene scene = scene::loadScene(sceneName);
-
         app::ReflectionRunOptions base;
         base.width = width;
         base.height = height;
@@ -231,7 +171,8 @@ int main(int argc, char** argv) {
         // --jitter measures with it.
         base.jitter = args.has("jitter");
         // As glint-render: 3 s along the plaza's path looks down the plaza past the puddles.
-        base.startSeconds = float(parsePositive("time", args.get("time", sceneName == "plaza" ? "3" : "0"), true));
+        base.startSeconds =
+            float(parsePositive("time", args.get("time", sceneName == "plaza" && !scaleRun ? "3" : "0"), true));
         try {
             base.renderer.backend = passes::parseBackend(args.get("backend", "auto"));
         } catch (const std::invalid_argument& e) {
@@ -241,6 +182,64 @@ int main(int argc, char** argv) {
         // A CPU device has no GPU clocks to raise (and a warm-up would double
         // its long runs); a GPU gets about a second of load at 1080p.
         const uint32_t warmupFrames = args.getUint("warmup-frames", cpuDevice ? 0 : 60);
+        bench::RunInfo info;
+        info.device = ctx.caps().deviceName;
+        info.deviceType = gpu::deviceTypeName(ctx.caps().deviceType);
+        info.driver = ctx.caps().driverName + " " + ctx.caps().driverInfo;
+        info.date = utcNow();
+        info.commit = gitCommit();
+        info.scene = stem;
+        info.width = width;
+        info.height = height;
+        info.frames = frames;
+        info.startSeconds = base.startSeconds;
+        info.jitter = base.jitter;
+        info.warmupFrames = warmupFrames;
+        info.ppd = ppd;
+        info.relMseEpsilon = metrics::kRelMseEpsilon;
+        // GPU timestamps on lavapipe miss compute dispatches: there each pass
+        // is submitted alone and timed on the host (rg::PassTimer::HostSerial).
+        info.timeAxis = "reflection_ms";
+        info.passTimer = cpuDevice ? "host_serial" : "gpu_timestamps";
+        info.referenceTolerance = app::ReferenceOptions{}.tolerance;
+        std::optional<uint32_t> referenceMaxFrames;
+        if (args.has("reference-max-frames")) referenceMaxFrames = args.getUint("reference-max-frames", 0);
+
+        if (scaleRun) {
+            // The city at each size, every mode with its defaults (--scene
+            // city:triangles=T,seed=S sets the rest of the city).
+            bench::ScaleSettings scale;
+            scale.instances = bench::parseScale(args.get("scale", ""));
+            if (sceneName.substr(0, 4) == "city") scale.city = scene::parseCityOptions(sceneName);
+            scale.base = base;
+            scale.modes = modes;
+            scale.warmupFrames = warmupFrames;
+            scale.ppd = ppd;
+            scale.referenceMaxFrames = referenceMaxFrames;
+            spdlog::info("scale: the city at {} sizes, {}x{}, {} frames from {} s, on {} ({})", scale.instances.size(),
+                         width, height, frames, base.startSeconds, info.device, info.deviceType);
+            const std::vector<bench::ScaleRow> rows = bench::runScale(ctx, scale);
+            bench::writeText(csvPath, bench::toScaleCsv(rows));
+            std::fputs(bench::toScaleCsv(rows).c_str(), stdout);
+            std::fflush(stdout);
+            spdlog::info("wrote {}", csvPath.string());
+            bench::writeText(jsonPath, bench::toScaleJson(info, rows));
+            spdlog::info("wrote {}", jsonPath.string());
+            bench::PlotOptions plot;
+            plot.title = "city " + std::to_string(width) + "x" + std::to_string(height) + ", " + info.device + ", " +
+                         info.date.substr(0, 10);
+            plot.xLabel = "instanced triangles";
+            plot.yLabel = cpuDevice ? "reflection_ms (host time of the reflection passes, each submitted alone)"
+                                    : "reflection_ms (GPU time of the reflection passes, median)";
+            plot.logX = true;
+            plot.seriesLines = true;
+            plot.paretoFront = false;
+            bench::writePlot(plotPath, bench::scalePlotPoints(rows), plot);
+            spdlog::info("wrote {}", plotPath.string());
+            ctx.waitIdle();
+            return app::validationClean(ctx) ? 0 : 2;
+        }
+        scene::Scene scene = scene::loadScene(sceneName);
 
         // Every configuration, so progress can say "k of n".
         std::vector<Configuration> configurations;
@@ -264,42 +263,15 @@ int main(int argc, char** argv) {
             return std::chrono::duration<double>(std::chrono::steady_clock::now() - benchStart).count();
         };
 
-        // 1. The reference at the last measured frame's pose and scene time:
-        // a still camera path that holds that pose (CameraPath::evaluate
-        // returns the first key exactly at or before its time), restored after.
-        const float lastSeconds = base.startSeconds + float(frames - 1) * base.frameSeconds;
-        const scene::CameraPose lastPose = app::cameraPoseAt(scene, base, frames - 1);
-        app::ReflectionRunOptions referenceOptions = base;
-        referenceOptions.reference.enabled = true;
-        referenceOptions.startSeconds = lastSeconds;
-        if (args.has("reference-max-frames")) {
-            const uint32_t maxFrames = args.getUint("reference-max-frames", 0);
-            if (maxFrames == 0 || maxFrames > 2048) {
-                throw std::runtime_error("--reference-max-frames: expected 1..2048");
-            }
-            referenceOptions.reference.maxFrames = maxFrames;
-            referenceOptions.reference.minFrames = std::min(referenceOptions.reference.minFrames, maxFrames);
-            referenceOptions.reference.checkEvery = std::min(referenceOptions.reference.checkEvery, maxFrames);
-        }
-        const scene::CameraPath path = scene.cameraPath;
-        scene.cameraPath.keys = {{lastSeconds, lastPose.position, lastPose.target},
-                                 {lastSeconds + 1.0f, lastPose.position, lastPose.target}};
-        spdlog::info("reference: {}x{} at the pose of frame {} ({:.3f} s)", width, height, frames - 1, lastSeconds);
-        app::ReflectionRunResult reference;
-        try {
-            reference = app::runReflections(ctx, scene, referenceOptions);
-        } catch (...) {
-            scene.cameraPath = path;
-            throw;
-        }
-        scene.cameraPath = path;
-        const metrics::Image referenceImage = metrics::imageFromSrgb8(width, height, reference.rgba, 4, "reference");
-        const ReflectionTerm referenceTerm = reflectionTerm(reference.resolved, width, height, exposure, "reference");
-        app::writePng((outDir / (stem + "_reference.png")).string(), width, height, reference.rgba);
+        // 1. The reference at the last measured frame's pose and scene time.
+        const bench::Reference reference = bench::renderReference(ctx, scene, base, referenceMaxFrames);
+        const metrics::Image& referenceImage = reference.image;
+        const bench::ReflectionTerm& referenceTerm = reference.term;
+        app::writePng((outDir / (stem + "_reference.png")).string(), width, height, reference.result.rgba);
         app::writePng((outDir / (stem + "_reference_reflections.png")).string(), width, height,
-                      toSrgb8(referenceTerm.display));
-        spdlog::info("reference: {} frames ({}) in {:.1f} s", reference.framesRun,
-                     reference.converged ? "converged" : "frame limit", elapsed());
+                      bench::toSrgb8(referenceTerm.display));
+        spdlog::info("reference: {} frames ({}) in {:.1f} s", reference.result.framesRun,
+                     reference.result.converged ? "converged" : "frame limit", elapsed());
 
         // 2. Every configuration over the same path.
         std::vector<bench::Row> rows;
@@ -313,21 +285,9 @@ int main(int argc, char** argv) {
             const std::string what =
                 baseline ? modeName + " defaults" : modeName + " " + c.param + "=" + bench::formatValue(c.value);
 
-            if (warmupFrames > 0) {
-                // Untimed frames of the same configuration right before the
-                // measured ones: while the metrics run on the CPU the GPU
-                // idles and drops its clocks, and 16 frames are too few to
-                // raise them again (H200, 1080p: the same configuration read
-                // 0.8 or 3.4 ms of reflections from one run to the next).
-                app::ReflectionRunOptions warmup = options;
-                warmup.frames = warmupFrames;
-                warmup.readResolved = false;
-                warmup.timeEveryFrame = false;
-                app::runReflections(ctx, scene, warmup);
-            }
-            const app::ReflectionRunResult result = app::runReflections(ctx, scene, options);
+            const app::ReflectionRunResult result = bench::runMeasured(ctx, scene, options, warmupFrames);
             const metrics::Image image = metrics::imageFromSrgb8(width, height, result.rgba, 4, what);
-            const ReflectionTerm term = reflectionTerm(result.resolved, width, height, exposure, what);
+            const bench::ReflectionTerm term = bench::reflectionTerm(result.resolved, width, height, exposure, what);
 
             bench::Row row;
             row.scene = stem;
@@ -341,14 +301,14 @@ int main(int argc, char** argv) {
             row.frameWallMs = result.frameWallMs;
             row.sslrRays = result.sslrRays;
             row.rtRays = result.rtRays;
-            row.image = measure(referenceImage, image, ppd);
+            row.image = bench::measure(referenceImage, image, ppd);
             row.reflection =
-                measure(referenceTerm.display, term.display, ppd, &referenceTerm.radiance, &term.radiance);
+                bench::measure(referenceTerm.display, term.display, ppd, &referenceTerm.radiance, &term.radiance);
             rows.push_back(row);
             if (baseline) {
                 app::writePng((outDir / (stem + "_" + modeName + ".png")).string(), width, height, result.rgba);
                 app::writePng((outDir / (stem + "_" + modeName + "_reflections.png")).string(), width, height,
-                              toSrgb8(term.display));
+                              bench::toSrgb8(term.display));
                 const metrics::FlipResult f = metrics::flip(referenceImage, image, ppd);
                 metrics::writeErrorMap(outDir / (stem + "_" + modeName + "_flip.png"), f.errorMap, width, height);
             }
@@ -363,29 +323,9 @@ int main(int argc, char** argv) {
         std::fputs(bench::toTable(rows).c_str(), stdout);
         std::fflush(stdout);
 
-        bench::RunInfo info;
-        info.device = ctx.caps().deviceName;
-        info.deviceType = gpu::deviceTypeName(ctx.caps().deviceType);
-        info.driver = ctx.caps().driverName + " " + ctx.caps().driverInfo;
-        info.date = utcNow();
-        info.commit = gitCommit();
-        info.scene = stem;
-        info.width = width;
-        info.height = height;
-        info.frames = frames;
-        info.startSeconds = base.startSeconds;
-        info.jitter = base.jitter;
-        info.warmupFrames = warmupFrames;
-        info.ppd = ppd;
-        info.relMseEpsilon = metrics::kRelMseEpsilon;
-        // GPU timestamps on lavapipe miss compute dispatches: there each pass
-        // is submitted alone and timed on the host (rg::PassTimer::HostSerial).
-        info.timeAxis = "reflection_ms";
-        info.passTimer = cpuDevice ? "host_serial" : "gpu_timestamps";
-        info.referenceFrames = reference.framesRun;
-        info.referenceConverged = reference.converged;
-        info.referenceLastChange = reference.lastChange;
-        info.referenceTolerance = referenceOptions.reference.tolerance;
+        info.referenceFrames = reference.result.framesRun;
+        info.referenceConverged = reference.result.converged;
+        info.referenceLastChange = reference.result.lastChange;
 
         bench::writeText(csvPath, bench::toCsv(rows));
         spdlog::info("wrote {}", csvPath.string());

@@ -180,6 +180,64 @@ std::vector<size_t> paretoFront(std::span<const Point> points) {
 
 // ---- Plot ------------------------------------------------------------------
 
+std::string toScaleCsv(std::span<const ScaleRow> rows) {
+    std::string out(kScaleCsvHeader);
+    out += '\n';
+    for (const ScaleRow& r : rows) {
+        std::string scene = r.scene;
+        std::replace(scene.begin(), scene.end(), ',', '_');
+        out += scene + ',' + r.mode + ',' + std::to_string(r.instances) + ',' + std::to_string(r.triangles) + ',' +
+               std::to_string(r.width) + ',' + std::to_string(r.height) + ',' + number(r.reflectionMs) + ',' +
+               number(r.reflectionSpanMs) + ',' + number(r.totalMs) + ',' + std::to_string(r.rtRays) + ',' +
+               std::to_string(r.sslrRays) + ',' + number(r.flipMean) + '\n';
+    }
+    return out;
+}
+
+std::string toScaleJson(const RunInfo& info, std::span<const ScaleRow> rows) {
+    Json j = Json::parse(toJson(info, {}));
+    j.erase("rows");
+    j.erase("scene");
+    Json list = Json::array();
+    for (const ScaleRow& r : rows) {
+        Json passes = Json::object();
+        for (const auto& [name, ms] : r.passes) passes[name] = ms;
+        const auto optional = [](const std::optional<double>& v) { return v ? Json(*v) : Json(nullptr); };
+        list.push_back({{"scene", r.scene},
+                        {"mode", r.mode},
+                        {"instances", r.instances},
+                        {"triangles", r.triangles},
+                        {"width", r.width},
+                        {"height", r.height},
+                        {"reflection_ms", optional(r.reflectionMs)},
+                        {"reflection_span_ms", optional(r.reflectionSpanMs)},
+                        {"total_ms", optional(r.totalMs)},
+                        {"rt_rays", r.rtRays},
+                        {"sslr_rays", r.sslrRays},
+                        {"flip_mean", std::isfinite(r.flipMean) ? Json(r.flipMean) : Json(nullptr)},
+                        {"passes", passes},
+                        {"draws", r.draws},
+                        {"triangles_drawn", r.trianglesDrawn},
+                        {"tlas_instances", r.tlasInstances},
+                        {"reference_frames", r.referenceFrames}});
+    }
+    j["rows"] = list;
+    return j.dump(2) + "\n";
+}
+
+std::vector<PlotPoint> scalePlotPoints(std::span<const ScaleRow> rows) {
+    std::vector<PlotPoint> points;
+    for (const ScaleRow& r : rows) {
+        if (!r.reflectionMs || r.triangles == 0) continue;
+        PlotPoint p;
+        p.at = {double(r.triangles), *r.reflectionMs};
+        p.series = r.mode;
+        p.label = r.mode;
+        points.push_back(p);
+    }
+    return points;
+}
+
 std::vector<PlotPoint> plotPoints(std::span<const Row> rows, bool wallTime) {
     std::vector<PlotPoint> points;
     for (const Row& r : rows) {
@@ -304,6 +362,19 @@ std::pair<double, double> axisRange(double lo, double hi) {
     return {a, b};
 }
 
+// A power of ten as the axis shows it: 1k, 10k, 1M, ...
+std::string decadeText(double v) {
+    const char* suffixes[] = {"", "k", "M", "G", "T"};
+    int k = 0;
+    while (v >= 1000.0 && k < 4) {
+        v /= 1000.0;
+        ++k;
+    }
+    char buffer[32];
+    std::snprintf(buffer, sizeof buffer, "%g%s", v, suffixes[k]);
+    return buffer;
+}
+
 std::string tickText(double v, double step) {
     const int decimals = step > 0.0 ? std::clamp(int(-std::floor(std::log10(step) + 1e-9)), 0, 6) : 3;
     char buffer[32];
@@ -331,8 +402,10 @@ std::vector<uint8_t> renderPlot(std::span<const PlotPoint> points, const PlotOpt
 
     // Legend entries, for the right margin's width.
     std::vector<std::string> legend = series;
-    legend.push_back("Pareto front");
-    legend.push_back("mode defaults");
+    if (options.paretoFront) {
+        legend.push_back("Pareto front");
+        legend.push_back("mode defaults");
+    }
     int legendWidth = 0;
     for (const std::string& s : legend) legendWidth = std::max(legendWidth, Canvas::textWidth(s, scale));
     legendWidth += 30 * scale;
@@ -343,21 +416,36 @@ std::vector<uint8_t> renderPlot(std::span<const PlotPoint> points, const PlotOpt
     const int bottom = h - std::min(h / 4, 3 * lineHeight + 4);
     const int plotW = std::max(right - left, 1), plotH = std::max(bottom - top, 1);
 
+    // x in plot space: its logarithm on a log axis, where x <= 0 has no place.
+    const auto tx = [&](double x) {
+        return options.logX ? (x > 0.0 ? std::log10(x) : std::numeric_limits<double>::quiet_NaN()) : x;
+    };
     double xmin = std::numeric_limits<double>::infinity(), xmax = -xmin, ymin = xmin, ymax = -xmin;
     for (const PlotPoint& p : points) {
-        if (!std::isfinite(p.at.x) || !std::isfinite(p.at.y)) continue;
-        xmin = std::min(xmin, p.at.x);
-        xmax = std::max(xmax, p.at.x);
+        if (!std::isfinite(tx(p.at.x)) || !std::isfinite(p.at.y)) continue;
+        xmin = std::min(xmin, tx(p.at.x));
+        xmax = std::max(xmax, tx(p.at.x));
         ymin = std::min(ymin, p.at.y);
         ymax = std::max(ymax, p.at.y);
     }
-    const auto [x0, x1] = axisRange(xmin, xmax);
+    auto [x0, x1] = axisRange(xmin, xmax);
+    if (options.logX && std::isfinite(xmin)) {
+        // The log axis may go below zero (x < 1): no clamp there.
+        const double pad = std::max((xmax - xmin) * 0.08, 0.1);
+        x0 = xmin - pad;
+        x1 = xmax + pad;
+    }
     const auto [y0, y1] = axisRange(ymin, ymax);
-    const auto px = [&](double x) { return left + (x - x0) / (x1 - x0) * plotW; };
+    const auto px = [&](double x) { return left + (tx(x) - x0) / (x1 - x0) * plotW; };
     const auto py = [&](double y) { return bottom - (y - y0) / (y1 - y0) * plotH; };
 
-    // Grid and tick labels.
-    const std::vector<double> xt = niceTicks(x0, x1, std::max(2, plotW / (60 * scale)));
+    // Grid and tick labels (a log axis: at the powers of ten inside it).
+    std::vector<double> xt;
+    if (options.logX) {
+        for (double d = std::ceil(x0); d <= x1; d += 1.0) xt.push_back(std::pow(10.0, d));
+    } else {
+        xt = niceTicks(x0, x1, std::max(2, plotW / (60 * scale)));
+    }
     const std::vector<double> yt = niceTicks(y0, y1, std::max(2, plotH / (40 * scale)));
     const double xStep = xt.size() > 1 ? xt[1] - xt[0] : 0.0;
     const double yStep = yt.size() > 1 ? yt[1] - yt[0] : 0.0;
@@ -365,7 +453,7 @@ std::vector<uint8_t> renderPlot(std::span<const PlotPoint> points, const PlotOpt
         const int x = int(std::lround(px(t)));
         canvas.fillRect(x, top, x + 1, bottom, kGrid);
         canvas.fillRect(x, bottom, x + 1, bottom + 3 * scale, kBlack);
-        const std::string s = tickText(t, xStep);
+        const std::string s = options.logX ? decadeText(t) : tickText(t, xStep);
         canvas.text(x - Canvas::textWidth(s, scale) / 2, bottom + 5 * scale, s, scale, kBlack);
     }
     for (const double t : yt) {
@@ -385,17 +473,30 @@ std::vector<uint8_t> renderPlot(std::span<const PlotPoint> points, const PlotOpt
     canvas.text(left + (plotW - Canvas::textWidth(options.xLabel, scale)) / 2, bottom + 5 * scale + lineHeight + 4,
                 options.xLabel, scale, kBlack);
 
-    // The Pareto front, under the points.
+    // Each series as a line, or the Pareto front, under the points.
+    if (options.seriesLines) {
+        for (const std::string& name : series) {
+            std::vector<Point> line;
+            for (const PlotPoint& p : points) {
+                if (p.series == name && std::isfinite(tx(p.at.x)) && std::isfinite(p.at.y)) line.push_back(p.at);
+            }
+            std::sort(line.begin(), line.end(), [](const Point& a, const Point& b) { return a.x < b.x; });
+            for (size_t i = 1; i < line.size(); ++i) {
+                canvas.line(px(line[i - 1].x), py(line[i - 1].y), px(line[i].x), py(line[i].y), 1.5 * scale,
+                            colors[name]);
+            }
+        }
+    }
     std::vector<Point> at;
     for (const PlotPoint& p : points) at.push_back(p.at);
-    const std::vector<size_t> front = paretoFront(at);
+    const std::vector<size_t> front = options.paretoFront ? paretoFront(at) : std::vector<size_t>{};
     for (size_t i = 1; i < front.size(); ++i) {
         canvas.line(px(at[front[i - 1]].x), py(at[front[i - 1]].y), px(at[front[i]].x), py(at[front[i]].y),
                     1.5 * scale, kFront);
     }
     const double r = 3.0 * scale;
     for (const PlotPoint& p : points) {
-        if (!std::isfinite(p.at.x) || !std::isfinite(p.at.y)) continue;
+        if (!std::isfinite(tx(p.at.x)) || !std::isfinite(p.at.y)) continue;
         const double radius = p.baseline ? r * 1.6 : r;
         if (p.baseline) canvas.disc(px(p.at.x), py(p.at.y), radius + 1.5, kBlack);
         canvas.disc(px(p.at.x), py(p.at.y), radius, colors[p.series]);
@@ -435,6 +536,7 @@ std::vector<uint8_t> renderPlot(std::span<const PlotPoint> points, const PlotOpt
         canvas.text(lx + 20 * scale, ly, s, scale, kBlack);
         ly += lineHeight + 4 * scale;
     }
+    if (!options.paretoFront) return canvas.take();
     canvas.line(lx, ly + 3.5 * scale, lx + 16 * scale, ly + 3.5 * scale, 1.5 * scale, kFront);
     canvas.text(lx + 20 * scale, ly, "Pareto front", scale, kBlack);
     ly += lineHeight + 4 * scale;

@@ -10,6 +10,7 @@
 #include <span>
 #include <string>
 #include <string_view>
+#include <utility>
 #include <vector>
 
 namespace glint::bench {
@@ -119,6 +120,12 @@ struct PlotOptions {
     std::string title;
     std::string xLabel;
     std::string yLabel;
+    // A logarithmic x axis (ticks at powers of ten; x must be positive).
+    bool logX = false;
+    // Each series' points joined in increasing x (a quantity against size).
+    bool seriesLines = false;
+    // The Pareto front of time against error, marked and labelled.
+    bool paretoFront = true;
 };
 
 // Rows as plot points: x is frame_wall_ms when `wallTime`, else
@@ -134,6 +141,42 @@ std::vector<uint8_t> renderPlot(std::span<const PlotPoint> points, const PlotOpt
 // renderPlot written as a PNG; creates the folder, throws
 // std::runtime_error naming the file on failure.
 void writePlot(const std::filesystem::path& path, std::span<const PlotPoint> points, const PlotOptions& options);
+
+// ---- Cost against scene size (glint-bench --scale) --------------------------
+
+// The CSV header of the scale run, column for column.
+inline constexpr std::string_view kScaleCsvHeader =
+    "scene,mode,instances,triangles,width,height,reflection_ms,reflection_span_ms,total_ms,rt_rays,sslr_rays,"
+    "flip_mean";
+
+// One mode at one size of the city.
+struct ScaleRow {
+    std::string scene;
+    std::string mode;
+    uint32_t instances = 0;   // buildings (scene::CityOptions::instances)
+    uint64_t triangles = 0;   // instanced triangles drawn at LOD 0 (scene::instancedTriangleCount)
+    uint32_t width = 0;
+    uint32_t height = 0;
+    std::optional<double> reflectionMs;      // median sum of the reflection passes' times
+    std::optional<double> reflectionSpanMs;  // median of the chain timed as one span
+    std::optional<double> totalMs;
+    uint64_t rtRays = 0;
+    uint64_t sslrRays = 0;
+    double flipMean = 0.0;  // the final image against this size's own reference
+    // JSON only: per-pass times (median, ms) and the raster work culling left.
+    std::vector<std::pair<std::string, double>> passes;
+    uint32_t draws = 0;
+    uint64_t trianglesDrawn = 0;
+    uint32_t tlasInstances = 0;
+    uint32_t referenceFrames = 0;
+};
+
+std::string toScaleCsv(std::span<const ScaleRow> rows);
+// {info..., "rows": [every CSV column, "passes": {name: ms}, draws, ...]}.
+std::string toScaleJson(const RunInfo& info, std::span<const ScaleRow> rows);
+
+// x = instanced triangles, y = reflection_ms, one series per mode.
+std::vector<PlotPoint> scalePlotPoints(std::span<const ScaleRow> rows);
 
 // Tick positions for an axis over [lo, hi]: multiples of 1, 2 or 5 x 10^k,
 // about `target` of them, all inside [lo, hi].

@@ -194,3 +194,48 @@ TEST_CASE("an empty plot still has axes") {
     const std::vector<uint8_t> rgba = renderPlot({}, options);
     CHECK(rgba.size() == 64u * 32u * 4u);
 }
+
+TEST_CASE("the scale CSV has its header and a row per size and mode; the plot puts sizes on a log axis") {
+    std::vector<ScaleRow> rows;
+    for (const uint32_t n : {16u, 256u, 4096u}) {
+        for (const char* mode : {"hybrid", "rt"}) {
+            ScaleRow r;
+            r.scene = "city";
+            r.mode = mode;
+            r.instances = n;
+            r.triangles = uint64_t(n) * 40000;
+            r.width = 1920;
+            r.height = 1080;
+            r.reflectionMs = std::string(mode) == "rt" ? 0.3 + 0.1 * std::log2(double(n)) : 0.4;
+            r.reflectionSpanMs = *r.reflectionMs * 0.9;
+            r.totalMs = 5.0;
+            r.rtRays = 1000;
+            r.sslrRays = 2000;
+            r.flipMean = 0.05;
+            r.passes = {{"gbuffer", 3.0}};
+            rows.push_back(r);
+        }
+    }
+    const std::vector<std::string> csv = lines(toScaleCsv(rows));
+    REQUIRE(csv.size() == rows.size() + 1);
+    CHECK(csv[0] == kScaleCsvHeader);
+    const std::vector<std::string> cells = split(csv[3], ',');
+    REQUIRE(cells.size() == split(std::string(kScaleCsvHeader), ',').size());
+    CHECK(cells[2] == "256");
+    CHECK(cells[3] == "10240000");
+    CHECK(std::stod(cells[7]) == doctest::Approx(0.36));
+
+    const std::vector<PlotPoint> points = scalePlotPoints(rows);
+    REQUIRE(points.size() == rows.size());
+    CHECK(points[0].at.x == 640000.0);
+    PlotOptions options;
+    options.logX = true;
+    options.seriesLines = true;
+    options.paretoFront = false;
+    const std::vector<uint8_t> rgba = renderPlot(points, options);
+    REQUIRE(rgba.size() == size_t(options.width) * options.height * 4);
+    // The hybrid line (purple) is drawn between its points.
+    size_t purple = 0;
+    for (size_t i = 0; i < rgba.size(); i += 4) purple += rgba[i] == 150 && rgba[i + 1] == 50 && rgba[i + 2] == 200;
+    CHECK(purple > 500u);
+}

@@ -1,0 +1,34 @@
+#pragma once
+// glint-bench --scale: the reflections' cost against scene size. The city
+// (scene::makeCity) at each instance count, each size with its own
+// converged reference, every mode with its defaults.
+
+#include "bench/report.h"
+#include "common/reflection_run.h"
+#include "gpu/context.h"
+#include "scene/builtin_scenes.h"
+
+#include <cstdint>
+#include <optional>
+#include <string_view>
+#include <vector>
+
+namespace glint::bench {
+
+struct ScaleSettings {
+    std::vector<uint32_t> instances;  // the sizes, as CityOptions::instances
+    scene::CityOptions city;          // triangles and seed; instances replaced per size
+    app::ReflectionRunOptions base;   // size, frames, start time, jitter, backend
+    std::vector<passes::ReflectionMode> modes;
+    uint32_t warmupFrames = 0;
+    double ppd = 0.0;
+    std::optional<uint32_t> referenceMaxFrames;
+};
+
+// "16,64,256": each in CityOptions' range, no repeats; throws naming --scale.
+std::vector<uint32_t> parseScale(std::string_view text);
+
+// One row per size and mode, in that order.
+std::vector<ScaleRow> runScale(gpu::Context& ctx, const ScaleSettings& settings);
+
+} // namespace glint::bench
