@@ -96,7 +96,8 @@ RayGenerationOutputs addRayGenerationPass(rg::Graph& graph, RayGenerationPipelin
     constants.rtMaxDistance = settings.rtMaxDistance;
     constants.sslrMinDistance = settings.sslrMinDistance;
     constants.flags = uint32_t(settings.mode) | (settings.reuse ? shader::kRayGenReuse : 0u) |
-                      (inputs.tileModes.valid() ? shader::kRayGenTileModes : 0u);
+                      (inputs.tileModes.valid() ? shader::kRayGenTileModes : 0u) |
+                      (settings.checkerboard ? shader::kRayGenCheckerboard : 0u);
     constants.coneRoughness = settings.coneRoughness;
     constants.rtToHybridShare = settings.rtToHybridShare;
     constants.tilesX = out.tilesX;

@@ -61,6 +61,13 @@ struct RayGenerationSettings {
     // differ by anyway; the bench sweeps it.
     float reuseRoughness = 0.1f;
     bool reuse = true;
+    // Half-rate rays on the smooth hybrid and RT pixels: on a checkerboard
+    // that swaps every frame, the pixels of the off squares share their
+    // row neighbour's ray (FidelityFX Hybrid Reflections' checkerboarded
+    // hybrid tiles); temporal accumulation sees each pixel's own ray every
+    // other frame. Off by default until the bench's plot shows it on the
+    // Pareto front.
+    bool checkerboard = false;
     // Pixels nearer than this (world units from the camera) go straight to
     // RT. Glint's starting value (the talk gives none): near reflections
     // are where SSLR most often leaves the screen. Measured on the plaza

@@ -71,7 +71,7 @@ struct Sweep {
     std::array<bool, 3> modes;  // passes::ReflectionMode order: hybrid, ssr, rt
 };
 
-const std::array<Sweep, 5> kSweeps = {{
+const std::array<Sweep, 7> kSweeps = {{
     // The talk's 0.9 (default) bracketed from "trust SSLR often" to "almost never".
     {"sslr_threshold", {0.5, 0.7, 0.8, 0.95, 0.99}, {0.7}, {true, false, false}},
     // FidelityFX's 0.22 (default): lower sends more pixels to the environment, higher traces more.
@@ -83,6 +83,10 @@ const std::array<Sweep, 5> kSweeps = {{
     {"reuse_roughness", {0.0, 0.05, 0.15, 1.0}, {0.0}, {true, true, true}},
     // The talk's 100 (default) around the camera; smaller radii drop distant BLASes.
     {"bvh_radius", {10, 25, 50, 200}, {25}, {true, false, true}},
+    // Pixels nearer than this go straight to RT (default 3): 0 tries SSLR first everywhere.
+    {"rt_near_distance", {0, 1, 6, 10}, {0}, {true, false, false}},
+    // Half-rate RT on a checkerboard (default off).
+    {"rt_checkerboard", {1}, {1}, {true, false, true}},
 }};
 
 double parsePositive(const std::string& flag, const std::string& text, bool allowZero) {

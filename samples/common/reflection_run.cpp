@@ -78,7 +78,7 @@ struct ParameterSlot {
     bool* (*boolField)(ReflectionRunOptions&) = nullptr;  // 0 or 1
 };
 
-const std::array<ParameterSlot, 10> kParameters = {{
+const std::array<ParameterSlot, 11> kParameters = {{
     {{"sslr_threshold", "SslrSettings::confidenceThreshold"},
      [](ReflectionRunOptions& o) { return &o.frame.sslr.confidenceThreshold; }, nullptr},
     {{"sslr_steps", "SslrSettings::linearSteps"}, nullptr,
@@ -98,6 +98,8 @@ const std::array<ParameterSlot, 10> kParameters = {{
      [](ReflectionRunOptions& o) { return &o.frame.rt.maxDistance; }, nullptr},
     {{"frustum_culling", "GBufferSettings::frustumCulling (0 or 1)"}, nullptr, nullptr,
      [](ReflectionRunOptions& o) { return &o.frame.gbuffer.frustumCulling; }},
+    {{"rt_checkerboard", "RayGenerationSettings::checkerboard (0 or 1)"}, nullptr, nullptr,
+     [](ReflectionRunOptions& o) { return &o.frame.rays.checkerboard; }},
 }};
 
 const ParameterSlot& findParameter(std::string_view name) {

@@ -127,11 +127,22 @@ void main() {
     // rough and in the same class (the same pass will trace it).
     const uvec2 local = gl_LocalInvocationID.xy;
     const uint leaderCorner = pc.frame & 3u;
-    const uvec2 leaderLocal = (local & ~1u) + uvec2(leaderCorner & 1u, leaderCorner >> 1u);
+    uvec2 leaderLocal = (local & ~1u) + uvec2(leaderCorner & 1u, leaderCorner >> 1u);
+    bool shares = rough;
+    // Checkerboard (kRayGenCheckerboard): of the smooth hybrid and RT
+    // pixels, those on the frame's off squares take the ray of their
+    // neighbour in the row, an on square of the same class (FidelityFX
+    // Hybrid Reflections' checkerboarded RT; the squares swap every frame,
+    // so temporal accumulation sees every pixel's own ray every other frame).
+    if (!rough && (pc.flags & kRayGenCheckerboard) != 0u && (pixelClass == kPixelHybrid || pixelClass == kPixelRt) &&
+        ((pixel.x + pixel.y + pc.frame) & 1u) == 1u) {
+        leaderLocal = uvec2(local.x ^ 1u, local.y);
+        shares = sharedRough[leaderLocal.y * 8u + leaderLocal.x] == 0u;
+    }
     const uint leaderLane = leaderLocal.y * 8u + leaderLocal.x;
     const uvec2 leaderPixel = gl_WorkGroupID.xy * 8u + leaderLocal;
     const bool leaderInside = leaderPixel.x < pc.size.x && leaderPixel.y < pc.size.y;
-    const bool reused = rough && leaderLane != lane && leaderInside && sharedRough[leaderLane] == 1u &&
+    const bool reused = shares && leaderLane != lane && leaderInside && sharedRough[leaderLane] == (rough ? 1u : 0u) &&
                         sharedClass[leaderLane] == pixelClass;
 
     if (inside) {

@@ -492,6 +492,46 @@ TEST_CASE("below the reuse roughness every pixel keeps its own ray") {
     }
 }
 
+TEST_CASE("the checkerboard halves the smooth hybrid and RT rays: off squares share their row neighbour's ray") {
+    test::GpuTest gpu;
+    passes::RayGenerationSettings settings;
+    settings.checkerboard = true;
+    settings.sslrMinDistance = 1e9f;  // RT and hybrid only
+    const std::vector<RayFrame> frames = generate(gpu, floorScene(0.05f), {4, 5}, settings);
+    const std::vector<RayFrame> plainFrames = generate(gpu, floorScene(0.05f), {4, 5});
+    for (uint32_t k = 0; k < frames.size(); ++k) {
+        const RayFrame& f = frames[k];
+        const RayFrame& plain = plainFrames[k];
+        const uint32_t frame = 4 + k;
+        uint32_t leaders = 0, followers = 0;
+        for (uint32_t y = kSize / 2 + 1; y < kSize; ++y) {
+            for (uint32_t x = 0; x < kSize; ++x) {
+                INFO("frame " << frame << ", pixel " << x << ", " << y);
+                const uint32_t c = f.classes[f.at(x, y)];
+                REQUIRE((c == shader::kPixelHybrid || c == shader::kPixelRt));
+                const shader::PackedRay& ray = f.rays[f.at(x, y)];
+                const uint32_t nx = x ^ 1u;
+                if (((x + y + frame) & 1u) == 0u || f.classes[f.at(nx, y)] != c) {
+                    // An on square (or a neighbour of another class): its own ray, as without.
+                    REQUIRE(ray.pixelFlags == shader::packRayPixel({x, y}, false));
+                    REQUIRE(ray.direction == plain.rays[plain.at(x, y)].direction);
+                    ++leaders;
+                } else {
+                    REQUIRE(ray.pixelFlags == shader::packRayPixel({nx, y}, true));
+                    REQUIRE(ray.direction == f.rays[f.at(nx, y)].direction);
+                    ++followers;
+                }
+            }
+        }
+        // About half the rays; the lists hold the leaders only.
+        CHECK(followers > leaders / 2);
+        CHECK(f.sslrArgs[shader::kRayListCountOffset] + f.rtArgs[shader::kRayListCountOffset] <
+              plain.sslrArgs[shader::kRayListCountOffset] + plain.rtArgs[shader::kRayListCountOffset] * 3 / 4 + 1);
+    }
+    // The squares swap: a pixel that followed in one frame leads in the next.
+    CHECK(frames[0].rays[frames[0].at(1, kSize - 2)].pixelFlags != frames[1].rays[frames[1].at(1, kSize - 2)].pixelFlags);
+}
+
 TEST_CASE("the ssr and rt modes send every traced pixel one way, and the RT list holds exactly the RT leaders") {
     test::GpuTest gpu;
     passes::RayGenerationSettings settings;
