@@ -68,8 +68,7 @@ struct CityMaterials {
     std::array<uint32_t, 4> carPaint{};
 };
 
-// Wet asphalt: glossy where the film of water lies on it, near-mirror in
-// puddles (an fBm mask, as the plaza's paving; Lagarde, "Water drop 2b -
+// Wet asphalt: glossy under its film of water, near-mirror in puddles (an fBm mask, as the plaza's paving; Lagarde, "Water drop 2b -
 // Dynamic rain and its effects", 2013), lane markings.
 struct RoadTextures {
     Texture baseColor;
@@ -92,7 +91,9 @@ RoadTextures makeRoadTextures(uint32_t size, uint32_t seed) {
             // A dashed centre line (0.15 m wide, 3 m dashes every 6 m).
             const bool marking = std::abs(u - 0.5f) < 0.0075f && std::fmod(v * 10.0f, 6.0f) < 3.0f;
             glm::vec3 albedo = glm::vec3(0.07f, 0.07f, 0.075f) * grain;
-            float roughness = 0.32f + 0.12f * grain - 0.1f;
+            // A film of water on the whole road: glossy (0.1-0.2) between the
+            // puddles, so that the street reflects everywhere, blurred.
+            float roughness = 0.08f + 0.1f * grain;
             if (marking) {
                 albedo = glm::vec3(0.7f, 0.68f, 0.6f);
                 roughness = 0.5f;
@@ -120,7 +121,7 @@ CityMaterials cityMaterials(SceneBuilder& b, uint32_t seed) {
     wet.baseColorTexture.texture = b.texture(road.baseColor);
     wet.metallicRoughnessTexture.texture = b.texture(road.metallicRoughness);
     m.road = b.material(wet);
-    m.sidewalk = b.material(makeMaterial("wet paving slabs", {0.3f, 0.28f, 0.26f}, 0.0f, 0.3f));
+    m.sidewalk = b.material(makeMaterial("wet paving slabs", {0.3f, 0.28f, 0.26f}, 0.0f, 0.2f));
     m.kerb = b.material(makeMaterial("granite kerb", {0.35f, 0.35f, 0.36f}, 0.0f, 0.5f));
     m.ground = b.material(makeMaterial("waste ground", {0.12f, 0.11f, 0.1f}, 0.0f, 0.95f));
     m.frame = b.material(makeMaterial("stone trim", {0.6f, 0.58f, 0.55f}, 0.0f, 0.6f));
