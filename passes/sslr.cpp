@@ -82,8 +82,8 @@ SslrOutputs addSslrPass(rg::Graph& graph, SslrPipelines& pipelines, const SslrIn
     if (gbuf.width == 0 || gbuf.height == 0 || rays.width != gbuf.width || rays.height != gbuf.height) {
         throw gpu::GpuError("addSslrPass: the G-buffer and the rays must have the same, non-zero size");
     }
-    if (settings.linearSteps == 0) {
-        throw gpu::GpuError("addSslrPass: linearSteps must be at least 1");
+    if (settings.linearSteps == 0 || !(settings.minStepPixels >= 0.0f)) {
+        throw gpu::GpuError("addSslrPass: linearSteps must be at least 1 and minStepPixels not negative");
     }
     checkProjection(inputs.projection);
 
@@ -202,6 +202,7 @@ SslrOutputs addSslrPass(rg::Graph& graph, SslrPipelines& pipelines, const SslrIn
     // The same 32-bit frame as ray generation's noise (glint/sampling.glsl).
     constants.frame = uint32_t(inputs.frameIndex);
     constants.linearSteps = settings.linearSteps;
+    constants.minStepPixels = settings.minStepPixels;
     constants.refineSteps = settings.refineSteps;
     constants.thickness = settings.thickness;
     constants.maxDistance = settings.maxDistance;

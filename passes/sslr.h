@@ -53,6 +53,13 @@ struct SslrSettings {
     // Far Cry 6 talk's linear-then-refine trace (DESIGN.md section 3).
     uint32_t linearSteps = 64;
     uint32_t refineSteps = 8;
+    // A ray takes fewer linear steps when its on-screen length has fewer
+    // pixels than linearSteps * minStepPixels: steps finer than a pixel
+    // read the same depth texels again (the refinement still resolves the
+    // crossing below a pixel). The march is a chain of dependent reads, so
+    // its latency, not bandwidth, bounds SSLR at low ray counts. 0: always
+    // linearSteps. Glint's starting value; the bench sweeps it.
+    float minStepPixels = 1.0f;
     // A hit counts when the refined point lies at most this fraction of
     // the surface's view distance behind the depth buffer (which has no
     // thickness of its own); a relative test holds at every distance.

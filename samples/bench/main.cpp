@@ -71,13 +71,15 @@ struct Sweep {
     std::array<bool, 3> modes;  // passes::ReflectionMode order: hybrid, ssr, rt
 };
 
-const std::array<Sweep, 7> kSweeps = {{
+const std::array<Sweep, 8> kSweeps = {{
     // The talk's 0.9 (default) bracketed from "trust SSLR often" to "almost never".
     {"sslr_threshold", {0.5, 0.7, 0.8, 0.95, 0.99}, {0.7}, {true, false, false}},
     // FidelityFX's 0.22 (default): lower sends more pixels to the environment, higher traces more.
     {"roughness_cutoff", {0.1, 0.15, 0.3, 0.5}, {0.5}, {true, true, true}},
     // 64 linear steps (default) against fewer and more.
-    {"sslr_steps", {16, 32, 96, 128}, {16}, {true, true, false}},
+    {"sslr_steps", {16, 32, 96, 128}, {16, 32}, {true, true, false}},
+    // Steps no finer than a pixel (default 1); 0: 64 steps whatever the ray's screen length.
+    {"sslr_min_step_pixels", {0, 2, 4}, {0, 2}, {true, true, false}},
     // Samples per quad: quads at or above this roughness share one ray. 0: every traced quad
     // shares (1 sample per quad); 1 (above any traced roughness): none does (4 per quad).
     {"reuse_roughness", {0.0, 0.05, 0.15, 1.0}, {0.0}, {true, true, true}},

@@ -78,11 +78,13 @@ struct ParameterSlot {
     bool* (*boolField)(ReflectionRunOptions&) = nullptr;  // 0 or 1
 };
 
-const std::array<ParameterSlot, 11> kParameters = {{
+const std::array<ParameterSlot, 12> kParameters = {{
     {{"sslr_threshold", "SslrSettings::confidenceThreshold"},
      [](ReflectionRunOptions& o) { return &o.frame.sslr.confidenceThreshold; }, nullptr},
     {{"sslr_steps", "SslrSettings::linearSteps"}, nullptr,
      [](ReflectionRunOptions& o) { return &o.frame.sslr.linearSteps; }},
+    {{"sslr_min_step_pixels", "SslrSettings::minStepPixels"},
+     [](ReflectionRunOptions& o) { return &o.frame.sslr.minStepPixels; }, nullptr},
     {{"sslr_thickness", "SslrSettings::thickness"},
      [](ReflectionRunOptions& o) { return &o.frame.sslr.thickness; }, nullptr},
     {{"roughness_cutoff", "RayGenerationSettings::roughnessCutoff"},

@@ -20,6 +20,7 @@ constexpr RangeRow kRanges[] = {
     {"sslr_threshold", 0.0f, 1.0f, false},      // a confidence
     {"sslr_steps", 1.0f, 256.0f, true},         // default 64 (the talk)
     {"sslr_thickness", 0.001f, 0.5f, false},    // default 0.02 view-space units
+    {"sslr_min_step_pixels", 0.0f, 8.0f, false}, // default 1 pixel
     {"roughness_cutoff", 0.0f, 1.0f, false},    // a roughness
     {"reuse_roughness", 0.0f, 1.0f, false},     // a roughness
     {"rt_near_distance", 0.0f, 50.0f, false},   // default 3 world units

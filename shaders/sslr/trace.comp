@@ -146,12 +146,18 @@ void main() {
     // turns the banding of large steps into noise the temporal filter
     // removes (Far Cry 6 talk).
     const float jitter = frameNoise(pixel, pc.frame).x;
-    const float step = tEnd / float(pc.linearSteps);
+    // No more steps than the ray's on-screen length has pixels per
+    // minStepPixels: finer steps would read the same texels again.
+    uint steps = pc.linearSteps;
+    if (pc.minStepPixels > 0.0) {
+        steps = clamp(uint(ceil(tEnd * pixelsPerT / pc.minStepPixels)), 1u, pc.linearSteps);
+    }
+    const float step = tEnd / float(steps);
     float tFront = 0.0;
     float tHit = -1.0;
     ivec2 hitTexel = ivec2(0);
     float gap = 0.0;
-    for (uint i = 0u; i < pc.linearSteps; ++i) {
+    for (uint i = 0u; i < steps; ++i) {
         const float t = (float(i) + jitter) * step;
         // Within a pixel of the origin the ray can only find its own surface.
         if (t * pixelsPerT < 1.0) {

@@ -41,8 +41,8 @@ struct SslrConstants {
     float edgeFade;
     float confidenceThreshold;  // as stored (passes::sslrStoredThreshold)
     uint pyramidMips;           // levels of the colour pyramid; 0: no cone trace
+    float minStepPixels;        // SslrSettings::minStepPixels
     uint pad0;
-    uint pad1;
 };
 
 // The pyramid stops at 2^(kSslrPyramidMaxMips - 1) pixels per texel: wider
