@@ -23,16 +23,22 @@ CommandPool::CommandPool(Context& ctx, uint32_t family, std::string_view name) :
 }
 
 VkCommandBuffer CommandPool::allocate() {
+    if (used_ < buffers_.size()) return buffers_[used_++];
     VkCommandBufferAllocateInfo info{VK_STRUCTURE_TYPE_COMMAND_BUFFER_ALLOCATE_INFO};
     info.commandPool = pool_.get();
     info.level = VK_COMMAND_BUFFER_LEVEL_PRIMARY;
     info.commandBufferCount = 1;
     VkCommandBuffer cmd = VK_NULL_HANDLE;
     check(vkAllocateCommandBuffers(device_, &info, &cmd), "vkAllocateCommandBuffers");
+    buffers_.push_back(cmd);
+    ++used_;
     return cmd;
 }
 
-void CommandPool::reset() { check(vkResetCommandPool(device_, pool_.get(), 0), "vkResetCommandPool"); }
+void CommandPool::reset() {
+    check(vkResetCommandPool(device_, pool_.get(), 0), "vkResetCommandPool");
+    used_ = 0;
+}
 
 // ---------------------------------------------------------------- TimelineSemaphore
 

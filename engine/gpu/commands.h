@@ -19,15 +19,24 @@ class CommandPool {
 public:
     CommandPool() = default;
     CommandPool(Context& ctx, uint32_t family, std::string_view name);
-    // A primary command buffer, freed with the pool (or by reset()).
+    // A primary command buffer in the initial state, freed with the pool.
+    // After reset() the pool hands out the buffers it already has before it
+    // allocates more (vkResetCommandPool returns buffers to the initial
+    // state but does not free them), so a pool reset every frame holds as
+    // many buffers as the busiest frame needed, not one more per frame.
     VkCommandBuffer allocate();
-    // Returns every command buffer of the pool to the initial state.
+    // Returns every command buffer of the pool to the initial state and
+    // makes them all available to allocate() again.
     void reset();
     VkCommandPool handle() const { return pool_.get(); }
+    // Command buffers the pool holds, in use or not.
+    size_t allocatedCount() const { return buffers_.size(); }
 
 private:
     VkDevice device_ = VK_NULL_HANDLE;
     Unique<VkCommandPool> pool_;
+    std::vector<VkCommandBuffer> buffers_;
+    size_t used_ = 0;
 };
 
 class TimelineSemaphore {

@@ -912,6 +912,9 @@ SubmittedFrame Executor::run(const Plan& plan, const FrameResources& imports) {
     }
     ++frame_;
     ++stats_.frames;
+    stats_.commandBuffers = 0;
+    for (const auto& s : slots_)
+        for (const gpu::CommandPool& pool : s->pools) stats_.commandBuffers += uint32_t(pool.allocatedCount());
     return submitted;
 }
 

@@ -194,6 +194,9 @@ struct ExecutorStats {
     uint64_t frames = 0;
     uint32_t transientRebuilds = 0;  // times the transient memory was (re)created
     uint64_t transientBytes = 0;     // bytes of the current transient heaps
+    // Command buffers held by the frames' pools: as many as the busiest
+    // frame of each slot needed, flat over a steady frame loop.
+    uint32_t commandBuffers = 0;
 };
 
 class Executor {
