@@ -10,7 +10,6 @@
 // the screen border, and hybrid rays below the threshold are listed for RT.
 #extension GL_GOOGLE_include_directive : require
 #extension GL_EXT_scalar_block_layout : require
-#extension GL_EXT_control_flow_attributes : require
 
 #include "glint/ray_generation_shared.h"
 #include "glint/sampling.glsl"
@@ -39,9 +38,6 @@ layout(set = 0, binding = 12) uniform sampler2D pyramidTexture;
 layout(set = 0, binding = 13, scalar) readonly buffer SslrArgs { uint sslrArgs[]; };
 
 layout(push_constant, scalar) uniform Constants { SslrConstants pc; };
-
-// Linear steps whose depth reads are issued together (see the march).
-const uint kMarchBatch = 8u;
 
 // View-space z (negative in front of the camera) of a reversed-Z depth;
 // see SslrConstants for the projection's form. Depth 0 (the sky) is
@@ -161,65 +157,47 @@ void main() {
     float tHit = -1.0;
     ivec2 hitTexel = ivec2(0);
     float gap = 0.0;
-    // The march in batches of kMarchBatch steps: each batch's depth reads
-    // are independent and issued together, then its steps are tested in
-    // order exactly as one at a time would test them. A march is a chain of
-    // dependent reads, so at low ray counts its latency, not bandwidth,
-    // bounds SSLR: batching shortens the chain from linearSteps reads to
-    // linearSteps / kMarchBatch (up to kMarchBatch - 1 reads past a hit are
-    // wasted).
-    bool found = false;
-    for (uint first = 0u; first < steps && !found; first += kMarchBatch) {
-        float batchT[kMarchBatch];
-        float batchD[kMarchBatch];
-        ivec2 batchTexel[kMarchBatch];
-        bool batchSky[kMarchBatch];
-        [[unroll]] for (uint k = 0u; k < kMarchBatch; ++k) {
-            batchT[k] = (float(first + k) + jitter) * step;
-            batchD[k] = behind(m, batchT[k], batchTexel[k], batchSky[k]);
-        }
-        for (uint k = 0u; k < kMarchBatch && first + k < steps; ++k) {
-            const float t = batchT[k];
-            // Within a pixel of the origin the ray can only find its own surface.
-            if (t * pixelsPerT < 1.0) {
-                tFront = t;
-                continue;
-            }
-            const ivec2 texel = batchTexel[k];
-            const float d = batchD[k];
-            if (batchSky[k] || d < 0.0) {
-                tFront = t;
-                continue;
-            }
-            // A crossing: refine between the last point in front and this one.
-            float lo = tFront, hi = t;
-            ivec2 hiTexel = texel;
-            float hiGap = d;
-            for (uint j = 0u; j < pc.refineSteps; ++j) {
-                const float mid = 0.5 * (lo + hi);
-                ivec2 midTexel;
-                bool midSky;
-                const float md = behind(m, mid, midTexel, midSky);
-                if (midSky || md < 0.0) {
-                    lo = mid;
-                } else {
-                    hi = mid;
-                    hiTexel = midTexel;
-                    hiGap = md;
-                }
-            }
-            // Thickness test: the depth buffer holds only front surfaces, so a
-            // ray found far behind one passed behind it; keep marching.
-            const float surfaceDistance = -viewZ(texelFetch(depthTexture, hiTexel, 0).x);
-            if (hiGap <= pc.thickness * surfaceDistance) {
-                tHit = hi;
-                hitTexel = hiTexel;
-                gap = hiGap / (pc.thickness * surfaceDistance);
-                found = true;
-                break;
-            }
+    for (uint i = 0u; i < steps; ++i) {
+        const float t = (float(i) + jitter) * step;
+        // Within a pixel of the origin the ray can only find its own surface.
+        if (t * pixelsPerT < 1.0) {
             tFront = t;
+            continue;
         }
+        ivec2 texel;
+        bool sky;
+        const float d = behind(m, t, texel, sky);
+        if (sky || d < 0.0) {
+            tFront = t;
+            continue;
+        }
+        // A crossing: refine between the last point in front and this one.
+        float lo = tFront, hi = t;
+        ivec2 hiTexel = texel;
+        float hiGap = d;
+        for (uint j = 0u; j < pc.refineSteps; ++j) {
+            const float mid = 0.5 * (lo + hi);
+            ivec2 midTexel;
+            bool midSky;
+            const float md = behind(m, mid, midTexel, midSky);
+            if (midSky || md < 0.0) {
+                lo = mid;
+            } else {
+                hi = mid;
+                hiTexel = midTexel;
+                hiGap = md;
+            }
+        }
+        // Thickness test: the depth buffer holds only front surfaces, so a
+        // ray found far behind one passed behind it; keep marching.
+        const float surfaceDistance = -viewZ(texelFetch(depthTexture, hiTexel, 0).x);
+        if (hiGap <= pc.thickness * surfaceDistance) {
+            tHit = hi;
+            hitTexel = hiTexel;
+            gap = hiGap / (pc.thickness * surfaceDistance);
+            break;
+        }
+        tFront = t;
     }
 
     float confidence = 0.0;
