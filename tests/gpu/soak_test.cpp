@@ -1,0 +1,128 @@
+// A long run of the whole reflection frame must hold its memory flat: host
+// RSS, the allocator's device memory and the executor's command buffers.
+// 2,400 frames of the plaza at 64x64 along its camera path, in segments of
+// 100 frames that cycle through the modes (hybrid, ssr, rt) and two sizes
+// (a resize rebuilds every size-dependent resource and drops the history),
+// each segment starting with a history reset; once with each pass timer.
+// Every six segments see each combination of mode and size; the first
+// twelve are the warm-up (on lavapipe the resident set steps up until the
+// eleventh and is flat from there on, over 30 segments), and nothing may
+// grow over the last twelve: not the resident set (by more than 1%), not
+// the device memory the allocator holds or hands out, not the executor's
+// command buffers. Before command pools handed their buffers out again,
+// the host-serial timer's 40 command buffers a frame grew the resident set
+// by about 70 KB a frame and the buffer count without bound.
+//
+// Validation is off here: it would multiply the run time and its own
+// bookkeeping grows with the objects it tracks. Every pass runs under
+// validation in the other suites.
+#include "gpu/context.h"
+#include "graph/executor.h"
+#include "graph/graph.h"
+#include "passes/reflection_frame.h"
+#include "scene/animation.h"
+#include "scene/builtin_scenes.h"
+#include "scene/camera.h"
+
+#include <doctest/doctest.h>
+#include <spdlog/spdlog.h>
+
+#include <array>
+#include <fstream>
+#include <string>
+#include <unistd.h>
+
+using namespace glint;
+
+namespace {
+
+constexpr uint32_t kSegmentFrames = 100;
+constexpr uint32_t kSegments = 24;
+constexpr uint32_t kWarmUpSegments = 12;
+constexpr std::array<passes::ReflectionMode, 3> kModes = {
+    passes::ReflectionMode::Hybrid, passes::ReflectionMode::Ssr, passes::ReflectionMode::Rt};
+constexpr std::array<glm::uvec2, 2> kSizes = {glm::uvec2(64, 64), glm::uvec2(96, 48)};
+
+// Resident set of this process, in bytes (/proc/self/statm's second field).
+uint64_t residentBytes() {
+    std::ifstream statm("/proc/self/statm");
+    uint64_t pages = 0, resident = 0;
+    statm >> pages >> resident;
+    return resident * uint64_t(sysconf(_SC_PAGESIZE));
+}
+
+struct Sample {
+    uint64_t rss = 0;
+    uint64_t deviceBlockBytes = 0;
+    uint64_t deviceUsedBytes = 0;
+    uint32_t commandBuffers = 0;
+};
+
+} // namespace
+
+TEST_CASE("2,400 frames with mode switches, resizes and history resets hold memory and command buffers flat") {
+    rg::PassTimer timer = rg::PassTimer::GpuTimestamps;
+    SUBCASE("GPU timestamps") {}
+    SUBCASE("host-serial pass timer") { timer = rg::PassTimer::HostSerial; }
+
+    gpu::ContextOptions options;
+    options.validation = false;
+    gpu::Context ctx(options);
+    scene::Scene scene = scene::makeBuiltinScene("plaza");
+    rg::Executor executor(ctx);
+    executor.setPassTimer(timer);
+    passes::ReflectionRenderer renderer(ctx, scene);
+
+    scene::Camera camera;
+    camera.lens = scene.lens;
+    std::array<Sample, kSegments> samples{};
+    for (uint32_t segment = 0; segment < kSegments; ++segment) {
+        const passes::ReflectionMode mode = kModes[segment % kModes.size()];
+        const glm::uvec2 size = kSizes[segment % kSizes.size()];
+        for (uint32_t f = 0; f < kSegmentFrames; ++f) {
+            const uint32_t frame = segment * kSegmentFrames + f;
+            const float seconds = float(frame % 600) / 30.0f;  // the plaza's 20-second path
+            const scene::CameraPose pose = scene.cameraPath.evaluate(seconds);
+            camera.resolution = size;
+            if (f == 0) {
+                camera.reset(pose, frame);
+            } else {
+                camera.advance(pose, frame);
+            }
+            scene::advanceScene(scene, seconds, &camera);
+            passes::ReflectionFrameSettings settings;
+            settings.mode = mode;
+            settings.resetHistory = f == 0;
+            rg::Graph graph(executor.queueCaps());
+            const passes::ReflectionFrame out = renderer.addFrame(graph, camera, settings);
+            rg::FrameResources resources;
+            renderer.bind(resources, out);
+            executor.run(graph.compile(executor.compileOptions()), resources);
+            // Reading the pass times every frame, as the samples do, keeps
+            // the timer's bookkeeping in the loop.
+            if (f % 2 == 1) {
+                executor.waitIdle();
+                (void)executor.timings();
+            }
+        }
+        executor.waitIdle();
+        const gpu::MemoryStats memory = ctx.memory().stats();
+        samples[segment] = {residentBytes(), memory.blockBytes, memory.usedBytes, executor.stats().commandBuffers};
+        spdlog::info("soak segment {}: rss {:.1f} MB, device {:.1f} MB in blocks ({:.1f} used), {} command buffers",
+                     segment, double(samples[segment].rss) * 1e-6, double(memory.blockBytes) * 1e-6,
+                     double(memory.usedBytes) * 1e-6, samples[segment].commandBuffers);
+    }
+
+    // Every measured segment against the end of the warm-up.
+    const Sample& warm = samples[kWarmUpSegments - 1];
+    for (uint32_t segment = kWarmUpSegments; segment < kSegments; ++segment) {
+        const Sample& s = samples[segment];
+        CAPTURE(segment);
+        CAPTURE(s.rss);
+        CAPTURE(warm.rss);
+        CHECK(double(s.rss) <= double(warm.rss) * 1.01);
+        CHECK(s.deviceBlockBytes <= warm.deviceBlockBytes);
+        CHECK(s.deviceUsedBytes <= warm.deviceUsedBytes);
+        CHECK(s.commandBuffers == warm.commandBuffers);
+    }
+}
