@@ -92,7 +92,7 @@ TEST_CASE("the city's buildings are tessellated to the triangle budget, the refl
         CHECK(triangleCount(coarse.meshes[m].lods[0]) < lod0 / 2);
     }
     CHECK(checked == 6);
-    // The default is a large scene: about 2.6 million instanced triangles.
+    // The default is a large scene: about 2.0 million instanced triangles.
     const Scene standard = makeCity();
     CHECK(instancedTriangleCount(standard) > 1'500'000);
     CHECK(instancedTriangleCount(standard) < 4'000'000);
