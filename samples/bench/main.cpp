@@ -71,7 +71,7 @@ struct Sweep {
     std::array<bool, 3> modes;  // passes::ReflectionMode order: hybrid, ssr, rt
 };
 
-const std::array<Sweep, 8> kSweeps = {{
+const std::array<Sweep, 9> kSweeps = {{
     // The talk's 0.9 (default) bracketed from "trust SSLR often" to "almost never".
     {"sslr_threshold", {0.5, 0.7, 0.8, 0.95, 0.99}, {0.7}, {true, false, false}},
     // FidelityFX's 0.22 (default): lower sends more pixels to the environment, higher traces more.
@@ -89,6 +89,9 @@ const std::array<Sweep, 8> kSweeps = {{
     {"rt_near_distance", {0, 1, 6, 10}, {0}, {true, false, false}},
     // Half-rate RT on a checkerboard (default off).
     {"rt_checkerboard", {1}, {1}, {true, false, true}},
+    // A tile goes RT-only when at most this share of its SSLR rays hit (default 0, the talk's
+    // rule): higher stops paying for SSLR where it rarely succeeds.
+    {"feedback_rt_hit_fraction", {0.05, 0.1, 0.25}, {0.1}, {true, false, false}},
 }};
 
 double parsePositive(const std::string& flag, const std::string& text, bool allowZero) {
