@@ -27,6 +27,7 @@
 #include <doctest/doctest.h>
 #include <spdlog/spdlog.h>
 
+#include <algorithm>
 #include <array>
 #include <fstream>
 #include <string>
@@ -113,14 +114,20 @@ TEST_CASE("2,400 frames with mode switches, resizes and history resets hold memo
                      double(memory.usedBytes) * 1e-6, samples[segment].commandBuffers);
     }
 
-    // Every measured segment against the end of the warm-up.
+    // Every measured segment against the warm-up's last cycle of six (one
+    // of each mode and size): the resident set against its highest there
+    // (it dips and returns by a few MB as lavapipe's threads free and take
+    // memory), the rest against the warm-up's end.
     const Sample& warm = samples[kWarmUpSegments - 1];
+    uint64_t warmRss = 0;
+    for (uint32_t segment = kWarmUpSegments - 6; segment < kWarmUpSegments; ++segment)
+        warmRss = std::max(warmRss, samples[segment].rss);
     for (uint32_t segment = kWarmUpSegments; segment < kSegments; ++segment) {
         const Sample& s = samples[segment];
         CAPTURE(segment);
         CAPTURE(s.rss);
-        CAPTURE(warm.rss);
-        CHECK(double(s.rss) <= double(warm.rss) * 1.01);
+        CAPTURE(warmRss);
+        CHECK(double(s.rss) <= double(warmRss) * 1.01);
         CHECK(s.deviceBlockBytes <= warm.deviceBlockBytes);
         CHECK(s.deviceUsedBytes <= warm.deviceUsedBytes);
         CHECK(s.commandBuffers == warm.commandBuffers);
