@@ -372,6 +372,7 @@ void Context::createDevice(const ContextOptions& options) {
     caps_.accelerationStructure = hasAs && asFeatures.accelerationStructure;
     caps_.rayQuery = hasRq && rqFeatures.rayQuery && caps_.accelerationStructure;
     caps_.rayTracingPipeline = hasRt && rtFeatures.rayTracingPipeline && caps_.accelerationStructure;
+    caps_.memoryBudget = hasExtension(extensions, VK_EXT_MEMORY_BUDGET_EXTENSION_NAME);
     if (options.requireRayTracing && !(caps_.rayQuery || caps_.rayTracingPipeline)) {
         throw GpuError("device '" + caps_.deviceName +
                        "' has no usable ray backend (needs accelerationStructure plus rayQuery or rayTracingPipeline)");
@@ -440,6 +441,9 @@ void Context::createDevice(const ContextOptions& options) {
     }
     if (options.swapchain) {
         enabledExtensions.push_back(VK_KHR_SWAPCHAIN_EXTENSION_NAME);
+    }
+    if (caps_.memoryBudget) {
+        enabledExtensions.push_back(VK_EXT_MEMORY_BUDGET_EXTENSION_NAME);
     }
     link(e13);
     link(e12);
@@ -561,6 +565,17 @@ void Context::createDevice(const ContextOptions& options) {
                  deviceTypeName(caps_.deviceType), caps_.driverName, caps_.driverInfo, caps_.rayQuery ? "yes" : "no",
                  caps_.rayTracingPipeline ? "yes" : "no",
                  caps_.computeFamily ? "family " + std::to_string(*caps_.computeFamily) : std::string("no"));
+}
+
+std::optional<uint64_t> Context::deviceMemoryInUse() const {
+    if (!caps_.memoryBudget) return std::nullopt;
+    VkPhysicalDeviceMemoryBudgetPropertiesEXT budget{VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_MEMORY_BUDGET_PROPERTIES_EXT};
+    VkPhysicalDeviceMemoryProperties2 properties{VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_MEMORY_PROPERTIES_2};
+    properties.pNext = &budget;
+    vkGetPhysicalDeviceMemoryProperties2(physicalDevice_, &properties);
+    uint64_t used = 0;
+    for (uint32_t heap = 0; heap < properties.memoryProperties.memoryHeapCount; ++heap) used += budget.heapUsage[heap];
+    return used;
 }
 
 void Context::setName(VkObjectType type, uint64_t handle, std::string_view name) const {

@@ -65,6 +65,7 @@ struct Capabilities {
     bool rayTracingPipeline = false;
     RayTracingProperties rayTracing;
 
+    bool memoryBudget = false;      // VK_EXT_memory_budget enabled (Context::deviceMemoryInUse)
     bool timestamps = false;        // graphics queue can write timestamps
     float timestampPeriodNs = 0.0f; // nanoseconds per tick
     uint64_t bufferImageGranularity = 1;
@@ -113,6 +114,10 @@ public:
     const Capabilities& caps() const { return caps_; }
     const DeviceFunctions& fn() const { return fn_; }
     MemoryAllocator& memory() { return *memory_; }
+    // Bytes of device memory this process uses, summed over the heaps, as
+    // the driver reports it (VK_EXT_memory_budget); none without the
+    // extension. Counts what the driver holds beyond our allocator's blocks.
+    std::optional<uint64_t> deviceMemoryInUse() const;
 
     const Queue& graphicsQueue() const { return graphics_; }
     // The async compute queue, or the graphics queue where the device has no

@@ -1,5 +1,5 @@
 // A long run of the whole reflection frame must hold its memory flat: host
-// RSS, the allocator's device memory and the executor's command buffers.
+// RSS, device memory and the executor's command buffers.
 // 2,400 frames of the plaza at 64x64 along its camera path, in segments of
 // 100 frames that cycle through the modes (hybrid, ssr, rt) and two sizes
 // (a resize rebuilds every size-dependent resource and drops the history),
@@ -7,11 +7,13 @@
 // Every six segments see each combination of mode and size; the first
 // twelve are the warm-up (on lavapipe the resident set steps up until the
 // eleventh and is flat from there on, over 30 segments), and nothing may
-// grow over the last twelve: not the resident set (by more than 1%), not
-// the device memory the allocator holds or hands out, not the executor's
-// command buffers. Before command pools handed their buffers out again,
-// the host-serial timer's 40 command buffers a frame grew the resident set
-// by about 70 KB a frame and the buffer count without bound.
+// grow over the last twelve: not the resident set and not the device
+// memory the driver reports in use (VK_EXT_memory_budget, on a GPU that
+// has it) by more than 1%, not the device memory our allocator holds or
+// hands out, not the executor's command buffers. Before command pools
+// handed their buffers out again, the host-serial timer's 21 command
+// buffers a frame grew the resident set by about 70 KB a frame and the
+// buffer count without bound.
 //
 // Validation is off here: it would multiply the run time and its own
 // bookkeeping grows with the objects it tracks. Every pass runs under
@@ -39,6 +41,15 @@ namespace {
 
 constexpr uint32_t kSegmentFrames = 100;
 constexpr uint32_t kSegments = 24;
+// AddressSanitizer keeps freed memory in quarantine (up to 256 MB), so the
+// resident set of a sanitized run grows with what it frees, not with what
+// it holds: there the resident set is not checked (LeakSanitizer checks
+// what is still held at exit), the rest is.
+#if defined(__SANITIZE_ADDRESS__)
+constexpr bool kSanitized = true;
+#else
+constexpr bool kSanitized = false;
+#endif
 constexpr uint32_t kWarmUpSegments = 12;
 constexpr std::array<passes::ReflectionMode, 3> kModes = {
     passes::ReflectionMode::Hybrid, passes::ReflectionMode::Ssr, passes::ReflectionMode::Rt};
@@ -57,6 +68,7 @@ struct Sample {
     uint64_t deviceBlockBytes = 0;
     uint64_t deviceUsedBytes = 0;
     uint32_t commandBuffers = 0;
+    uint64_t driverBytes = 0;  // VK_EXT_memory_budget's heap usage, where the device has it
 };
 
 } // namespace
@@ -73,6 +85,10 @@ TEST_CASE("2,400 frames with mode switches, resizes and history resets hold memo
     rg::Executor executor(ctx);
     executor.setPassTimer(timer);
     passes::ReflectionRenderer renderer(ctx, scene);
+    // lavapipe's heap "usage" moves with the whole system's memory in use
+    // (about 550 MB here while this process holds 250), so on a CPU device
+    // it is logged, not checked: the resident set is the device memory there.
+    const bool cpuDevice = ctx.caps().deviceType == VK_PHYSICAL_DEVICE_TYPE_CPU;
 
     scene::Camera camera;
     camera.lens = scene.lens;
@@ -108,10 +124,13 @@ TEST_CASE("2,400 frames with mode switches, resizes and history resets hold memo
         }
         executor.waitIdle();
         const gpu::MemoryStats memory = ctx.memory().stats();
-        samples[segment] = {residentBytes(), memory.blockBytes, memory.usedBytes, executor.stats().commandBuffers};
-        spdlog::info("soak segment {}: rss {:.1f} MB, device {:.1f} MB in blocks ({:.1f} used), {} command buffers",
+        samples[segment] = {residentBytes(), memory.blockBytes, memory.usedBytes, executor.stats().commandBuffers,
+                            ctx.deviceMemoryInUse().value_or(0)};
+        spdlog::info("soak segment {}: rss {:.1f} MB, device {:.1f} MB in blocks ({:.1f} used), driver {:.1f} MB, "
+                     "{} command buffers",
                      segment, double(samples[segment].rss) * 1e-6, double(memory.blockBytes) * 1e-6,
-                     double(memory.usedBytes) * 1e-6, samples[segment].commandBuffers);
+                     double(memory.usedBytes) * 1e-6, double(samples[segment].driverBytes) * 1e-6,
+                     samples[segment].commandBuffers);
     }
 
     // Every measured segment against the warm-up's last cycle of six (one
@@ -119,15 +138,18 @@ TEST_CASE("2,400 frames with mode switches, resizes and history resets hold memo
     // (it dips and returns by a few MB as lavapipe's threads free and take
     // memory), the rest against the warm-up's end.
     const Sample& warm = samples[kWarmUpSegments - 1];
-    uint64_t warmRss = 0;
-    for (uint32_t segment = kWarmUpSegments - 6; segment < kWarmUpSegments; ++segment)
+    uint64_t warmRss = 0, warmDriver = 0;
+    for (uint32_t segment = kWarmUpSegments - 6; segment < kWarmUpSegments; ++segment) {
         warmRss = std::max(warmRss, samples[segment].rss);
+        warmDriver = std::max(warmDriver, samples[segment].driverBytes);
+    }
     for (uint32_t segment = kWarmUpSegments; segment < kSegments; ++segment) {
         const Sample& s = samples[segment];
         CAPTURE(segment);
         CAPTURE(s.rss);
         CAPTURE(warmRss);
-        CHECK(double(s.rss) <= double(warmRss) * 1.01);
+        if (!kSanitized) CHECK(double(s.rss) <= double(warmRss) * 1.01);
+        if (!cpuDevice) CHECK(double(s.driverBytes) <= double(warmDriver) * 1.01);
         CHECK(s.deviceBlockBytes <= warm.deviceBlockBytes);
         CHECK(s.deviceUsedBytes <= warm.deviceUsedBytes);
         CHECK(s.commandBuffers == warm.commandBuffers);
