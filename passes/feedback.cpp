@@ -40,6 +40,12 @@ FeedbackOutputs addFeedbackPass(rg::Graph& graph, FeedbackPipelines& pipelines, 
     if (gbuf.width == 0 || gbuf.height == 0) {
         throw gpu::GpuError("addFeedbackPass: the G-buffer has no size");
     }
+    const auto fraction = [](float f) { return f >= 0.0f && f <= 1.0f; };
+    if (!fraction(settings.sslrMissFraction) || !fraction(settings.rtHitFraction)) {
+        throw gpu::GpuError("addFeedbackPass: sslrMissFraction and rtHitFraction must lie in [0, 1] (got " +
+                            std::to_string(settings.sslrMissFraction) + ", " + std::to_string(settings.rtHitFraction) +
+                            ")");
+    }
     FeedbackOutputs out;
     out.tilesX = (gbuf.width + shader::kTileSize - 1) / shader::kTileSize;
     out.tilesY = (gbuf.height + shader::kTileSize - 1) / shader::kTileSize;

@@ -68,8 +68,9 @@ struct CityMaterials {
     std::array<uint32_t, 4> carPaint{};
 };
 
-// Wet asphalt: glossy under its film of water, near-mirror in puddles (an fBm mask, as the plaza's paving; Lagarde, "Water drop 2b -
-// Dynamic rain and its effects", 2013), lane markings.
+// Wet asphalt: glossy under its film of water, near-mirror in puddles (an
+// fBm mask, as the plaza's paving; Lagarde, "Water drop 2b - Dynamic rain
+// and its effects", 2013), lane markings.
 struct RoadTextures {
     Texture baseColor;
     Texture metallicRoughness;
@@ -91,7 +92,7 @@ RoadTextures makeRoadTextures(uint32_t size, uint32_t seed) {
             // A dashed centre line (0.15 m wide, 3 m dashes every 6 m).
             const bool marking = std::abs(u - 0.5f) < 0.0075f && std::fmod(v * 10.0f, 6.0f) < 3.0f;
             glm::vec3 albedo = glm::vec3(0.07f, 0.07f, 0.075f) * grain;
-            // A film of water on the whole road: glossy (0.1-0.2) between the
+            // A film of water on the whole road: glossy (0.08-0.18) between the
             // puddles, so that the street reflects everywhere, blurred.
             float roughness = 0.08f + 0.1f * grain;
             if (marking) {

@@ -1098,6 +1098,20 @@ TEST_CASE("tile modes follow the carried counts and the feedback settings") {
     }
 }
 
+TEST_CASE("feedback refuses hit and miss fractions outside [0, 1]") {
+    test::GpuTest gpu;
+    Harness harness(gpu, wallScene());
+    const std::vector<uint32_t> counters(kTiles * kTiles, 0u);
+    passes::FeedbackSettings settings;
+    settings.rtHitFraction = 1.5f;
+    CHECK_THROWS_WITH_AS(harness.runFeedback(testCamera(), 0, counters, settings),
+                         doctest::Contains("rtHitFraction must lie in [0, 1]"), gpu::GpuError);
+    settings.rtHitFraction = 0.0f;
+    settings.sslrMissFraction = -0.1f;
+    CHECK_THROWS_WITH_AS(harness.runFeedback(testCamera(), 0, counters, settings),
+                         doctest::Contains("(got -0.1"), gpu::GpuError);
+}
+
 TEST_CASE("integrate refuses an RT radiance without its hit distance") {
     test::GpuTest gpu;
     auto& ctx = gpu.ctx();
