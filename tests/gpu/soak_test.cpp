@@ -41,6 +41,7 @@ namespace {
 
 constexpr uint32_t kSegmentFrames = 100;
 constexpr uint32_t kSegments = 24;
+constexpr uint32_t kWarmUpSegments = 12;
 // AddressSanitizer keeps freed memory in quarantine (up to 256 MB), so the
 // resident set of a sanitized run grows with what it frees, not with what
 // it holds: there the resident set is not checked (LeakSanitizer checks
@@ -50,10 +51,12 @@ constexpr bool kSanitized = true;
 #else
 constexpr bool kSanitized = false;
 #endif
-constexpr uint32_t kWarmUpSegments = 12;
 constexpr std::array<passes::ReflectionMode, 3> kModes = {
     passes::ReflectionMode::Hybrid, passes::ReflectionMode::Ssr, passes::ReflectionMode::Rt};
 constexpr std::array<glm::uvec2, 2> kSizes = {glm::uvec2(64, 64), glm::uvec2(96, 48)};
+// Segments until every mode has run at every size (3 and 2 are coprime).
+constexpr uint32_t kCycleSegments = uint32_t(kModes.size() * kSizes.size());
+static_assert(kWarmUpSegments % kCycleSegments == 0 && kWarmUpSegments >= 2 * kCycleSegments);
 
 // Resident set of this process, in bytes (/proc/self/statm's second field).
 uint64_t residentBytes() {
@@ -133,13 +136,13 @@ TEST_CASE("2,400 frames with mode switches, resizes and history resets hold memo
                      samples[segment].commandBuffers);
     }
 
-    // Every measured segment against the warm-up's last cycle of six (one
+    // Every measured segment against the warm-up's last cycle (one segment
     // of each mode and size): the resident set against its highest there
     // (it dips and returns by a few MB as lavapipe's threads free and take
     // memory), the rest against the warm-up's end.
     const Sample& warm = samples[kWarmUpSegments - 1];
     uint64_t warmRss = 0, warmDriver = 0;
-    for (uint32_t segment = kWarmUpSegments - 6; segment < kWarmUpSegments; ++segment) {
+    for (uint32_t segment = kWarmUpSegments - kCycleSegments; segment < kWarmUpSegments; ++segment) {
         warmRss = std::max(warmRss, samples[segment].rss);
         warmDriver = std::max(warmDriver, samples[segment].driverBytes);
     }
