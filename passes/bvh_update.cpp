@@ -144,10 +144,11 @@ struct BvhManager::FrameWork {
     // Particles: empty without (then nothing below is recorded).
     std::vector<shader::ParticleData> particles;
     shader::ParticleBillboardParams billboard{};
-    std::optional<gpu::AccelBuild> particleBlasBuild;
+    // One BLAS build and one TLAS instance per quad axis.
+    std::vector<gpu::AccelBuild> particleBlasBuilds;
     std::optional<gpu::AccelBuild> particleTlasBuild;
-    VkAccelerationStructureInstanceKHR particleInstance{};
-    VkDeviceSize particleBlasScratchOffset = 0;  // beside the BLAS builds
+    std::array<VkAccelerationStructureInstanceKHR, shader::kParticleQuadAxes> particleInstances{};
+    std::array<VkDeviceSize, shader::kParticleQuadAxes> particleBlasScratchOffsets{};  // beside the BLAS builds
     VkDeviceSize particleTlasScratchOffset = 0;  // beside the TLAS build
 };
 
@@ -396,13 +397,15 @@ void BvhManager::prepareParticles(const scene::BvhPlan& plan, const scene::Camer
             replace(staging, {dataBytes, VK_BUFFER_USAGE_TRANSFER_SRC_BIT, gpu::MemoryUsage::Upload,
                               "bvh.particles.staging", true});
         }
-        replace(particleQuads_, {VkDeviceSize(particleCapacity_) * shader::kParticleQuadVertices * sizeof(glm::vec3),
+        replace(particleQuads_, {VkDeviceSize(particleCapacity_) * shader::kParticleQuadAxes *
+                                     shader::kParticleQuadVertices * sizeof(glm::vec3),
                                  VK_BUFFER_USAGE_STORAGE_BUFFER_BIT | kBuildInput, gpu::MemoryUsage::DeviceLocal,
                                  "bvh.particle_quads", true});
         for (gpu::Buffer& instances : particleInstances_) {
             if (!instances) {
-                instances = gpu::Buffer(ctx_, {sizeof(VkAccelerationStructureInstanceKHR), kBuildInput,
-                                               gpu::MemoryUsage::Upload, "bvh.particle_tlas_instance", true});
+                instances = gpu::Buffer(ctx_, {sizeof(VkAccelerationStructureInstanceKHR) * shader::kParticleQuadAxes,
+                                               kBuildInput, gpu::MemoryUsage::Upload, "bvh.particle_tlas_instances",
+                                               true});
             }
         }
         // Sized for the capacity: a build of fewer quads fits (Vulkan only
@@ -414,18 +417,21 @@ void BvhManager::prepareParticles(const scene::BvhPlan& plan, const scene::Camer
         sizing.triangleCount = particleCapacity_ * 2;
         sizing.opaque = false;
         const gpu::AccelBuild blasSizing = gpu::AccelBuild::bottomLevel(ctx_, {&sizing, 1}, options_.particleFlags);
-        if (particleBlas_) retire(std::move(particleBlas_));
-        particleBlas_ = std::make_unique<gpu::AccelerationStructure>(
-            ctx_, VK_ACCELERATION_STRUCTURE_TYPE_BOTTOM_LEVEL_KHR, blasSizing.structureSize(), "bvh.particle_blas", true);
+        stats_.particleBytes = particleData_.size() + particleQuads_.size();
+        for (std::unique_ptr<gpu::AccelerationStructure>& blas : particleBlases_) {
+            if (blas) retire(std::move(blas));
+            blas = std::make_unique<gpu::AccelerationStructure>(ctx_, VK_ACCELERATION_STRUCTURE_TYPE_BOTTOM_LEVEL_KHR,
+                                                                blasSizing.structureSize(), "bvh.particle_blas", true);
+            stats_.particleBytes += blas->buffer().size();
+        }
         if (!particleTlas_) {
-            const gpu::AccelBuild tlasSizing =
-                gpu::AccelBuild::topLevel(ctx_, particleInstances_[0].address(), 1, options_.particleFlags);
+            const gpu::AccelBuild tlasSizing = gpu::AccelBuild::topLevel(ctx_, particleInstances_[0].address(),
+                                                                         shader::kParticleQuadAxes, options_.particleFlags);
             particleTlas_ = std::make_unique<gpu::AccelerationStructure>(
                 ctx_, VK_ACCELERATION_STRUCTURE_TYPE_TOP_LEVEL_KHR, tlasSizing.structureSize(), "bvh.particle_tlas",
                 true);
         }
-        stats_.particleBytes = particleData_.size() + particleQuads_.size() + particleBlas_->buffer().size() +
-                               particleTlas_->buffer().size();
+        stats_.particleBytes += particleTlas_->buffer().size();
     }
 
     work.particles.resize(count);
@@ -433,29 +439,33 @@ void BvhManager::prepareParticles(const scene::BvhPlan& plan, const scene::Camer
         const scene::Particle& p = scene_.particles[i];
         work.particles[i] = {p.position, p.radius, p.color};
     }
-    // The camera's right and up in world space: the view matrix's first
-    // two rows (its rotation is orthonormal). The forward pass
-    // (passes/particles.cpp) faces its billboards the same way.
-    const glm::mat4& view = camera.view;
-    work.billboard.right = glm::normalize(glm::vec3(view[0][0], view[1][0], view[2][0]));
-    work.billboard.up = glm::normalize(glm::vec3(view[0][1], view[1][1], view[2][1]));
+    // The camera's basis in world space, the quads' axes: the view
+    // matrix's rows (its rotation is orthonormal). The forward pass
+    // (passes/particles.cpp) faces its billboards along the same right and up.
+    work.billboard = particleBasis(camera.view);
     work.billboard.count = count;
 
-    gpu::TriangleGeometry quads;
-    quads.vertices = particleQuads_.address();
-    quads.vertexCount = count * shader::kParticleQuadVertices;
-    quads.triangleCount = count * 2;
-    // Not opaque: the traces look at every quad a ray crosses (any-hit or
-    // the ray query's candidates) and keep the nearest covering ones.
-    quads.opaque = false;
-    work.particleBlasBuild = gpu::AccelBuild::bottomLevel(ctx_, {&quads, 1}, options_.particleFlags);
+    // Axis a's quads are the a-th third of the quads buffer (particle_quads.comp).
     const float identity[12] = {1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1, 0};
-    work.particleInstance =
-        gpu::makeInstance(*particleBlas_, identity, 0, uint8_t(shader::kInstanceMaskAll), shader::kSbtOffsetParticles);
-    work.particleTlasBuild =
-        gpu::AccelBuild::topLevel(ctx_, particleInstances_[work.slot].address(), 1, options_.particleFlags);
+    const VkDeviceSize axisBytes = VkDeviceSize(count) * shader::kParticleQuadVertices * sizeof(glm::vec3);
+    for (uint32_t axis = 0; axis < shader::kParticleQuadAxes; ++axis) {
+        gpu::TriangleGeometry quads;
+        quads.vertices = particleQuads_.address() + axis * axisBytes;
+        quads.vertexCount = count * shader::kParticleQuadVertices;
+        quads.triangleCount = count * 2;
+        // Not opaque: the traces look at every quad a ray crosses (any-hit or
+        // the ray query's candidates) and keep the nearest covering ones.
+        quads.opaque = false;
+        work.particleBlasBuilds.push_back(gpu::AccelBuild::bottomLevel(ctx_, {&quads, 1}, options_.particleFlags));
+        work.particleInstances[axis] = gpu::makeInstance(*particleBlases_[axis], identity, 0,
+                                                         uint8_t(shader::particleAxisMask(axis)),
+                                                         shader::kSbtOffsetParticles);
+    }
+    work.particleTlasBuild = gpu::AccelBuild::topLevel(ctx_, particleInstances_[work.slot].address(),
+                                                       shader::kParticleQuadAxes, options_.particleFlags);
     stats_.particleTlasBuilds = 1;
     stats_.particles = count;
+    stats_.particleQuads = count * shader::kParticleQuadAxes;
     stats_.particleDispatches = 1;
 }
 
@@ -496,7 +506,7 @@ std::shared_ptr<BvhManager::FrameWork> BvhManager::prepare(const scene::BvhPlan&
     stats_.frame = frame_;
     stats_.blasBuilds = stats_.blasRebuilds = stats_.blasReleased = 0;
     stats_.packedTriangles = stats_.packDispatches = 0;
-    stats_.particleTlasBuilds = stats_.particles = stats_.particleDispatches = 0;
+    stats_.particleTlasBuilds = stats_.particles = stats_.particleQuads = stats_.particleDispatches = 0;
 
     for (const scene::BlasDrop& drop : plan.drops) {
         const auto it = blases_.find(drop.blas);
@@ -630,9 +640,11 @@ std::shared_ptr<BvhManager::FrameWork> BvhManager::prepare(const scene::BvhPlan&
     if (plan.particleTlas && camera) {
         prepareParticles(plan, *camera, *work);
     }
-    if (work->particleBlasBuild) {
-        work->particleBlasScratchOffset = blasScratch;
-        blasScratch += work->particleBlasBuild->scratchSize();
+    if (work->particleTlasBuild) {
+        for (uint32_t axis = 0; axis < shader::kParticleQuadAxes; ++axis) {
+            work->particleBlasScratchOffsets[axis] = blasScratch;
+            blasScratch += work->particleBlasBuilds[axis].scratchSize();
+        }
         work->particleTlasScratchOffset = tlasScratch;
         tlasScratch += work->particleTlasBuild->scratchSize();
     }
@@ -680,7 +692,7 @@ void BvhManager::record(FrameWork& work, rg::PassContext& pc, const BvhUpdateOut
     if (particles) {
         std::memcpy(particleStaging_[slot].mapped(), work.particles.data(),
                     work.particles.size() * sizeof(shader::ParticleData));
-        std::memcpy(particleInstances_[slot].mapped(), &work.particleInstance, sizeof(work.particleInstance));
+        std::memcpy(particleInstances_[slot].mapped(), work.particleInstances.data(), sizeof(work.particleInstances));
     }
 
     // Resources the graph does not see (BLASes, their positions, an outgrown
@@ -760,8 +772,10 @@ void BvhManager::record(FrameWork& work, rg::PassContext& pc, const BvhUpdateOut
         }
         if (particles) {
             // Rebuilt every frame: the quads turned with the camera.
-            work.particleBlasBuild->record(ctx_, cmd, particleBlas_->handle(),
-                                           scratch.address() + work.particleBlasScratchOffset);
+            for (uint32_t axis = 0; axis < shader::kParticleQuadAxes; ++axis) {
+                work.particleBlasBuilds[axis].record(ctx_, cmd, particleBlases_[axis]->handle(),
+                                                     scratch.address() + work.particleBlasScratchOffsets[axis]);
+            }
         }
         // BLAS writes -> TLAS build reads; the TLAS build also reuses the scratch.
         gpu::memoryBarrier(cmd, VK_PIPELINE_STAGE_2_ACCELERATION_STRUCTURE_BUILD_BIT_KHR,
@@ -777,6 +791,14 @@ void BvhManager::record(FrameWork& work, rg::PassContext& pc, const BvhUpdateOut
         work.particleTlasBuild->record(ctx_, cmd, pc.accel(handles.particleTlas).handle(),
                                        scratch.address() + work.particleTlasScratchOffset);
     }
+}
+
+shader::ParticleBillboardParams particleBasis(const glm::mat4& view) {
+    shader::ParticleBillboardParams basis{};
+    basis.right = glm::normalize(glm::vec3(view[0][0], view[1][0], view[2][0]));
+    basis.up = glm::normalize(glm::vec3(view[0][1], view[1][1], view[2][1]));
+    basis.back = glm::normalize(glm::vec3(view[0][2], view[1][2], view[2][2]));
+    return basis;
 }
 
 BvhUpdateOutputs addBvhUpdatePass(rg::Graph& graph, BvhManager& manager, const scene::BvhPlan& plan) {

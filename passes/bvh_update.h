@@ -22,11 +22,13 @@
 //
 // Particles (issue 4's particle TLAS, DESIGN.md section 3 pass 0): when the
 // plan says particleTlas and the pass is given the camera, the same pass
-// uploads the scene's particles (per frame in flight), writes a
-// camera-facing quad per particle (shaders/bvh/particle_quads.comp, in the
-// pack step), builds one BLAS of those quads beside the other BLASes and a
-// particle TLAS of that one instance (kSbtOffsetParticles) beside the TLAS,
-// both every frame with fast build. A scene without particles gets no
+// uploads the scene's particles (per frame in flight), writes three quads
+// per particle, one facing each of the camera's axes
+// (shaders/bvh/particle_quads.comp, in the pack step; why three:
+// glint/particles_shared.h), builds a BLAS per axis beside the other
+// BLASes and a particle TLAS of their three instances (mask
+// particleAxisMask(axis), kSbtOffsetParticles) beside the TLAS, all every
+// frame with fast build. A scene without particles gets no
 // particle buffer, BLAS, TLAS or dispatch (issue 4: model only what a scene
 // needs); BvhUpdateOutputs::particleTlas is then invalid.
 //
@@ -60,6 +62,9 @@
 #include "scene/camera.h"
 #include "scene/scene.h"
 
+#include "glint/particles_shared.h"
+
+#include <array>
 #include <cstdint>
 #include <map>
 #include <memory>
@@ -107,11 +112,13 @@ struct BvhGpuStats {
     uint64_t uploadBytes = 0;         // staged for those uploads, all frames (copied inside the update pass)
     uint64_t scratchBytes = 0;        // this frame's scratch request to the graph
     uint64_t totalBlasBuilds = 0;     // first builds and rebuilds, all frames
-    // Particles: this frame's particle BLAS/TLAS builds (1 or 0: none
-    // without particles), their particles and quad dispatches; the bytes
-    // of what is allocated for them (BLAS, TLAS, quads, particle data).
+    // Particles: this frame's particle TLAS builds (1 or 0: none without
+    // particles), their particles, their quads in the particle BLASes
+    // (kParticleQuadAxes per particle) and quad dispatches; the bytes of
+    // what is allocated for them (BLASes, TLAS, quads, particle data).
     uint32_t particleTlasBuilds = 0;
     uint32_t particles = 0;
+    uint32_t particleQuads = 0;
     uint32_t particleDispatches = 0;
     uint64_t particleBytes = 0;
 };
@@ -212,13 +219,14 @@ private:
     uint64_t scratchCapacity_ = 0;                // high-water mark of the scratch request
     // Particles, allocated on the first frame with particles, grown in
     // powers of two: the data (device-local, read by the traces) and its
-    // per-slot staging, the quads (build input), the BLAS and TLAS sized
-    // for the capacity, the TLAS's one instance per slot.
+    // per-slot staging, the quads (build input, three per particle), a
+    // BLAS per quad axis and the TLAS sized for the capacity, the TLAS's
+    // instances (one per axis) per slot.
     uint32_t particleCapacity_ = 0;
     gpu::Buffer particleData_;
     std::vector<gpu::Buffer> particleStaging_;
     gpu::Buffer particleQuads_;
-    std::unique_ptr<gpu::AccelerationStructure> particleBlas_;
+    std::array<std::unique_ptr<gpu::AccelerationStructure>, shader::kParticleQuadAxes> particleBlases_;
     std::unique_ptr<gpu::AccelerationStructure> particleTlas_;
     std::vector<gpu::Buffer> particleInstances_;
     std::vector<Retired> retired_;
@@ -237,6 +245,10 @@ BvhUpdateOutputs addBvhUpdatePass(rg::Graph& graph, BvhManager& manager, const s
 // plan.particleTlas (see the top of this file).
 BvhUpdateOutputs addBvhUpdatePass(rg::Graph& graph, BvhManager& manager, const scene::BvhPlan& plan,
                                   const scene::Camera& camera);
+
+// The camera's basis (right, up, back in world space) that the particle
+// quads are built in and the forward pass's billboards face; count 0.
+shader::ParticleBillboardParams particleBasis(const glm::mat4& view);
 
 // The state the imports are left in and expected in: read by the trace
 // passes on the graphics queue, from compute (ray query) or the ray tracing

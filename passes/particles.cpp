@@ -62,12 +62,12 @@ std::string unsupportedMessage(const gpu::Context& ctx, RtBackend backend) {
     return "particle trace: " + device + " has neither ray query nor a ray tracing pipeline";
 }
 
-// Push constants of the forward pass (96 bytes).
+// Push constants of the forward pass (112 bytes).
 struct ForwardPush {
     glm::mat4 viewProjection;
     shader::ParticleBillboardParams basis;
 };
-static_assert(sizeof(ForwardPush) == 96);
+static_assert(sizeof(ForwardPush) == 112);
 
 // vkCmdUpdateBuffer takes at most 65536 bytes per call.
 constexpr VkDeviceSize kUpdateChunkBytes = 65536;
@@ -182,6 +182,11 @@ ParticleTraceOutputs addParticleTracePass(rg::Graph& graph, ParticlePipelines& p
     shader::ParticleTraceConstants constants{};
     constants.inverseViewProjection = glm::inverse(inputs.camera.viewProjection());
     constants.cameraPosition = glm::vec4(inputs.camera.position, 1.0f);
+    // The basis the BVH update built this frame's quads in: the same camera's.
+    const shader::ParticleBillboardParams basis = particleBasis(inputs.camera.view);
+    constants.cameraRight = glm::vec4(basis.right, 0.0f);
+    constants.cameraUp = glm::vec4(basis.up, 0.0f);
+    constants.cameraBack = glm::vec4(basis.back, 0.0f);
     constants.size = {gbuf.width, gbuf.height};
     constants.confidenceThreshold = sslrStoredThreshold(settings.confidenceThreshold);
     constants.maxDistance = settings.maxDistance;
@@ -308,8 +313,7 @@ ParticleForwardOutputs addParticleForwardPass(rg::Graph& graph, ParticlePipeline
     ForwardPush push{};
     // As the G-buffer rasterised (jittered), so the depth test compares like with like.
     push.viewProjection = inputs.camera.jitteredProjection * view;
-    push.basis.right = glm::normalize(glm::vec3(view[0][0], view[1][0], view[2][0]));
-    push.basis.up = glm::normalize(glm::vec3(view[0][1], view[1][1], view[2][1]));
+    push.basis = particleBasis(view);
     push.basis.count = uint32_t(data->size());
 
     struct UploadData {

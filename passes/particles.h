@@ -4,8 +4,10 @@
 //
 // The particle trace. For every traced reflection ray - the ray leaders
 // of ray generation's SSLR, hybrid and RT pixels, whichever trace resolved
-// them - one ray through the BVH update's particle TLAS (camera-facing
-// quads, passes/bvh_update.h) from the G-buffer surface along the ray's
+// them - one ray through the BVH update's particle TLAS (three quads per
+// particle, one facing each camera axis; the ray's cull mask picks the
+// axis its direction is largest along, so it meets each particle once,
+// never edge-on: glint/particles_shared.h) from the G-buffer surface along the ray's
 // direction, up to the distance integrate will give the pixel's
 // reflection: the particle pass reads the same SSLR and RT outputs as
 // integrate and makes the same choice (glint/integrate_shared.h's
@@ -27,7 +29,7 @@
 // it (IntegrateInputs::particles): particles.rgb + (1 - a) * reflection.
 //
 // The forward pass. The particles drawn into the G-buffer's lit colour as
-// camera-facing billboards (the same quads and coverage as the trace),
+// camera-facing billboards (the trace's back-axis quads, the same coverage),
 // premultiplied "over" blending, depth-tested against the G-buffer's
 // reversed-Z depth without writing it, back to front.
 //

@@ -274,7 +274,8 @@ struct Instance {
     uint64_t deformVersion = 0;
 };
 
-// A camera-facing quad of the particle TLAS.
+// A soft round sprite: a camera-facing billboard in the direct view, three
+// quads (one per camera axis) in the particle TLAS (glint/particles_shared.h).
 struct Particle {
     glm::vec3 position{0.0f};
     float radius = 0.1f;

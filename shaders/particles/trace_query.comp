@@ -11,11 +11,11 @@
 
 layout(local_size_x = kParticleTraceGroupSize, local_size_y = kParticleTraceGroupSize) in;
 
-ParticleHits particleTraceSegment(vec3 origin, vec3 direction, float tMax) {
+ParticleHits particleTraceSegment(vec3 origin, vec3 direction, float tMax, uint cullMask) {
     ParticleHits hits;
     particleHitsClear(hits);
     rayQueryEXT query;
-    rayQueryInitializeEXT(query, particleTlas, gl_RayFlagsNoneEXT, 0xFFu, origin, 0.0, direction, tMax);
+    rayQueryInitializeEXT(query, particleTlas, gl_RayFlagsNoneEXT, cullMask, origin, 0.0, direction, tMax);
     while (rayQueryProceedEXT(query)) {
         if (rayQueryGetIntersectionTypeEXT(query, false) == gl_RayQueryCandidateIntersectionTriangleEXT) {
             particleConsiderHit(hits, origin, direction, rayQueryGetIntersectionTEXT(query, false),

@@ -5,9 +5,12 @@
 // reflects, particle A floating in front of the wall (so the floor's
 // reflection shows it) and particle B behind the wall (its reflection
 // would show on the floor but the wall hides it). The camera looks down -Z
-// from the origin, so the quads face +Z. A CPU reference intersects each
-// floor pixel's mirror ray with A's quad and evaluates the coverage the
-// shaders evaluate (glint/particles_shared.h).
+// from the origin. A CPU reference intersects each floor pixel's mirror ray
+// with the quad of A that the ray sees (the one facing the camera axis the
+// ray's direction is largest along) and evaluates the coverage the shaders
+// evaluate (glint/particles_shared.h). A second scene looks down at a
+// mirror floor at 42 degrees, so that the floor reflects rays at 84 degrees
+// to the view: they meet a camera-facing quad nearly edge-on.
 #include "support/gpu_test.h"
 #include "support/pass_test_scene.h"
 
@@ -32,7 +35,10 @@
 
 #include <glm/gtc/packing.hpp>
 
+#include <glm/gtc/matrix_transform.hpp>
+
 #include <algorithm>
+#include <bit>
 #include <cmath>
 #include <cstring>
 #include <optional>
@@ -89,6 +95,35 @@ scene::Scene mirrorScene(bool withParticles) {
     return s;
 }
 
+// The edge-on scene: the camera 2 above the floor looks down at 42
+// degrees, so the floor's mirror rays leave it at 84 degrees to the view
+// direction; particle C floats on the mirror ray of the image's centre,
+// 2 units from the floor.
+constexpr float kEdgeOnPitch = glm::radians(44.0f);
+const glm::vec3 kEdgeOnEye{0.0f, kFloorY + 2.0f, 0.0f};
+
+scene::Camera edgeOnCamera() {
+    scene::Camera camera = test::testCamera();
+    const glm::vec3 forward(0.0f, -std::sin(kEdgeOnPitch), -std::cos(kEdgeOnPitch));
+    camera.reset({kEdgeOnEye, kEdgeOnEye + forward, {0, 1, 0}}, 0);
+    return camera;
+}
+
+scene::Particle edgeOnParticle() {
+    const glm::vec3 forward(0.0f, -std::sin(kEdgeOnPitch), -std::cos(kEdgeOnPitch));
+    const glm::vec3 floorPoint = kEdgeOnEye + ((kFloorY - kEdgeOnEye.y) / forward.y) * forward;
+    const glm::vec3 mirror = glm::reflect(forward, glm::vec3(0, 1, 0));
+    return {floorPoint + 2.0f * mirror, 0.65f, {0.3f, 1.0f, 0.4f, 0.9f}};
+}
+
+scene::Scene edgeOnScene() {
+    scene::Scene s = mirrorScene(false);
+    s.instances.resize(1);  // the floor alone
+    s.particles = {edgeOnParticle()};
+    scene::prepareScene(s);
+    return s;
+}
+
 size_t pixelIndex(uint32_t x, uint32_t y) { return size_t(y) * kSize + x; }
 
 // The floor point seen at pixel (x, y) and the CPU's expected particle
@@ -98,27 +133,53 @@ struct Expected {
     glm::vec4 particles{0.0f};
 };
 
-Expected expectedAt(const scene::Camera& camera, uint32_t x, uint32_t y) {
-    Expected e;
+// Which of a particle's quads a ray meets (glint/particles_shared.h).
+enum class Quads { ByRayAxis, BillboardOnly };
+
+// Premultiplied colour and coverage of `particle` along the ray from `p`
+// in direction `r`, through the quad `quads` picks: the plane through its
+// centre facing that camera axis.
+glm::vec4 particleAlong(const scene::Camera& camera, const scene::Particle& particle, glm::vec3 p, glm::vec3 r,
+                        Quads quads) {
+    const shader::ParticleBillboardParams basis = passes::particleBasis(camera.view);
+    const glm::vec3 axes[shader::kParticleQuadAxes] = {basis.right, basis.up, basis.back};
+    const uint32_t axis = quads == Quads::BillboardOnly
+                              ? shader::kParticleAxisBack
+                              : shader::particleQuadAxis(glm::vec3(glm::dot(r, basis.right), glm::dot(r, basis.up),
+                                                                   glm::dot(r, basis.back)));
+    const glm::vec3 normal = axes[axis];
+    const float facing = glm::dot(r, normal);
+    if (std::abs(facing) < 1e-6f) return glm::vec4(0.0f);
+    const float t = glm::dot(particle.position - p, normal) / facing;
+    if (t <= 0.0f) return glm::vec4(0.0f);
+    const shader::ParticleData data{particle.position, particle.radius, particle.color};
+    const float coverage = shader::particleCoverageAt(data, p + t * r);
+    return glm::vec4(glm::vec3(particle.color) * coverage, coverage);
+}
+
+// The floor point (y = kFloorY, in front of `wallZ`) seen at pixel (x, y)
+// and its mirror ray; false where the pixel sees no floor.
+bool floorRay(const scene::Camera& camera, uint32_t x, uint32_t y, float wallZ, glm::vec3& p, glm::vec3& r) {
     const glm::mat4 inv = glm::inverse(camera.viewProjection());
     const glm::vec2 ndc = test::pixelNdc(x, y);
     const glm::vec4 a = inv * glm::vec4(ndc, 1.0f, 1.0f);
     const glm::vec4 b = inv * glm::vec4(ndc, 0.5f, 1.0f);
     const glm::vec3 origin = glm::vec3(a) / a.w;
     const glm::vec3 dir = glm::normalize(glm::vec3(b) / b.w - origin);
-    if (dir.y >= -1e-4f) return e;
+    if (dir.y >= -1e-4f) return false;
     const float s = (kFloorY - origin.y) / dir.y;
-    const glm::vec3 p = origin + s * dir;
-    if (p.z < kWallZ || std::abs(p.x) > 8.0f) return e;
+    p = origin + s * dir;
+    if (p.z < wallZ || std::abs(p.x) > 8.0f) return false;
+    r = glm::reflect(dir, glm::vec3(0, 1, 0));
+    return true;
+}
+
+Expected expectedAt(const scene::Camera& camera, uint32_t x, uint32_t y) {
+    Expected e;
+    glm::vec3 p, r;
+    if (!floorRay(camera, x, y, kWallZ, p, r)) return e;
     e.floor = true;
-    const glm::vec3 r = glm::reflect(dir, glm::vec3(0, 1, 0));
-    // A's quad: the plane z = A.z (it faces the camera, which looks down -Z).
-    const float t = (kParticleA.position.z - p.z) / r.z;
-    if (t <= 0.0f) return e;
-    const glm::vec3 q = p + t * r;
-    const shader::ParticleData particle{kParticleA.position, kParticleA.radius, kParticleA.color};
-    const float coverage = shader::particleCoverageAt(particle, q);
-    e.particles = glm::vec4(glm::vec3(kParticleA.color) * coverage, coverage);
+    e.particles = particleAlong(camera, kParticleA, p, r, Quads::ByRayAxis);
     return e;
 }
 
@@ -140,10 +201,10 @@ struct Frame {
 
 class Rig {
 public:
-    Rig(gpu::Context& ctx, scene::Scene s)
+    Rig(gpu::Context& ctx, scene::Scene s, scene::Camera camera = test::testCamera())
         : ctx_(ctx),
           scene_(std::move(s)),
-          camera_(test::testCamera()),
+          camera_(std::move(camera)),
           executor_(ctx),
           renderer_(ctx, scene_),
           bvh_(ctx, scene_),
@@ -416,6 +477,98 @@ TEST_CASE("a particle in front of a mirror tints exactly the reflected rays thro
     }
 }
 
+TEST_CASE("a particle reflected at 80-89 degrees to its billboard keeps its coverage: each ray meets the quad facing "
+          "its largest view axis, once") {
+    test::GpuTest gpu;
+    auto& ctx = gpu.ctx();
+    const auto backends = availableBackends(ctx);
+    REQUIRE_FALSE(backends.empty());
+    const scene::Camera camera = edgeOnCamera();
+    const scene::Particle c = edgeOnParticle();
+    const shader::ParticleBillboardParams basis = passes::particleBasis(camera.view);
+    Rig rig(ctx, edgeOnScene(), camera);
+    for (const passes::RtBackend backend : backends) {
+        const std::string backendName = passes::rtBackendName(backend);
+        CAPTURE(backendName);
+        const Frame f = rig.run(passes::ReflectionMode::Rt, backend);
+        REQUIRE(f.traced);
+        CHECK(f.bvh.particles == 1u);
+        CHECK(f.bvh.particleQuads == shader::kParticleQuadAxes);
+        uint32_t covered = 0, wrong = 0;
+        double sumGot = 0.0, sumExpected = 0.0, sumBillboard = 0.0;
+        float peak = 0.0f, expectedPeak = 0.0f, nearestToNormal = 90.0f;
+        for (uint32_t y = 0; y < kSize; ++y) {
+            for (uint32_t x = 0; x < kSize; ++x) {
+                const glm::vec4 got = f.particles[pixelIndex(x, y)];
+                glm::vec3 p, r;
+                if (!floorRay(camera, x, y, -1e9f, p, r)) {
+                    CHECK(got == glm::vec4(0.0f));
+                    continue;
+                }
+                const glm::vec4 expected = particleAlong(camera, c, p, r, Quads::ByRayAxis);
+                if (!near(got, expected, 0.02f) && wrong++ < 5) {
+                    MESSAGE("pixel " << x << "," << y << ": " << text(got) << " vs " << text(expected));
+                }
+                sumGot += got.a;
+                sumExpected += expected.a;
+                sumBillboard += particleAlong(camera, c, p, r, Quads::BillboardOnly).a;
+                peak = std::max(peak, got.a);
+                expectedPeak = std::max(expectedPeak, expected.a);
+                if (expected.a > 0.0f) {
+                    ++covered;
+                    const float degrees = glm::degrees(std::acos(std::abs(glm::dot(r, basis.back))));
+                    nearestToNormal = std::min(nearestToNormal, degrees);
+                }
+            }
+        }
+        MESSAGE(covered << " pixels see C; coverage summed " << sumGot << " (expected " << sumExpected
+                        << ", through the billboard alone " << sumBillboard << "); rays at least " << nearestToNormal
+                        << " degrees from the billboard's normal");
+        // The rays that see C all meet its billboard between 80 and 90 degrees.
+        CHECK(nearestToNormal >= 80.0f);
+        CHECK(covered > 50);
+        CHECK(wrong == 0);
+        CHECK(std::abs(sumGot - sumExpected) <= 0.02 * sumExpected);
+        // Through the camera-facing quad alone the reflection keeps a sliver.
+        CHECK(sumBillboard < 0.2 * sumExpected);
+        // Seen once: the ray nearest C's centre gets nearly its alpha, not more.
+        CHECK(expectedPeak > 0.9f * c.color.a);
+        CHECK(std::abs(peak - expectedPeak) <= 0.02f);
+        CHECK(peak <= c.color.a + 1e-3f);
+    }
+}
+
+TEST_CASE("a particle's quad axis follows the ray's largest view-space component, one mask per direction") {
+    using namespace shader;
+    CHECK(particleQuadAxis({0.0f, 0.0f, -1.0f}) == kParticleAxisBack);
+    CHECK(particleQuadAxis({0.9f, 0.1f, 0.3f}) == kParticleAxisRight);
+    CHECK(particleQuadAxis({-0.2f, -0.9f, 0.3f}) == kParticleAxisUp);
+    // Ties: back before right before up, so a diagonal ray still sees one quad.
+    CHECK(particleQuadAxis({0.5f, 0.5f, 0.5f}) == kParticleAxisBack);
+    CHECK(particleQuadAxis({0.5f, 0.5f, 0.1f}) == kParticleAxisRight);
+    // Distinct single-bit masks, none of them the main TLAS's "all".
+    uint32_t masks = 0;
+    for (uint32_t axis = 0; axis < kParticleQuadAxes; ++axis) {
+        const uint32_t mask = particleAxisMask(axis);
+        CHECK(std::popcount(mask) == 1);
+        CHECK((masks & mask) == 0u);
+        masks |= mask;
+    }
+    // Each quad spans the two axes it does not face.
+    const glm::mat4 view = glm::lookAt(glm::vec3(1, 2, 3), glm::vec3(0, 0, 0), glm::vec3(0, 1, 0));
+    const ParticleBillboardParams basis = passes::particleBasis(view);
+    const glm::vec3 axes[kParticleQuadAxes] = {basis.right, basis.up, basis.back};
+    for (uint32_t axis = 0; axis < kParticleQuadAxes; ++axis) {
+        CAPTURE(axis);
+        CHECK(std::abs(glm::dot(particleQuadSpanU(basis, axis), axes[axis])) < 1e-6f);
+        CHECK(std::abs(glm::dot(particleQuadSpanV(basis, axis), axes[axis])) < 1e-6f);
+        CHECK(std::abs(glm::dot(particleQuadSpanU(basis, axis), particleQuadSpanV(basis, axis))) < 1e-6f);
+    }
+    // The billboard the forward pass draws is the back axis's quad.
+    CHECK(particleQuadSpanU(basis, kParticleAxisBack) == basis.right);
+    CHECK(particleQuadSpanV(basis, kParticleAxisBack) == basis.up);
+}
+
 TEST_CASE("particles behind the reflected surface are not composited; without a trace to end the ray they would be") {
     test::GpuTest gpu;
     auto& ctx = gpu.ctx();
@@ -446,10 +599,13 @@ TEST_CASE("the ray query and the ray tracing pipeline particle traces are bit-id
         MESSAGE("device '" << ctx.caps().deviceName << "' has one backend; nothing to compare");
         return;
     }
-    Rig rig(ctx, mirrorScene(true));
-    for (const passes::ReflectionMode mode : {passes::ReflectionMode::Rt, passes::ReflectionMode::Hybrid}) {
-        const Frame query = rig.run(mode, passes::RtBackend::RayQuery);
-        const Frame pipeline = rig.run(mode, passes::RtBackend::Pipeline);
+    Rig mirror(ctx, mirrorScene(true));
+    Rig edgeOn(ctx, edgeOnScene(), edgeOnCamera());
+    for (const auto& [rig, mode] : {std::pair{&mirror, passes::ReflectionMode::Rt},
+                                    std::pair{&mirror, passes::ReflectionMode::Hybrid},
+                                    std::pair{&edgeOn, passes::ReflectionMode::Rt}}) {
+        const Frame query = rig->run(mode, passes::RtBackend::RayQuery);
+        const Frame pipeline = rig->run(mode, passes::RtBackend::Pipeline);
         uint32_t differing = 0, covered = 0;
         for (size_t i = 0; i < kPixels; ++i) {
             if (query.particleBits[i] != pipeline.particleBits[i] && differing++ < 5) {
@@ -471,6 +627,7 @@ TEST_CASE("a scene without particles builds no particle TLAS, buffer or dispatch
         CHECK_FALSE(f.traced);
         CHECK(f.bvh.particleTlasBuilds == 0);
         CHECK(f.bvh.particles == 0);
+        CHECK(f.bvh.particleQuads == 0);
         CHECK(f.bvh.particleDispatches == 0);
         CHECK(f.bvh.particleBytes == 0);
         // Nothing drawn: the forward pass declared nothing, the lit colour is untouched.
@@ -482,6 +639,7 @@ TEST_CASE("a scene without particles builds no particle TLAS, buffer or dispatch
         CHECK(f.traced);
         CHECK(f.bvh.particleTlasBuilds == 1);
         CHECK(f.bvh.particles == 2);
+        CHECK(f.bvh.particleQuads == 2 * shader::kParticleQuadAxes);
         CHECK(f.bvh.particleDispatches == 1);
         CHECK(f.bvh.particleBytes > 0);
     }

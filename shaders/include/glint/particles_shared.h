@@ -4,13 +4,23 @@
 // and the constants of the passes; shared by GLSL and C++. Buffers use
 // scalar layout.
 //
-// A particle is a camera-facing quad of half-size `radius` (two triangles,
-// primitives 2i and 2i + 1 of particle i in the particle BLAS), emitting
-// colour.rgb (radiance, the lit colour's units) with a soft round coverage
-// (particleCoverage). Both the traced quads and the forward pass's
-// billboards span the camera's right and up vectors, so a point on a quad
-// is centre + radius * (u * right + v * up) in both and the coverage, a
-// function of u^2 + v^2, is the same seen directly and in a reflection.
+// A particle is a soft round sprite of radius `radius` around its centre,
+// emitting colour.rgb (radiance, the lit colour's units) with a coverage
+// that falls with the distance from the centre (particleCoverageAt). The
+// forward pass draws it as a camera-facing billboard. A reflection ray,
+// though, may meet that billboard edge-on (a floor seen at 45 degrees
+// reflects rays at right angles to the view), and the sprite would vanish
+// from the reflection: the Far Cry 6 talk's "missing sprites". So the
+// particle BLASes hold three quads per particle, one facing each of the
+// camera's axes (right, up, back; the last one is the billboard), each
+// axis in its own BLAS and TLAS instance with its own instance mask, and a
+// ray's cull mask takes only the axis its view-space direction is largest
+// along (particleQuadAxis): each ray meets every particle once, through the
+// quad that faces it best (at most 54.7 degrees from its normal). In every
+// axis's BLAS primitives 2i and 2i + 1 are particle i. A point on any of
+// the quads lies in a plane through the centre, so the coverage, a
+// function of the distance from the centre, is the same seen directly and
+// in a reflection.
 #ifndef GLINT_PARTICLES_SHARED_H
 #define GLINT_PARTICLES_SHARED_H
 
@@ -28,16 +38,49 @@ struct ParticleData {
 
 GLINT_CONST uint kParticleBillboardGroupSize = 64u;
 GLINT_CONST uint kParticleTraceGroupSize = 8u;  // 8x8 pixels per workgroup (ray query backend)
-GLINT_CONST uint kParticleQuadVertices = 6u;    // two unindexed triangles per particle
+GLINT_CONST uint kParticleQuadVertices = 6u;    // two unindexed triangles per quad
 
-// Push constants of the billboard dispatch (shaders/bvh/particle_quads.comp)
-// and the forward pass's vertex shader: the camera's basis (32 bytes).
+// The quads of a particle in the particle BLASes: one per view-space axis,
+// named by the axis it faces (its normal). kParticleAxisBack's quad spans
+// the camera's right and up: the billboard the forward pass draws.
+GLINT_CONST uint kParticleQuadAxes = 3u;
+GLINT_CONST uint kParticleAxisRight = 0u;
+GLINT_CONST uint kParticleAxisUp = 1u;
+GLINT_CONST uint kParticleAxisBack = 2u;
+
+// Push constants of the quad dispatch (shaders/bvh/particle_quads.comp)
+// and the forward pass's vertex shader: the camera's basis (48 bytes).
 struct ParticleBillboardParams {
     vec3 right;  // world, unit: the camera's +x
     uint count;  // particles
     vec3 up;     // world, unit: the camera's +y
-    uint pad;
+    uint pad0;
+    vec3 back;   // world, unit: the camera's +z (it looks down -z)
+    uint pad1;
 };
+
+// The particle TLAS instance holding axis `axis`'s quads has this mask.
+GLINT_FUNC uint particleAxisMask(uint axis) { return 1u << axis; }
+
+// The axis whose quads a ray with this view-space direction sees: the one
+// its direction is largest along, so the quad meets it at most
+// acos(1 / sqrt(3)) = 54.7 degrees from its normal. Ties go to back, then
+// right: one axis for every direction, so no particle is counted twice.
+GLINT_FUNC uint particleQuadAxis(vec3 viewDirection) {
+    const vec3 a = abs(viewDirection);
+    if (a.z >= a.x && a.z >= a.y) return kParticleAxisBack;
+    return a.x >= a.y ? kParticleAxisRight : kParticleAxisUp;
+}
+
+// The two world directions (u, v) that span axis `axis`'s quad, from the
+// camera's basis: a point of the quad is centre + radius * (c.x u + c.y v)
+// for corners c of particleQuadCorner.
+GLINT_FUNC vec3 particleQuadSpanU(ParticleBillboardParams basis, uint axis) {
+    return axis == kParticleAxisRight ? basis.back : basis.right;
+}
+GLINT_FUNC vec3 particleQuadSpanV(ParticleBillboardParams basis, uint axis) {
+    return axis == kParticleAxisUp ? basis.back : basis.up;
+}
 
 // Corner k (0..5) of a particle's two triangles in quad coordinates
 // (u, v) in {-1, 1}^2: (-1,-1) (1,-1) (1,1) and (-1,-1) (1,1) (-1,1), both
@@ -72,10 +115,15 @@ GLINT_FUNC float particleCoverageAt(ParticleData particle, vec3 p) {
 // are dropped.
 GLINT_CONST uint kParticleMaxHits = 8u;
 
-// Constants of the particle trace (a storage buffer: 112 bytes).
+// Constants of the particle trace (a storage buffer: 160 bytes).
 struct ParticleTraceConstants {
     mat4 inverseViewProjection;  // unjittered, the G-buffer's camera (as integrate reconstructs)
     vec4 cameraPosition;
+    // The camera's right, up and back (w unused): the basis the BVH
+    // update's quads were built in, which picks a ray's quad axis.
+    vec4 cameraRight;
+    vec4 cameraUp;
+    vec4 cameraBack;
     uvec2 size;                  // pixels
     float confidenceThreshold;   // integrate's (which trace a pixel's reflection takes)
     float maxDistance;           // the longest particle ray (misses reach this far)
@@ -89,8 +137,8 @@ GLINT_END
 
 #ifdef __cplusplus
 static_assert(sizeof(glint::shader::ParticleData) == 32);
-static_assert(sizeof(glint::shader::ParticleBillboardParams) == 32);
-static_assert(sizeof(glint::shader::ParticleTraceConstants) == 112);
+static_assert(sizeof(glint::shader::ParticleBillboardParams) == 48);
+static_assert(sizeof(glint::shader::ParticleTraceConstants) == 160);
 #endif
 
 #endif

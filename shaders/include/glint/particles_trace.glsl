@@ -104,9 +104,18 @@ void particleConsiderHit(inout ParticleHits h, vec3 origin, vec3 direction, floa
 // The largest finite half float: the RGBA16F output's limit.
 const float kParticleMaxHalf = 65504.0;
 
-// The backend's traversal: every particle quad on [0, tMax] offered to
-// particleConsiderHit, none committed.
-ParticleHits particleTraceSegment(vec3 origin, vec3 direction, float tMax);
+// The backend's traversal: every particle quad on [0, tMax] in the
+// instances `cullMask` selects offered to particleConsiderHit, none
+// committed.
+ParticleHits particleTraceSegment(vec3 origin, vec3 direction, float tMax, uint cullMask);
+
+// The particle TLAS instance a ray sees: the quads facing the camera axis
+// its direction is largest along (glint/particles_shared.h).
+uint particleCullMask(vec3 direction) {
+    const vec3 view = vec3(dot(direction, C.cameraRight.xyz), dot(direction, C.cameraUp.xyz),
+                           dot(direction, C.cameraBack.xyz));
+    return particleAxisMask(particleQuadAxis(view));
+}
 
 bool particleFinite(float x) { return (floatBitsToUint(x) & 0x7F800000u) != 0x7F800000u; }
 bool particleFinite(vec3 v) { return particleFinite(v.x) && particleFinite(v.y) && particleFinite(v.z); }
@@ -191,7 +200,7 @@ void particleTracePixel(uvec2 pixel) {
             const vec3 direction = unpackRayDirection(ray.direction);
             const float tMax = min(particleReflectionDistance(p, pixelClass, position), C.maxDistance);
             if (tMax > 0.0 && particleFinite(position)) {
-                const ParticleHits hits = particleTraceSegment(position, direction, tMax);
+                const ParticleHits hits = particleTraceSegment(position, direction, tMax, particleCullMask(direction));
                 result = particleComposite(hits, position, direction);
             }
         }
