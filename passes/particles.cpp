@@ -192,6 +192,7 @@ ParticleTraceOutputs addParticleTracePass(rg::Graph& graph, ParticlePipelines& p
     constants.maxDistance = settings.maxDistance;
     constants.sslrBound = hasSslr ? 1u : 0u;
     constants.rtBound = hasRt ? 1u : 0u;
+    constants.sslrSeesParticles = settings.sslrSeesParticles ? 1u : 0u;
 
     struct UploadData {
         rg::Buffer constants;

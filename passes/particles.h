@@ -106,6 +106,15 @@ struct ParticleTraceSettings {
     // How far a ray whose reflection missed (the environment) looks for
     // particles: the BVH's radius (RtTraceSettings::maxDistance).
     float maxDistance = 100.0f;
+    // The Far Cry 6 talk's "SSLR particles": the forward pass drew the
+    // particles into the lit colour before SSLR sampled it, so a pixel
+    // whose reflection integrate takes from SSLR shows the particles SSLR
+    // saw there, and the trace skips it (0 written); the trace covers only
+    // what the ray tracer and the environment resolve. Each particle
+    // reaches a pixel by one road, never both. Cheaper (fewer particle
+    // rays), at a cost: SSLR sees a particle only where it is on screen,
+    // at the depth of the surface behind it.
+    bool sslrSeesParticles = false;
 };
 
 struct ParticleTraceOutputs {

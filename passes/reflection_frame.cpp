@@ -148,8 +148,12 @@ ReflectionFrame ReflectionRenderer::addFrame(rg::Graph& graph, const scene::Came
         lastPlanStats_ = plan.stats;
         f.bvh = addBvhUpdatePass(graph, bvh_, plan, camera);
     }
-    // 1. G-buffer.
+    // 1. G-buffer; with SSLR particles, the particles drawn into its lit
+    // colour before anything samples it.
     f.gbuffer = addGBufferPass(graph, gbuffer_, {camera, lighting, f.environment}, settings.gbuffer);
+    if (settings.sslrParticles) {
+        f.gbuffer.lit = addParticleForwardPass(graph, particles_, {f.gbuffer, scene_.particles, camera}).lit;
+    }
     // 6 (of last frame). Feedback: only the hybrid band follows tile modes.
     RayGenerationInputs rayInputs{f.gbuffer, frameIndex, camera};
     if (mode == ReflectionMode::Hybrid) {
@@ -207,6 +211,7 @@ ReflectionFrame ReflectionRenderer::addFrame(rg::Graph& graph, const scene::Came
         particleSettings.backend = rt_.backend();
         particleSettings.confidenceThreshold = settings.sslr.confidenceThreshold;
         particleSettings.maxDistance = settings.rt.maxDistance;
+        particleSettings.sslrSeesParticles = settings.sslrParticles && f.sslr.has_value();
         f.particles = addParticleTracePass(graph, particles_, particleInputs, particleSettings);
     }
     // 5. Integrate.
@@ -283,12 +288,15 @@ ReflectionFrame ReflectionRenderer::addFrame(rg::Graph& graph, const scene::Came
         f.counts = count.counts;
     }
 
-    // 8. Composite and tonemap, or the debug view in its place. The
-    // particles are drawn into the lit colour only now: SSLR (and its cone
-    // pyramid) must not see them, or they would be reflected twice.
+    // 8. Composite and tonemap, or the debug view in its place. Without
+    // SSLR particles the particles are drawn into the lit colour only now:
+    // SSLR (and its cone pyramid) must not see them, or the trace and SSLR
+    // would both reflect them.
     if (view.empty() || view == "final") {
         GBufferOutputs composited = f.gbuffer;
-        composited.lit = addParticleForwardPass(graph, particles_, {f.gbuffer, scene_.particles, camera}).lit;
+        if (!settings.sslrParticles) {
+            composited.lit = addParticleForwardPass(graph, particles_, {f.gbuffer, scene_.particles, camera}).lit;
+        }
         f.output = addCompositePass(graph, composite_, {composited, f.temporal.resolved, camera}, settings.composite);
         graph.markOutput(f.output.color);
         return f;

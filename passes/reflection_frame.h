@@ -7,6 +7,8 @@
 //   BVH update (async compute) -> G-buffer -> feedback -> ray generation
 //   -> SSLR -> ray-traced hits -> particles trace -> integrate -> temporal
 //   -> particles forward -> composite
+// (with ReflectionFrameSettings::sslrParticles the particles forward pass
+// comes right after the G-buffer, so that SSLR sees the particles)
 //
 // Each mode declares only what it uses: ssr has no BVH, no ray-traced pass
 // and no reflected particles (the direct view still draws them), rt no
@@ -71,6 +73,12 @@ struct ReflectionFrameSettings {
     IntegrateSettings integrate;  // integrate.confidenceThreshold is taken from sslr
     TemporalSettings temporal;
     CompositeSettings composite;
+    // The Far Cry 6 talk's "SSLR particles": the particles are drawn into
+    // the lit colour before SSLR samples it, and the particle trace covers
+    // only the reflections SSLR did not resolve
+    // (ParticleTraceSettings::sslrSeesParticles). Off: drawn after SSLR,
+    // and every traced reflection takes its particles from the trace.
+    bool sslrParticles = false;
     // Empty or "final": the composited image; otherwise one of
     // debugViewNames(), shown in `output` instead.
     std::string debugView;

@@ -78,7 +78,7 @@ struct ParameterSlot {
     bool* (*boolField)(ReflectionRunOptions&) = nullptr;  // 0 or 1
 };
 
-const std::array<ParameterSlot, 13> kParameters = {{
+const std::array<ParameterSlot, 14> kParameters = {{
     {{"sslr_threshold", "SslrSettings::confidenceThreshold"},
      [](ReflectionRunOptions& o) { return &o.frame.sslr.confidenceThreshold; }, nullptr},
     {{"sslr_steps", "SslrSettings::linearSteps"}, nullptr,
@@ -104,6 +104,8 @@ const std::array<ParameterSlot, 13> kParameters = {{
      [](ReflectionRunOptions& o) { return &o.frame.rays.checkerboard; }},
     {{"feedback_rt_hit_fraction", "FeedbackSettings::rtHitFraction"},
      [](ReflectionRunOptions& o) { return &o.frame.feedback.rtHitFraction; }, nullptr},
+    {{"sslr_particles", "ReflectionFrameSettings::sslrParticles (0 or 1)"}, nullptr, nullptr,
+     [](ReflectionRunOptions& o) { return &o.frame.sslrParticles; }},
 }};
 
 const ParameterSlot& findParameter(std::string_view name) {

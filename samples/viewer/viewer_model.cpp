@@ -30,6 +30,7 @@ constexpr RangeRow kRanges[] = {
     {"frustum_culling", 0.0f, 1.0f, true},      // on or off
     {"rt_checkerboard", 0.0f, 1.0f, true},      // on or off
     {"feedback_rt_hit_fraction", 0.0f, 1.0f, false}, // default 0 (the talk)
+    {"sslr_particles", 0.0f, 1.0f, true},       // on or off
 };
 
 bool startsWith(std::string_view s, std::string_view prefix) { return s.substr(0, prefix.size()) == prefix; }

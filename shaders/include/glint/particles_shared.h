@@ -129,7 +129,10 @@ struct ParticleTraceConstants {
     float maxDistance;           // the longest particle ray (misses reach this far)
     uint sslrBound;              // 1: the SSLR outputs are bound (else dummies)
     uint rtBound;                // 1: the RT outputs are bound (else dummies)
-    uint pad0;
+    // 1: SSLR sampled a lit colour with the particles drawn in, so rays
+    // whose reflection integrate takes from SSLR carry them already and
+    // are not traced here (ParticleTraceSettings::sslrSeesParticles).
+    uint sslrSeesParticles;
     uint pad1;
 };
 

@@ -128,9 +128,9 @@ vec3 particleWorldPosition(vec2 pixelPosition, float depth) {
     return world.xyz / world.w;
 }
 
-// The distance integrate will give pixel p's reflection (integrate.glsl,
-// same inputs, same choice).
-float particleReflectionDistance(ivec2 p, uint pixelClass, vec3 position) {
+// The distance integrate will give pixel p's reflection and the trace it
+// takes it from (integrate.glsl, same inputs, same choice).
+float particleReflectionDistance(ivec2 p, uint pixelClass, vec3 position, out uint trace) {
     float confidence = 0.0;
     vec2 sslrHitUv = vec2(0.0);
     // Where SSLR handed the ray on, as integrate decides it (integrate.glsl).
@@ -154,7 +154,7 @@ float particleReflectionDistance(ivec2 p, uint pixelClass, vec3 position) {
         rtTraced = radiance.a > 0.5 && particleFinite(radiance.rgb);
         rtHitDistance = particleFinite(d) ? clamp(d, 0.0, kMissHitDistance) : kMissHitDistance;
     }
-    const uint trace = chooseReflectionTrace(confidence, C.confidenceThreshold, rtTraced);
+    trace = chooseReflectionTrace(confidence, C.confidenceThreshold, rtTraced);
     if (trace == kTraceRt) {
         return rtHitDistance;
     }
@@ -198,8 +198,12 @@ void particleTracePixel(uvec2 pixel) {
         if (depth > 0.0) {
             const vec3 position = particleWorldPosition(vec2(pixel) + 0.5, depth);
             const vec3 direction = unpackRayDirection(ray.direction);
-            const float tMax = min(particleReflectionDistance(p, pixelClass, position), C.maxDistance);
-            if (tMax > 0.0 && particleFinite(position)) {
+            uint trace;
+            const float tMax = min(particleReflectionDistance(p, pixelClass, position, trace), C.maxDistance);
+            // What SSLR resolved already shows the particles it saw in the
+            // lit colour: each particle reaches a pixel by one road.
+            const bool seenBySslr = C.sslrSeesParticles != 0u && trace == kTraceSslr;
+            if (!seenBySslr && tMax > 0.0 && particleFinite(position)) {
                 const ParticleHits hits = particleTraceSegment(position, direction, tMax, particleCullMask(direction));
                 result = particleComposite(hits, position, direction);
             }
