@@ -66,9 +66,10 @@ uint applyMode(uint pixelClass, uvec2 pixel) {
         return kPixelSslr;
     }
     if (tileMode == kTileModeRt) {
-        // Decorrelated from the ray's own noise (frameNoise) by the extra
-        // frame offset; the share is exact on average over frames.
-        const float u = frameNoise(pixel, pc.frame + 0x9E3779B9u).x;
+        // A dimension of its own (glint/sampling.glsl): the pixels kept
+        // hybrid draw GGX samples from the whole lobe; the share is exact
+        // on average over frames.
+        const float u = scalarNoise(pixel, pc.frame, kNoiseRtToHybrid);
         return u < pc.rtToHybridShare ? kPixelHybrid : kPixelRt;
     }
     return kPixelHybrid;
@@ -108,7 +109,7 @@ void main() {
                              : distance >= pc.sslrMinDistance ? kPixelSslr
                                                               : kPixelHybrid;
                 pixelClass = applyMode(pixelClass, pixel);
-                const vec2 u = frameNoise(pixel, pc.frame);
+                const vec2 u = ggxNoise(pixel, pc.frame);
                 const vec3 l = sampleReflection(normalize(normal.xyz), toCamera / distance, roughness, u);
                 direction = packRayDirection(l);
                 rough = (pc.flags & kRayGenReuse) != 0u && roughness >= pc.reuseRoughness;

@@ -145,7 +145,7 @@ void main() {
     // The random start offset (a fraction of one step, new every frame)
     // turns the banding of large steps into noise the temporal filter
     // removes (Far Cry 6 talk).
-    const float jitter = frameNoise(pixel, pc.frame).x;
+    const float jitter = scalarNoise(pixel, pc.frame, kNoiseSslrOffset);
     // No more steps than the ray's on-screen length has pixels per
     // minStepPixels: finer steps would read the same texels again.
     uint steps = pc.linearSteps;

@@ -232,7 +232,7 @@ TEST_CASE("GGX visible-normal samples match the analytic distribution's moments 
             constexpr uint32_t kSamples = 1u << 18;
             double meanZ = 0.0, meanX = 0.0, meanZ2 = 0.0;
             for (uint32_t i = 0; i < kSamples; ++i) {
-                const glm::vec2 u = shader::frameNoise({i % 512u, i / 512u}, 7u);
+                const glm::vec2 u = shader::ggxNoise({i % 512u, i / 512u}, 7u);
                 const glm::vec3 h = shader::sampleGgxVndf(v, alpha, u);
                 REQUIRE(std::isfinite(h.x));
                 REQUIRE(h.z > 0.0f);
@@ -265,7 +265,7 @@ TEST_CASE("GGX samples at normal incidence are uniform in the inverse CDF of D c
         constexpr uint32_t kSamples = 1u << 16;
         std::array<int, kBins> histogram{};
         for (uint32_t i = 0; i < kSamples; ++i) {
-            const glm::vec3 h = shader::sampleGgxVndf({0, 0, 1}, alpha, shader::frameNoise({i % 256u, i / 256u}, 3u));
+            const glm::vec3 h = shader::sampleGgxVndf({0, 0, 1}, alpha, shader::ggxNoise({i % 256u, i / 256u}, 3u));
             const double t = (double(h.x) * h.x + double(h.y) * h.y) / (double(h.z) * h.z);
             const double cdf = t / (double(alpha) * alpha + t);
             ++histogram[std::min(kBins - 1, int(cdf * kBins))];
@@ -284,8 +284,8 @@ TEST_CASE("reflection sampling is finite and above the surface at roughness 0, 1
         for (uint32_t i = 0; i < 4096; ++i) {
             // Normals and views from the noise; views may face away from
             // the normal (interpolated normals do) or graze it.
-            const glm::vec2 a = shader::frameNoise({i, 1u}, 11u);
-            const glm::vec2 b = shader::frameNoise({i, 2u}, 13u);
+            const glm::vec2 a = shader::ggxNoise({i, 1u}, 11u);
+            const glm::vec2 b = shader::ggxNoise({i, 2u}, 13u);
             const auto sphere = [](glm::vec2 u) {
                 const float z = 1.0f - 2.0f * u.x, r = std::sqrt(std::max(0.0f, 1.0f - z * z));
                 return glm::vec3(r * std::cos(6.2831853f * u.y), r * std::sin(6.2831853f * u.y), z);
@@ -293,7 +293,7 @@ TEST_CASE("reflection sampling is finite and above the surface at roughness 0, 1
             const glm::vec3 n = sphere(a);
             glm::vec3 v = sphere(b);
             if (i % 4 == 0) v = glm::normalize(v - n * glm::dot(v, n) + n * 1e-5f);  // grazing
-            const glm::vec3 l = shader::sampleReflection(n, v, roughness, shader::frameNoise({i, 3u}, 17u));
+            const glm::vec3 l = shader::sampleReflection(n, v, roughness, shader::ggxNoise({i, 3u}, 17u));
             const glm::vec3 packed = shader::unpackRayDirection(shader::packRayDirection(l));
             INFO("roughness " << roughness << ", sample " << i);
             REQUIRE(std::isfinite(l.x));
@@ -308,9 +308,9 @@ TEST_CASE("reflection sampling is finite and above the surface at roughness 0, 1
 }
 
 TEST_CASE("the noise is deterministic and walks a different sample every frame") {
-    CHECK(shader::frameNoise({3, 5}, 9) == shader::frameNoise({3, 5}, 9));
-    CHECK(shader::frameNoise({3, 5}, 9) != shader::frameNoise({3, 5}, 10));
-    CHECK(shader::frameNoise({3, 5}, 9) != shader::frameNoise({5, 3}, 9));
+    CHECK(shader::ggxNoise({3, 5}, 9) == shader::ggxNoise({3, 5}, 9));
+    CHECK(shader::ggxNoise({3, 5}, 9) != shader::ggxNoise({3, 5}, 10));
+    CHECK(shader::ggxNoise({3, 5}, 9) != shader::ggxNoise({5, 3}, 9));
 }
 
 TEST_CASE("a mirror floor (roughness 0) gives exactly the reflected view direction in every floor pixel") {

@@ -56,18 +56,41 @@ GLINT_FUNC float unitFromBits(uint bits) {
     return float(bits >> 8u) * (1.0f / 16777216.0f);
 }
 
+// Each use of random numbers in a frame draws its own dimension, so that
+// no two uses see the same number, or a shifted copy of it: the GGX
+// sample (two dimensions), SSLR's start offset, and which pixels of an RT
+// tile stay hybrid. Were two uses to share a dimension, the SSLR offset
+// would follow the GGX sample's u.x, and the pixels kept hybrid would all
+// draw GGX samples from one band of u.x.
+GLINT_CONST uint kNoiseSslrOffset = 0u;
+GLINT_CONST uint kNoiseRtToHybrid = 1u;
+
 // Roberts' R2 sequence ("The Unreasonable Effectiveness of Quasirandom
 // Sequences", 2018): x_n = frac(n / g, n / g^2), g = 1.3247179572 (the
 // plastic number), here in 32-bit fixed point (2^32 / g, 2^32 / g^2) so
 // it wraps exactly instead of losing precision as n grows. Each pixel
 // offsets it by its own hash (a Cranley-Patterson rotation), so pixels are
 // decorrelated and every pixel still walks a low-discrepancy sequence over
-// frames.
-GLINT_FUNC vec2 frameNoise(uvec2 pixel, uint frame) {
+// frames. The GGX sample's two dimensions.
+GLINT_FUNC vec2 ggxNoise(uvec2 pixel, uint frame) {
     const uint h = pcgHash(pixel.x + pcgHash(pixel.y));
     const uint seedX = h;
     const uint seedY = pcgHash(h);
     return vec2(unitFromBits(seedX + frame * 3242174889u), unitFromBits(seedY + frame * 2447445413u));
+}
+
+// One more dimension, kNoise*: a Weyl sequence frac(seed + n alpha) per
+// pixel, its seed hashed from the pixel and the dimension, its step an
+// irrational of its own: 2^32 / golden ratio for the SSLR offset, 2^32
+// (sqrt 2 - 1) for the hybrid share. 1, 1/g, 1/g^2, 1/phi and sqrt 2 are
+// linearly independent over the rationals (the fields Q(g) and
+// Q(sqrt 5, sqrt 2) meet only in Q), so over frames each pixel's GGX
+// sample and these dimensions are jointly equidistributed (Weyl), and
+// across pixels their seeds are independent hashes.
+GLINT_FUNC float scalarNoise(uvec2 pixel, uint frame, uint dimension) {
+    const uint seed = pcgHash(pixel.x + pcgHash(pixel.y + pcgHash(dimension + 0x51ED27u)));
+    const uint step = dimension == kNoiseSslrOffset ? 2654435769u : 1779033703u;
+    return unitFromBits(seed + frame * step);
 }
 
 // ---------------------------------------------------------------------------
