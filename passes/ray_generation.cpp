@@ -5,9 +5,12 @@
 #include "graph/executor.h"
 
 #include "glint/ray_generation_shared.h"
+#include "glint/sampling.glsl"
 #include "glint/sslr_shared.h"
+#include "sampling/blue_noise.h"
 
 #include <array>
+#include <cstring>
 
 namespace glint::passes {
 
@@ -18,7 +21,7 @@ static_assert(uint32_t(ReflectionMode::Hybrid) == shader::kModeHybrid && uint32_
 
 namespace {
 
-constexpr uint32_t kBindingCount = 11;
+constexpr uint32_t kBindingCount = 12;
 
 std::vector<gpu::Binding> classifyBindings() {
     std::vector<gpu::Binding> bindings;
@@ -31,7 +34,48 @@ std::vector<gpu::Binding> classifyBindings() {
     return bindings;
 }
 
+// The blue noise in a device-local buffer: staged, copied and made
+// visible to every later shader read on the graphics queue, once.
+gpu::Buffer uploadBlueNoise(gpu::Context& ctx) {
+    const std::vector<uint32_t> words = loadBlueNoiseWords();
+    const VkDeviceSize bytes = words.size() * sizeof(uint32_t);
+    gpu::Buffer buffer(ctx, {bytes, VK_BUFFER_USAGE_STORAGE_BUFFER_BIT | VK_BUFFER_USAGE_TRANSFER_DST_BIT,
+                             gpu::MemoryUsage::DeviceLocal, "ray_generation.blue_noise"});
+    gpu::Buffer staging(ctx, {bytes, VK_BUFFER_USAGE_TRANSFER_SRC_BIT, gpu::MemoryUsage::Upload,
+                              "ray_generation.blue_noise.staging"});
+    std::memcpy(staging.mapped(), words.data(), bytes);
+    gpu::submitAndWait(ctx, ctx.graphicsQueue(), "blue noise upload", [&](VkCommandBuffer cmd) {
+        const VkBufferCopy region{0, 0, bytes};
+        vkCmdCopyBuffer(cmd, staging.handle(), buffer.handle(), 1, &region);
+        gpu::bufferBarrier(cmd, buffer, VK_PIPELINE_STAGE_2_COPY_BIT, VK_ACCESS_2_TRANSFER_WRITE_BIT,
+                           VK_PIPELINE_STAGE_2_COMPUTE_SHADER_BIT, VK_ACCESS_2_SHADER_STORAGE_READ_BIT);
+    });
+    return buffer;
+}
+
 } // namespace
+
+std::filesystem::path blueNoisePath() { return gpu::shaderDirectory() / "noise" / "blue_noise.bin"; }
+
+std::vector<uint32_t> loadBlueNoiseWords() {
+    const std::filesystem::path path = blueNoisePath();
+    sampling::BlueNoiseTexture texture;
+    try {
+        texture = sampling::readBlueNoise(path);
+    } catch (const std::exception& e) {
+        throw gpu::GpuError(e.what());
+    }
+    if (texture.size.width != shader::kBlueNoiseWidth || texture.size.height != shader::kBlueNoiseHeight ||
+        texture.size.depth != shader::kBlueNoiseDepth || texture.channels != shader::kBlueNoiseChannels) {
+        throw gpu::GpuError(path.string() + ": blue noise of " + std::to_string(texture.size.width) + "x" +
+                            std::to_string(texture.size.height) + "x" + std::to_string(texture.size.depth) + ", " +
+                            std::to_string(texture.channels) + " channels; the shaders read " +
+                            std::to_string(shader::kBlueNoiseWidth) + "x" + std::to_string(shader::kBlueNoiseHeight) +
+                            "x" + std::to_string(shader::kBlueNoiseDepth) + ", " +
+                            std::to_string(shader::kBlueNoiseChannels));
+    }
+    return sampling::blueNoiseWords(texture);
+}
 
 RayGenerationPipelines::RayGenerationPipelines(gpu::Context& ctx)
     : ctx_(ctx),
@@ -41,7 +85,8 @@ RayGenerationPipelines::RayGenerationPipelines(gpu::Context& ctx)
       // The G-buffer is read texel by texel (texelFetch); the sampler only
       // completes the combined descriptor.
       nearest_(ctx, {VK_FILTER_NEAREST, VK_SAMPLER_MIPMAP_MODE_NEAREST, VK_SAMPLER_ADDRESS_MODE_CLAMP_TO_EDGE, 0.0f,
-                     "ray_generation.nearest"}) {}
+                     "ray_generation.nearest"}),
+      blueNoise_(uploadBlueNoise(ctx)) {}
 
 RayGenerationOutputs addRayGenerationPass(rg::Graph& graph, RayGenerationPipelines& pipelines,
                                           const RayGenerationInputs& inputs, const RayGenerationSettings& settings) {
@@ -53,6 +98,8 @@ RayGenerationOutputs addRayGenerationPass(rg::Graph& graph, RayGenerationPipelin
         throw gpu::GpuError("addRayGenerationPass: the packed ray holds pixels up to 32768 x 16384");
     }
     RayGenerationOutputs out;
+    out.blueNoise = settings.blueNoise;
+    out.blueNoiseBuffer = &pipelines.blueNoise_;
     out.width = gbuf.width;
     out.height = gbuf.height;
     out.tilesX = (gbuf.width + shader::kTileSize - 1) / shader::kTileSize;
@@ -97,7 +144,8 @@ RayGenerationOutputs addRayGenerationPass(rg::Graph& graph, RayGenerationPipelin
     constants.sslrMinDistance = settings.sslrMinDistance;
     constants.flags = uint32_t(settings.mode) | (settings.reuse ? shader::kRayGenReuse : 0u) |
                       (inputs.tileModes.valid() ? shader::kRayGenTileModes : 0u) |
-                      (settings.checkerboard ? shader::kRayGenCheckerboard : 0u);
+                      (settings.checkerboard ? shader::kRayGenCheckerboard : 0u) |
+                      (settings.blueNoise ? shader::kRayGenBlueNoise : 0u);
     constants.coneRoughness = settings.coneRoughness;
     constants.rtToHybridShare = settings.rtToHybridShare;
     constants.tilesX = out.tilesX;
@@ -150,6 +198,7 @@ RayGenerationOutputs addRayGenerationPass(rg::Graph& graph, RayGenerationPipelin
                 // Without tile modes the shader never reads binding 10; the
                 // class buffer only completes the descriptor set.
                 .storageBuffer(10, pc.buffer(d.tileModes.valid() ? d.tileModes : d.out.classes))
+                .storageBuffer(11, pipelines.blueNoise_)
                 .push(pipelines.ctx_, pc.cmd());
             pipeline.pushConstants(pc.cmd(), constants);
             pc.dispatch(pipeline, d.out.tilesX, d.out.tilesY);

@@ -27,6 +27,8 @@
 #include "scene/camera.h"
 
 #include <cstdint>
+#include <filesystem>
+#include <vector>
 
 namespace glint::passes {
 
@@ -37,6 +39,7 @@ inline constexpr VkDeviceSize kRayListTraceArgsBytes = 3 * sizeof(uint32_t);
 
 // Which trace resolves a pixel's reflection: issue 5's three modes.
 enum class ReflectionMode : uint32_t { Hybrid, Ssr, Rt };
+
 inline constexpr VkFormat kRayClassDebugFormat = VK_FORMAT_R8G8B8A8_UNORM;
 
 struct RayGenerationInputs {
@@ -95,6 +98,15 @@ struct RayGenerationSettings {
     // counters keep seeing SSLR and it can return to SSLR (Far Cry 6 talk,
     // DESIGN.md section 3). Glint's starting value; the bench sweeps it.
     float rtToHybridShare = 1.0f / 16.0f;
+    // Where the random numbers of ray generation (the GGX samples, the
+    // pixels kept hybrid) and of SSLR (its start offsets, which follow this
+    // choice through RayGenerationOutputs) come from, each use its own
+    // dimension (glint/sampling.glsl): spatiotemporal blue noise
+    // (engine/sampling/blue_noise.h), blue in space and over a pixel's
+    // frames, so that the temporal filter averages out the error faster;
+    // false: per-pixel hashed low-discrepancy sequences (R2 for the GGX
+    // sample, a Weyl sequence for each other use). The bench compares both.
+    bool blueNoise = true;
 };
 
 struct RayGenerationOutputs {
@@ -105,16 +117,28 @@ struct RayGenerationOutputs {
     rg::Buffer rtRays;        // RT ray list: shader::PackedRay per RT ray leader (capacity: one per pixel)
     rg::Buffer rtArgs;        // shader::kRayListArgsWords: dispatch at kRayListDispatchArgsBytes, trace at kRayListTraceArgsBytes
     rg::Texture classDebug;   // kRayClassDebugFormat: a colour per class (debug view "ray_classes")
+    // Whether the rays were drawn from the blue noise, and its buffer
+    // (owned by RayGenerationPipelines, uploaded once when they were
+    // created and never written again, so no pass needs to order itself
+    // against it): SSLR draws its start offsets the same way.
+    bool blueNoise = false;
+    const gpu::Buffer* blueNoiseBuffer = nullptr;
     uint32_t width = 0;
     uint32_t height = 0;
     uint32_t tilesX = 0;
     uint32_t tilesY = 0;
 };
 
-// The pipeline and the sampler the pass records with; created once.
+// The pipeline, the sampler and the blue noise the pass records with;
+// created once. The blue noise is read from "noise/blue_noise.bin" beside
+// the shaders (gpu::shaderDirectory(); the build generates it) and
+// uploaded to a device-local buffer; a missing or mismatched file throws
+// gpu::GpuError naming it.
 class RayGenerationPipelines {
 public:
     explicit RayGenerationPipelines(gpu::Context& ctx);
+
+    const gpu::Buffer& blueNoise() const { return blueNoise_; }
 
 private:
     friend RayGenerationOutputs addRayGenerationPass(rg::Graph&, RayGenerationPipelines&, const RayGenerationInputs&,
@@ -122,7 +146,15 @@ private:
     gpu::Context& ctx_;
     gpu::Pipeline classify_;
     gpu::Sampler nearest_;
+    gpu::Buffer blueNoise_;
 };
+
+// The blue noise file the passes read, and its texels as the shaders
+// index them (uvec2 per texel: glint/sampling.glsl's blueNoise*). Throws
+// gpu::GpuError naming the file when it is missing or not the size and
+// channels the shaders expect.
+std::filesystem::path blueNoisePath();
+std::vector<uint32_t> loadBlueNoiseWords();
 
 // Declares the pass (see the top of this file) on the graphics queue.
 RayGenerationOutputs addRayGenerationPass(rg::Graph& graph, RayGenerationPipelines& pipelines,

@@ -18,7 +18,7 @@ namespace glint::passes {
 
 namespace {
 
-constexpr uint32_t kBindingCount = 14;
+constexpr uint32_t kBindingCount = 15;
 
 std::vector<gpu::Binding> traceBindings() {
     std::vector<gpu::Binding> bindings;
@@ -86,6 +86,9 @@ SslrOutputs addSslrPass(rg::Graph& graph, SslrPipelines& pipelines, const SslrIn
         throw gpu::GpuError("addSslrPass: linearSteps must be at least 1 and minStepPixels not negative");
     }
     checkProjection(inputs.projection);
+    if (rays.blueNoiseBuffer == nullptr) {
+        throw gpu::GpuError("addSslrPass: the rays carry no blue noise buffer (not from addRayGenerationPass)");
+    }
 
     SslrOutputs out;
     out.width = gbuf.width;
@@ -209,6 +212,7 @@ SslrOutputs addSslrPass(rg::Graph& graph, SslrPipelines& pipelines, const SslrIn
     constants.edgeFade = settings.edgeFade;
     constants.confidenceThreshold = sslrStoredThreshold(settings.confidenceThreshold);
     constants.pyramidMips = pyramidMips;
+    constants.blueNoise = rays.blueNoise ? 1u : 0u;
 
     struct TraceData {
         rg::Texture depth, normal, lit, roughnessMetal, pyramid;
@@ -238,7 +242,7 @@ SslrOutputs addSslrPass(rg::Graph& graph, SslrPipelines& pipelines, const SslrIn
             d.out.rtArgs = b.write(rays.rtArgs, rg::Access::StorageReadWrite);
             d.out.litPyramid = d.pyramid;
         },
-        [&pipelines, constants](const TraceData& d, rg::PassContext& pc) {
+        [&pipelines, constants, blueNoise = rays.blueNoiseBuffer](const TraceData& d, rg::PassContext& pc) {
             const gpu::Pipeline& pipeline = pipelines.trace_;
             const VkSampler sampler = pipelines.nearest_.handle();
             pipeline.bind(pc.cmd());
@@ -260,6 +264,7 @@ SslrOutputs addSslrPass(rg::Graph& graph, SslrPipelines& pipelines, const SslrIn
                 .sampledImage(12, pc.view(d.pyramid.valid() ? d.pyramid : d.lit), pipelines.trilinear_.handle(),
                               pc.layout(d.pyramid.valid() ? d.pyramid : d.lit))
                 .storageBuffer(13, pc.buffer(d.sslrArgs))
+                .storageBuffer(14, *blueNoise)
                 .push(pipelines.ctx_, pc.cmd());
             pipeline.pushConstants(pc.cmd(), constants);
             pc.dispatchIndirect(pipeline, d.sslrArgs, kRayListDispatchArgsBytes);

@@ -78,7 +78,7 @@ struct ParameterSlot {
     bool* (*boolField)(ReflectionRunOptions&) = nullptr;  // 0 or 1
 };
 
-const std::array<ParameterSlot, 14> kParameters = {{
+const std::array<ParameterSlot, 15> kParameters = {{
     {{"sslr_threshold", "SslrSettings::confidenceThreshold"},
      [](ReflectionRunOptions& o) { return &o.frame.sslr.confidenceThreshold; }, nullptr},
     {{"sslr_steps", "SslrSettings::linearSteps"}, nullptr,
@@ -106,6 +106,8 @@ const std::array<ParameterSlot, 14> kParameters = {{
      [](ReflectionRunOptions& o) { return &o.frame.feedback.rtHitFraction; }, nullptr},
     {{"sslr_particles", "ReflectionFrameSettings::sslrParticles (0 or 1)"}, nullptr, nullptr,
      [](ReflectionRunOptions& o) { return &o.frame.sslrParticles; }},
+    {{"blue_noise", "RayGenerationSettings::blueNoise (1: spatiotemporal blue noise, 0: hashed sequences)"}, nullptr,
+     nullptr, [](ReflectionRunOptions& o) { return &o.frame.rays.blueNoise; }},
 }};
 
 const ParameterSlot& findParameter(std::string_view name) {
@@ -192,6 +194,9 @@ ReflectionRunOptions referenceSettings(const ReflectionRunOptions& in) {
     o.jitter = false;
     o.frame.mode = passes::ReflectionMode::Rt;
     o.frame.rays.reuse = false;
+    // The reference converges on the low-discrepancy sequences, whichever
+    // noise the measured runs use.
+    o.frame.rays.blueNoise = false;
     o.frame.rays.roughnessCutoff = 1.0f;  // rough pixels are traced too: the environment is an approximation
     o.renderer.bvh.radius = std::numeric_limits<float>::max();
     o.renderer.bvh.longRangeRadius = std::numeric_limits<float>::max();

@@ -28,6 +28,8 @@ layout(set = 0, binding = 9, scalar) buffer RtArgs { uint rtArgs[]; };
 // The feedback pass's kTileMode* per tile (glint/feedback_shared.h); read
 // only when pc.tileModesEnabled is 1.
 layout(set = 0, binding = 10, scalar) readonly buffer TileModes { uint tileModes[]; };
+// The spatiotemporal blue noise (glint/sampling.glsl); read only with kRayGenBlueNoise.
+layout(set = 0, binding = 11, scalar) readonly buffer BlueNoise { uvec2 blueNoise[]; };
 
 layout(push_constant, scalar) uniform Constants { RayGenerationConstants pc; };
 
@@ -69,7 +71,9 @@ uint applyMode(uint pixelClass, uvec2 pixel) {
         // A dimension of its own (glint/sampling.glsl): the pixels kept
         // hybrid draw GGX samples from the whole lobe; the share is exact
         // on average over frames.
-        const float u = scalarNoise(pixel, pc.frame, kNoiseRtToHybrid);
+        const float u = (pc.flags & kRayGenBlueNoise) != 0u
+                            ? blueNoiseChannel(blueNoise[blueNoiseTexel(pixel, pc.frame)], kBlueNoiseRtToHybrid)
+                            : scalarNoise(pixel, pc.frame, kNoiseRtToHybrid);
         return u < pc.rtToHybridShare ? kPixelHybrid : kPixelRt;
     }
     return kPixelHybrid;
@@ -109,7 +113,13 @@ void main() {
                              : distance >= pc.sslrMinDistance ? kPixelSslr
                                                               : kPixelHybrid;
                 pixelClass = applyMode(pixelClass, pixel);
-                const vec2 u = ggxNoise(pixel, pc.frame);
+                vec2 u;
+                if ((pc.flags & kRayGenBlueNoise) != 0u) {
+                    const uvec2 texel = blueNoise[blueNoiseTexel(pixel, pc.frame)];
+                    u = vec2(blueNoiseChannel(texel, kBlueNoiseGgxX), blueNoiseChannel(texel, kBlueNoiseGgxY));
+                } else {
+                    u = ggxNoise(pixel, pc.frame);
+                }
                 const vec3 l = sampleReflection(normalize(normal.xyz), toCamera / distance, roughness, u);
                 direction = packRayDirection(l);
                 rough = (pc.flags & kRayGenReuse) != 0u && roughness >= pc.reuseRoughness;

@@ -36,6 +36,8 @@ layout(set = 0, binding = 11) uniform sampler2D roughnessMetalTexture;
 layout(set = 0, binding = 12) uniform sampler2D pyramidTexture;
 // The SSLR list's args: its length at kRayListCountOffset.
 layout(set = 0, binding = 13, scalar) readonly buffer SslrArgs { uint sslrArgs[]; };
+// Ray generation's spatiotemporal blue noise (glint/sampling.glsl); read only when pc.blueNoise is 1.
+layout(set = 0, binding = 14, scalar) readonly buffer BlueNoise { uvec2 blueNoise[]; };
 
 layout(push_constant, scalar) uniform Constants { SslrConstants pc; };
 
@@ -145,7 +147,9 @@ void main() {
     // The random start offset (a fraction of one step, new every frame)
     // turns the banding of large steps into noise the temporal filter
     // removes (Far Cry 6 talk).
-    const float jitter = scalarNoise(pixel, pc.frame, kNoiseSslrOffset);
+    const float jitter = pc.blueNoise != 0u
+                             ? blueNoiseChannel(blueNoise[blueNoiseTexel(pixel, pc.frame)], kBlueNoiseSslrOffset)
+                             : scalarNoise(pixel, pc.frame, kNoiseSslrOffset);
     // No more steps than the ray's on-screen length has pixels per
     // minStepPixels: finer steps would read the same texels again.
     uint steps = pc.linearSteps;

@@ -93,6 +93,37 @@ GLINT_FUNC float scalarNoise(uvec2 pixel, uint frame, uint dimension) {
     return unitFromBits(seed + frame * step);
 }
 
+// Spatiotemporal blue noise (engine/sampling/blue_noise.h, generated at
+// build time): the same four uses from a 64 x 64 x 32 volume, one channel
+// each, the volume tiling the screen and frame t reading slice t mod 32.
+// Each pass through the 32 slices shifts the volume by an R2 step, so the
+// pattern does not repeat every 32 frames. The shaders read it as a
+// storage buffer of uvec2 per texel (four 16-bit channels); the passes
+// check that the file has this size and these channels.
+GLINT_CONST uint kBlueNoiseWidth = 64u;
+GLINT_CONST uint kBlueNoiseHeight = 64u;
+GLINT_CONST uint kBlueNoiseDepth = 32u;
+GLINT_CONST uint kBlueNoiseChannels = 4u;
+GLINT_CONST uint kBlueNoiseGgxX = 0u;
+GLINT_CONST uint kBlueNoiseGgxY = 1u;
+GLINT_CONST uint kBlueNoiseSslrOffset = 2u;
+GLINT_CONST uint kBlueNoiseRtToHybrid = 3u;
+
+// The texel pixel `pixel` reads in frame `frame`.
+GLINT_FUNC uint blueNoiseTexel(uvec2 pixel, uint frame) {
+    const uint cycle = frame / kBlueNoiseDepth;
+    const uint x = (pixel.x + ((cycle * 3242174889u) >> 26u)) % kBlueNoiseWidth;
+    const uint y = (pixel.y + ((cycle * 2447445413u) >> 26u)) % kBlueNoiseHeight;
+    return ((frame % kBlueNoiseDepth) * kBlueNoiseHeight + y) * kBlueNoiseWidth + x;
+}
+
+// Channel `channel` of a texel's two words, as a number in (0, 1).
+GLINT_FUNC float blueNoiseChannel(uvec2 texel, uint channel) {
+    const uint word = channel < 2u ? texel.x : texel.y;
+    const uint value = (word >> (16u * (channel & 1u))) & 0xFFFFu;
+    return (float(value) + 0.5f) * (1.0f / 65536.0f);
+}
+
 // ---------------------------------------------------------------------------
 // Tangent frames
 // ---------------------------------------------------------------------------

@@ -42,7 +42,7 @@ struct SslrConstants {
     float confidenceThreshold;  // as stored (passes::sslrStoredThreshold)
     uint pyramidMips;           // levels of the colour pyramid; 0: no cone trace
     float minStepPixels;        // SslrSettings::minStepPixels
-    uint pad0;
+    uint blueNoise;             // 1: start offsets from the blue noise (ray generation's choice)
 };
 
 // The pyramid stops at 2^(kSslrPyramidMaxMips - 1) pixels per texel: wider
