@@ -1,7 +1,9 @@
 #pragma once
 
-// Synthetic frames for tests and glint-graph-bench: the reflection frame of
-// DESIGN §3 and seeded random graphs. Each is a Script -- passes and uses as
+// Synthetic frames for tests and glint-graph-bench: a frame shaped like the
+// reflection frame of DESIGN §3 and seeded random graphs. Synthetic: hand
+// kept, not derived from passes::ReflectionRenderer::addFrame (the real
+// frame's plan is tested in tests/gpu/reflection_frame_plan_test.cpp). Each is a Script -- passes and uses as
 // data -- that declare() replays into a Graph, so a benchmark can time
 // declaration without timing the generator.
 
@@ -58,9 +60,11 @@ struct ReflectionOptions {
     std::string prefix;                         // names are prefix + name (for tiling copies)
 };
 
-// DESIGN §3: BVH update on async compute, G-buffer, ray generation, SSLR
-// (which validates screen-space hits with ray queries against the TLAS, so
-// it is the first graphics consumer of the BVH), hardware trace, particle
+// A synthetic frame after DESIGN §3: BVH update on async compute, G-buffer,
+// ray generation, SSLR (which here validates screen-space hits with ray
+// queries against the TLAS, so it is the first graphics consumer of the
+// BVH, as in Far Cry 6; the real SSLR reads no TLAS, and the real frame's
+// graphics queue waits at the ray tracer instead), hardware trace, particle
 // trace, integrate, reflection motion, temporal accumulation, spatial
 // filter, composite and tonemap into an imported output image.
 Script reflectionFrame(const ReflectionOptions& options = {});

@@ -1,7 +1,9 @@
-// The reflection frame of DESIGN §3 must compile to the shape the issue
-// asks for: BVH update on async compute overlapping G-buffer and ray
-// generation, graphics waiting for it exactly before SSLR; and on one
-// queue, the same frame correctly synchronised on graphics alone.
+// The synthetic reflection frame (engine/graph/synthetic.h, shaped after
+// DESIGN §3, its SSLR reading the TLAS as Far Cry 6's does) must compile to
+// the shape the technique asks for: BVH update on async compute overlapping
+// G-buffer and ray generation, graphics waiting for it exactly before SSLR;
+// and on one queue, the same frame correctly synchronised on graphics
+// alone. The real frame's plan: tests/gpu/reflection_frame_plan_test.cpp.
 
 #include <doctest/doctest.h>
 
@@ -20,7 +22,7 @@ Plan reflectionPlan(const QueueCaps& caps, const synthetic::ReflectionOptions& o
 
 } // namespace
 
-TEST_CASE("two queues: the BVH update runs on compute beside G-buffer and ray generation, graphics waits before SSLR") {
+TEST_CASE("synthetic frame, two queues: the BVH update runs on compute beside G-buffer and ray generation, graphics waits before SSLR") {
     const Plan plan = reflectionPlan(twoQueues());
     const PlannedPass& bvh = passNamed(plan, "bvh_update");
     CHECK((bvh.queue == Queue::AsyncCompute));
@@ -57,7 +59,7 @@ TEST_CASE("two queues: the BVH update runs on compute beside G-buffer and ray ge
     CHECK(plan.resources[resourceNamed(plan, "bvh.tlas")].crossQueue);
 }
 
-TEST_CASE("two queues: next frame's BVH rebuild waits for this frame's trace reads of the TLAS") {
+TEST_CASE("synthetic frame, two queues: next frame's BVH rebuild waits for this frame's trace reads of the TLAS") {
     const Plan plan = reflectionPlan(twoQueues());
     const auto waits = plan.waitsOf(batchOf(plan, "bvh_update"));
     REQUIRE(waits.size() == 1);
@@ -67,7 +69,7 @@ TEST_CASE("two queues: next frame's BVH rebuild waits for this frame's trace rea
     CHECK(waits[0].stages == VK_PIPELINE_STAGE_2_ACCELERATION_STRUCTURE_BUILD_BIT_KHR);
 }
 
-TEST_CASE("one queue: the same frame runs on graphics alone, synchronised by barriers") {
+TEST_CASE("synthetic frame, one queue: the same frame runs on graphics alone, synchronised by barriers") {
     const Plan plan = reflectionPlan(oneQueue());
     CHECK(plan.batches.size() == 1);
     CHECK(plan.waits.empty());
@@ -88,7 +90,7 @@ TEST_CASE("one queue: the same frame runs on graphics alone, synchronised by bar
     CHECK(rebuild[0].srcAccess == 0);
 }
 
-TEST_CASE("the reflection frame with a ray tracing pipeline verifies on both queue setups") {
+TEST_CASE("the synthetic reflection frame with a ray tracing pipeline verifies on both queue setups") {
     synthetic::ReflectionOptions options;
     options.tracePipeline = Pipeline::RayTracing;
     for (const QueueCaps& caps : {twoQueues(), oneQueue()}) {
@@ -101,7 +103,7 @@ TEST_CASE("the reflection frame with a ray tracing pipeline verifies on both que
     }
 }
 
-TEST_CASE("the reflection frame saves at least 40% of its transient memory at 1080p by aliasing") {
+TEST_CASE("the synthetic reflection frame saves at least 40% of its transient memory at 1080p by aliasing") {
     const Plan plan = reflectionPlan(twoQueues());
     const double saved =
         1.0 - static_cast<double>(plan.stats.aliasedTransientBytes) / static_cast<double>(plan.stats.transientBytes);
@@ -113,7 +115,7 @@ TEST_CASE("the reflection frame saves at least 40% of its transient memory at 10
             CHECK(b.oldLayout == VK_IMAGE_LAYOUT_UNDEFINED);
 }
 
-TEST_CASE("the reflection frame's output ends ready to present") {
+TEST_CASE("the synthetic reflection frame's output ends ready to present") {
     const Plan plan = reflectionPlan(twoQueues());
     const uint32_t output = resourceNamed(plan, "output");
     bool presented = false;
