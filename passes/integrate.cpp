@@ -125,6 +125,7 @@ IntegrateOutputs addIntegratePass(rg::Graph& graph, IntegratePipelines& pipeline
     constants.tiles = {tilesX, tilesY};
     constants.confidenceThreshold = sslrStoredThreshold(settings.confidenceThreshold);
     constants.particlesBound = hasParticles ? 1u : 0u;
+    constants.rtMissesTrusted = settings.rtMissesTrusted ? 1u : 0u;
 
     // The constants outgrow push constants (glint/integrate_shared.h); a
     // transfer inside the frame keeps their lifetime the graph's.

@@ -85,6 +85,13 @@ struct IntegrateSettings {
     // where the stored SSLR confidence is below it (compared, as SSLR does,
     // at sslrStoredThreshold), since nothing clears the traces' outputs.
     float confidenceThreshold = 0.9f;
+    // Whether a ray-traced miss may override a partial SSLR hit. False
+    // while the BVH is still building objects in range
+    // (scene::BvhPlan::complete; ReflectionRenderer sets it per frame): a
+    // miss may have passed where an unbuilt object stands, and the SSLR hit
+    // may be that object. SSLR is the fallback while the BVH builds (the
+    // Far Cry 6 talk).
+    bool rtMissesTrusted = true;
 };
 
 struct IntegrateOutputs {

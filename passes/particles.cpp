@@ -193,6 +193,7 @@ ParticleTraceOutputs addParticleTracePass(rg::Graph& graph, ParticlePipelines& p
     constants.sslrBound = hasSslr ? 1u : 0u;
     constants.rtBound = hasRt ? 1u : 0u;
     constants.sslrSeesParticles = settings.sslrSeesParticles ? 1u : 0u;
+    constants.rtMissesTrusted = settings.rtMissesTrusted ? 1u : 0u;
 
     struct UploadData {
         rg::Buffer constants;

@@ -115,6 +115,9 @@ struct ParticleTraceSettings {
     // rays), at a cost: SSLR sees a particle only where it is on screen,
     // at the depth of the surface behind it.
     bool sslrSeesParticles = false;
+    // Integrate's IntegrateSettings::rtMissesTrusted: the same choice of
+    // trace, so the same reflection distance.
+    bool rtMissesTrusted = true;
 };
 
 struct ParticleTraceOutputs {

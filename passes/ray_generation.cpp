@@ -145,7 +145,8 @@ RayGenerationOutputs addRayGenerationPass(rg::Graph& graph, RayGenerationPipelin
     constants.flags = uint32_t(settings.mode) | (settings.reuse ? shader::kRayGenReuse : 0u) |
                       (inputs.tileModes.valid() ? shader::kRayGenTileModes : 0u) |
                       (settings.checkerboard ? shader::kRayGenCheckerboard : 0u) |
-                      (settings.blueNoise ? shader::kRayGenBlueNoise : 0u);
+                      (settings.blueNoise ? shader::kRayGenBlueNoise : 0u) |
+                      (settings.sslrFirst ? shader::kRayGenSslrFirst : 0u);
     constants.coneRoughness = settings.coneRoughness;
     constants.rtToHybridShare = settings.rtToHybridShare;
     constants.tilesX = out.tilesX;

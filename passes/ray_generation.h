@@ -107,6 +107,12 @@ struct RayGenerationSettings {
     // false: per-pixel hashed low-discrepancy sequences (R2 for the GGX
     // sample, a Weyl sequence for each other use). The bench compares both.
     bool blueNoise = true;
+    // Hybrid mode: every pixel that would be traced alone (nearer than
+    // rtMaxDistance, or in a tile the feedback sends to RT) tries SSLR
+    // first. Set by ReflectionRenderer while the BVH is still building
+    // objects in range (scene::BvhPlan::complete), so that their
+    // reflections come from SSLR rather than from rays that pass through.
+    bool sslrFirst = false;
 };
 
 struct RayGenerationOutputs {

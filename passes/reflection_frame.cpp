@@ -146,6 +146,7 @@ ReflectionFrame ReflectionRenderer::addFrame(rg::Graph& graph, const scene::Came
     if (traces) {
         const scene::BvhPlan plan = planner_.plan(scene_, camera);
         lastPlanStats_ = plan.stats;
+        f.bvhComplete = plan.complete();
         f.bvh = addBvhUpdatePass(graph, bvh_, plan, camera);
     }
     // 1. G-buffer; with SSLR particles, the particles drawn into its lit
@@ -163,6 +164,8 @@ ReflectionFrame ReflectionRenderer::addFrame(rg::Graph& graph, const scene::Came
     // 2. Ray generation and tile classification.
     RayGenerationSettings raySettings = settings.rays;
     raySettings.mode = mode;
+    const bool sslrFallback = !f.bvhComplete && settings.sslrWhileBvhBuilds && screenSpace;
+    raySettings.sslrFirst = raySettings.sslrFirst || (sslrFallback && mode == ReflectionMode::Hybrid);
     // The traces write only their rays' pixels; a debug view of their raw
     // outputs shows the rest cleared rather than stale.
     const bool viewsSslr = view.substr(0, 5) == "sslr_" || view == "lit_pyramid";
@@ -212,6 +215,7 @@ ReflectionFrame ReflectionRenderer::addFrame(rg::Graph& graph, const scene::Came
         particleSettings.confidenceThreshold = settings.sslr.confidenceThreshold;
         particleSettings.maxDistance = settings.rt.maxDistance;
         particleSettings.sslrSeesParticles = settings.sslrParticles && f.sslr.has_value();
+        particleSettings.rtMissesTrusted = !sslrFallback;
         f.particles = addParticleTracePass(graph, particles_, particleInputs, particleSettings);
     }
     // 5. Integrate.
@@ -234,6 +238,7 @@ ReflectionFrame ReflectionRenderer::addFrame(rg::Graph& graph, const scene::Came
     }
     IntegrateSettings integrateSettings = settings.integrate;
     integrateSettings.confidenceThreshold = settings.sslr.confidenceThreshold;
+    integrateSettings.rtMissesTrusted = integrateSettings.rtMissesTrusted && !sslrFallback;
     f.integrate = addIntegratePass(graph, integrate_, integrateInputs, integrateSettings);
     // 7. Reflection motion and temporal accumulation.
     TemporalInputs temporalInputs;

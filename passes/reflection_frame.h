@@ -79,6 +79,13 @@ struct ReflectionFrameSettings {
     // (ParticleTraceSettings::sslrSeesParticles). Off: drawn after SSLR,
     // and every traced reflection takes its particles from the trace.
     bool sslrParticles = false;
+    // While the BVH is still building objects in range (its first-build
+    // budget, scene::BvhSettings), SSLR is the fallback (the Far Cry 6
+    // talk): in hybrid mode every pixel tries SSLR first, and a ray-traced
+    // miss no longer overrides a partial SSLR hit
+    // (RayGenerationSettings::sslrFirst, IntegrateSettings::rtMissesTrusted).
+    // Off: the incomplete BVH is traced as it is.
+    bool sslrWhileBvhBuilds = true;
     // Empty or "final": the composited image; otherwise one of
     // debugViewNames(), shown in `output` instead.
     std::string debugView;
@@ -94,6 +101,9 @@ struct ReflectionFrame {
     ReflectionMode mode = ReflectionMode::Hybrid;
     GBufferOutputs gbuffer;
     std::optional<BvhUpdateOutputs> bvh;
+    // The TLAS holds every object in range (scene::BvhPlan::complete);
+    // false while first builds wait for their budget.
+    bool bvhComplete = true;
     std::optional<FeedbackOutputs> feedback;
     RayGenerationOutputs rays;
     std::optional<SslrOutputs> sslr;

@@ -38,9 +38,11 @@ std::string formatStats(const BvhStats& s) {
     out << "BLAS built " << s.built << ", rebuilt " << s.rebuilt << " (skinned " << s.rebuiltSkinned
         << ", first person " << s.rebuiltFirstPerson << "), dropped " << s.dropped << "; skipped: unchanged "
         << s.skippedUnchanged << ", out of range " << s.skippedOutOfRange << ", over budget " << s.deferredBudget
-        << ", over skinned budget " << s.deferredSkinnedBudget << "; static reused " << s.staticReused
+        << ", over skinned budget " << s.deferredSkinnedBudget << ", first builds waiting " << s.deferredFirstBuilds
+        << "; static reused " << s.staticReused
         << "; instances in range " << s.instancesInRange << ", culled " << s.instancesCulled << " ("
-        << s.instancesWithoutBlas << " without BLAS), moved " << s.instancesMoved << "; TLAS " << s.tlasInstances
+        << s.instancesWithoutBlas << " without BLAS), awaiting their BLAS " << s.instancesAwaitingBlas << ", moved "
+        << s.instancesMoved << "; TLAS " << s.tlasInstances
         << ", resident BLAS " << s.residentBlases << ", pool " << s.poolTriangles << " triangles";
     return out.str();
 }
@@ -241,44 +243,96 @@ BvhPlan BvhPlanner::plan(const Scene& scene, const glm::vec3& cameraPosition, ui
     }
 
     // --- First builds: objects within their radius that have no BLAS. ------
-    std::set<BlasId> builtThisFrame;
+    // Candidates in priority order (first person, largest on screen,
+    // nearest; a shared BLAS takes its best instance's place), built while
+    // the frame's first-build budget lasts.
+    struct Candidate {
+        Key key;
+        uint32_t instance = 0;
+        bool firstPerson = false;
+        float screenSize = 0.0f;  // bounding radius over distance
+        float distance = 0.0f;
+    };
+    std::map<Key, Candidate> candidates;
     for (size_t i = 0; i < scene.instances.size(); ++i) {
         if (!views[i].inRange) {
             continue;
         }
         const Instance& inst = scene.instances[i];
-        const MeshLod& lod = scene.meshes[inst.mesh].lods[lodOf[inst.mesh]];
+        const Aabb box = instanceBounds(scene, inst);
+        Candidate c;
+        c.instance = uint32_t(i);
+        c.firstPerson = inst.firstPerson;
+        c.distance = distanceToBounds(box, cameraPosition);
+        c.screenSize = 0.5f * glm::length(box.max - box.min) / std::max(c.distance, 1e-3f);
+        const auto better = [](const Candidate& a, const Candidate& b) {
+            if (a.firstPerson != b.firstPerson) return a.firstPerson;
+            if (a.screenSize != b.screenSize) return a.screenSize > b.screenSize;
+            return a.distance < b.distance;
+        };
         for (const Key& key : views[i].keys) {
             if (resident_.count(key)) {
                 continue;
             }
-            Resident r;
-            BlasDesc& desc = r.desc;
-            desc.id = nextId_++;
-            desc.mesh = inst.mesh;
-            desc.lod = key.lod;
-            desc.part = key.part;
-            desc.instance = key.perInstance ? int32_t(i) : kNone;
-            desc.motion = motionOf(key);
-            for (uint32_t g : partsOf[inst.mesh][key.part]) {
-                desc.geometries.push_back({g, lod.geometries[g].material, lod.geometries[g].triangleCount(), 0});
-                desc.triangleCount += lod.geometries[g].triangleCount();
+            c.key = key;
+            const auto [it, inserted] = candidates.emplace(key, c);
+            if (!inserted && better(c, it->second)) {
+                it->second = c;
             }
-            desc.poolOffset = pool_.allocate(desc.triangleCount);
-            uint32_t offset = desc.poolOffset;
-            for (BlasGeometry& g : desc.geometries) {
-                g.poolOffset = offset;
-                offset += g.triangleCount;
-            }
-            r.builtVersion = key.perInstance ? inst.deformVersion : 0;
-            r.lastInRange = frame;
-            r.lastBuilt = frame;
-            plan.builds.push_back({desc.id, BlasBuildReason::FirstInRange});
-            stats.builtTriangles += desc.triangleCount;
-            builtThisFrame.insert(desc.id);
-            ++stats.built;
-            resident_.emplace(key, std::move(r));
         }
+    }
+    std::vector<Candidate> order;
+    for (const auto& [key, c] : candidates) order.push_back(c);
+    std::stable_sort(order.begin(), order.end(), [](const Candidate& a, const Candidate& b) {
+        if (a.firstPerson != b.firstPerson) return a.firstPerson;
+        if (a.screenSize != b.screenSize) return a.screenSize > b.screenSize;
+        return a.distance < b.distance;
+    });
+    std::set<BlasId> builtThisFrame;
+    uint32_t firstBuilds = 0;
+    uint64_t firstBuildTriangles = 0;
+    for (const Candidate& c : order) {
+        const Key& key = c.key;
+        const Instance& inst = scene.instances[c.instance];
+        const MeshLod& lod = scene.meshes[inst.mesh].lods[lodOf[inst.mesh]];
+        uint32_t triangles = 0;
+        for (uint32_t g : partsOf[inst.mesh][key.part]) {
+            triangles += lod.geometries[g].triangleCount();
+        }
+        const bool fits = firstBuilds < settings_.maxFirstBuildsPerFrame &&
+                          (firstBuilds == 0 || firstBuildTriangles + triangles <= settings_.maxFirstBuildTrianglesPerFrame);
+        if (!fits) {
+            ++stats.deferredFirstBuilds;
+            continue;
+        }
+        ++firstBuilds;
+        firstBuildTriangles += triangles;
+        Resident r;
+        BlasDesc& desc = r.desc;
+        desc.id = nextId_++;
+        desc.mesh = inst.mesh;
+        desc.lod = key.lod;
+        desc.part = key.part;
+        desc.instance = key.perInstance ? int32_t(c.instance) : kNone;
+        desc.motion = motionOf(key);
+        for (uint32_t g : partsOf[inst.mesh][key.part]) {
+            desc.geometries.push_back({g, lod.geometries[g].material, lod.geometries[g].triangleCount(), 0});
+            desc.triangleCount += lod.geometries[g].triangleCount();
+        }
+        desc.poolOffset = pool_.allocate(desc.triangleCount);
+        uint32_t offset = desc.poolOffset;
+        for (BlasGeometry& g : desc.geometries) {
+            g.poolOffset = offset;
+            offset += g.triangleCount;
+        }
+        r.builtVersion = key.perInstance ? inst.deformVersion : 0;
+        r.lastInRange = frame;
+        r.lastBuilt = frame;
+        plan.builds.push_back({desc.id, BlasBuildReason::FirstInRange});
+        stats.builtTriangles += desc.triangleCount;
+        builtThisFrame.insert(desc.id);
+        ++stats.built;
+        resident_.emplace(key, std::move(r));
     }
 
     // --- Rebuilds: first person, then the round-robin loop, in budget. -----
@@ -368,6 +422,11 @@ BvhPlan BvhPlanner::plan(const Scene& scene, const glm::vec3& cameraPosition, ui
         ++stats.instancesInRange;
         if (inst.transform != inst.previousTransform) {
             ++stats.instancesMoved;
+        }
+        // Whole objects only: one whose BLASes are not all built waits.
+        if (!std::all_of(views[i].keys.begin(), views[i].keys.end(), [&](const Key& k) { return resident_.count(k) > 0; })) {
+            ++stats.instancesAwaitingBlas;
+            continue;
         }
         const uint8_t mask = uint8_t(inst.firstPerson ? shader::kInstanceMaskFirstPerson
                                      : inst.longRange ? shader::kInstanceMaskLongRange

@@ -15,6 +15,14 @@
 //    TLAS instance transform, never a BLAS rebuild;
 //  - first-person objects that deformed are rebuilt every frame, ahead of
 //    the loop and inside the same budget;
+//  - first builds (objects entering the radius) have a budget of their own,
+//    BLASes and triangles per frame, so that a crowd entering range builds
+//    over several frames instead of stalling one: first-person objects
+//    first, then the largest on screen (bounding radius over distance),
+//    then the nearest. An instance is in the TLAS once all its BLASes are
+//    built; until then the frame reflects it through SSLR or the
+//    environment (BvhPlan::complete, passes::ReflectionRenderer: "SSLR is
+//    the fallback while the BVH builds", the talk);
 //  - the TLAS holds the instances within 100 m of the camera (the long-range
 //    group: a larger radius); an object never within the radius gets no
 //    BLAS; the particle TLAS exists only when there are particles.
@@ -40,6 +48,13 @@ struct BvhSettings {
     uint32_t maxRebuildsPerFrame = 16;         // FC6
     uint32_t maxSkinnedRebuildsPerFrame = 12;  // FC6
     uint32_t maxGeometriesPerBlas = 32;        // FC6
+    // First builds per frame: at most this many BLASes and triangles (one
+    // BLAS is always built, however large). Glint's values: above what the
+    // built-in scenes and the shared glTF scenes build on their first frame
+    // (the plaza 41 BLASes, 31k triangles), about 2 ms of builds on the
+    // H200 (1M triangles build in 1.2-2.4 ms there).
+    uint32_t maxFirstBuildsPerFrame = 64;
+    uint64_t maxFirstBuildTrianglesPerFrame = 1'000'000;
     // 0 keeps a BLAS once built (FC6 builds static BLASes once); otherwise a
     // BLAS whose objects stayed outside their radius this many frames is
     // dropped to free memory.
@@ -113,6 +128,8 @@ struct BvhStats {
     uint32_t skippedOutOfRange = 0;      // deformed, but outside the radius: rebuilt when back in range
     uint32_t deferredBudget = 0;         // deformed, waiting: the frame's 16 rebuilds were used
     uint32_t deferredSkinnedBudget = 0;  // skinned, waiting: the frame's 12 skinned rebuilds were used
+    uint32_t deferredFirstBuilds = 0;    // BLASes of objects in range not built yet: the first-build budget was used
+    uint32_t instancesAwaitingBlas = 0;  // in range, but a BLAS of theirs is not built yet: not in the TLAS
     uint32_t staticReused = 0;           // static BLASes in the TLAS without any build
     uint32_t instancesInRange = 0;
     uint32_t instancesCulled = 0;       // outside their radius: not in the TLAS
@@ -137,6 +154,10 @@ struct BvhPlan {
     BvhStats stats;
 
     const BlasDesc* find(BlasId id) const;
+    // Every instance in range is in the TLAS: no first build is waiting.
+    // Until then a ray tracer's miss may have passed where an unbuilt
+    // object stands.
+    bool complete() const { return stats.instancesAwaitingBlas == 0; }
 };
 
 // One line of stats for logs.

@@ -126,7 +126,7 @@ Reflection integratePixel(uvec2 pixel) {
         // A non-finite result is no hit: the pixel falls through to the
         // next source rather than carrying NaN into temporal accumulation.
         if (radiance.a > 0.5 && isFinite(radiance.rgb) && isFinite(c) && isFinite(hitUv)) {
-            confidence = clamp(c, 0.0, 1.0);
+            confidence = sslrHitConfidence(clamp(c, 0.0, 1.0), C.rtMissesTrusted != 0u);
             sslrRadiance = radiance.rgb;
             sslrHitUv = hitUv;
         }
@@ -158,7 +158,8 @@ Reflection integratePixel(uvec2 pixel) {
 
     // glint/integrate_shared.h's chooseReflectionTrace, which the particle
     // trace shares.
-    const uint trace = chooseReflectionTrace(confidence, C.confidenceThreshold, rtTraced);
+    const uint trace = chooseReflectionTrace(confidence, C.confidenceThreshold, rtTraced,
+                                             C.rtMissesTrusted != 0u || rtHitDistance < kMissHitDistance);
     if (trace == kTraceRt) {
         r.radiance = rtRadiance;
         r.hitDistance = rtHitDistance;

@@ -60,6 +60,12 @@ uint applyMode(uint pixelClass, uvec2 pixel) {
     if (mode == kModeRt) {
         return kPixelRt;
     }
+    // While the BVH builds, a ray traced alone could pass where an unbuilt
+    // object stands: every RT pixel tries SSLR first (the Far Cry 6 talk's
+    // SSLR fallback while the BVH builds).
+    if ((pc.flags & kRayGenSslrFirst) != 0u) {
+        return pixelClass == kPixelRt ? kPixelHybrid : pixelClass;
+    }
     if (pixelClass != kPixelHybrid || (pc.flags & kRayGenTileModes) == 0u) {
         return pixelClass;
     }

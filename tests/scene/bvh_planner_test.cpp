@@ -136,7 +136,11 @@ TEST_CASE("deforming dynamic BLASes are rebuilt round-robin, at most 16 a frame,
             t.add({float(i % 10) * 3.0f, 0, float(i / 10) * 3.0f}, Motion::Dynamic);
         }
         t.prepare();
-        BvhPlanner planner;
+        // Every BLAS first built on frame 0 (the first-build budget is
+        // another test's), so that frame 1 on is the rebuild loop alone.
+        BvhSettings settings;
+        settings.maxFirstBuildsPerFrame = n;
+        BvhPlanner planner(settings);
         std::map<BlasId, uint64_t> lastRebuilt;
         const uint64_t bound = (n + 15) / 16;
         for (uint64_t frame = 0; frame < 60; ++frame) {
@@ -313,6 +317,85 @@ TEST_CASE("an object never within the radius gets no BLAS; one that arrives is b
     }
     // Bounds reach z = -149.5; within 100 m once the camera is at z <= -49.5.
     CHECK(arrivalBuild == 50);
+}
+
+TEST_CASE("200 objects entering range at once are built over frames within the first-build budget, first person "
+          "first, then the largest on screen; each joins the TLAS whole once built") {
+    TestScene t;
+    // 199 boxes on a spiral out to 90 m, one first-person object at the far end.
+    for (uint32_t i = 0; i < 199; ++i) {
+        const float angle = 0.7f * float(i), distance = 3.0f + 0.45f * float(i);
+        t.add({distance * std::cos(angle), 0.0f, distance * std::sin(angle)}, Motion::Dynamic);
+    }
+    const uint32_t player = t.add({0.0f, 0.0f, 95.0f}, Motion::Dynamic);
+    t.scene.instances[player].firstPerson = true;
+    t.prepare();
+    BvhSettings settings;
+    settings.maxFirstBuildsPerFrame = 16;
+    BvhPlanner planner(settings);
+    std::set<uint32_t> built;  // scene instances whose BLAS exists
+    float previousFarthest = 0.0f;
+    uint64_t frame = 0;
+    for (; frame < 20; ++frame) {
+        const BvhPlan plan = planner.plan(t.scene, {0, 0, 0}, frame);
+        CHECK(plan.stats.built <= 16u);
+        CHECK(plan.stats.built == std::min<size_t>(16u, 200u - built.size()));
+        float nearest = 1e30f, farthest = 0.0f;
+        for (const BlasBuild& b : plan.builds) {
+            REQUIRE(b.reason == BlasBuildReason::FirstInRange);
+            const uint32_t instance = uint32_t(plan.find(b.blas)->instance);
+            built.insert(instance);
+            if (instance == player) {
+                CHECK(frame == 0);
+                continue;
+            }
+            const float d = glm::length(glm::vec3(t.scene.instances[instance].transform[3]));
+            nearest = std::min(nearest, d);
+            farthest = std::max(farthest, d);
+        }
+        // Equal boxes: the largest on screen are the nearest, so no box
+        // waits for one farther away.
+        if (!plan.builds.empty()) CHECK(nearest >= previousFarthest);
+        previousFarthest = std::max(previousFarthest, farthest);
+        // The TLAS holds exactly the built objects; the rest wait.
+        CHECK(plan.tlas.size() == built.size());
+        for (const TlasInstance& ti : plan.tlas) CHECK(built.count(ti.sceneInstance) == 1u);
+        CHECK(plan.stats.instancesAwaitingBlas == 200u - built.size());
+        CHECK(plan.stats.deferredFirstBuilds == 200u - built.size());
+        CHECK(plan.complete() == (built.size() == 200u));
+        if (plan.complete()) break;
+    }
+    CHECK(frame == 12);  // ceil(200 / 16) frames: 0..12
+}
+
+TEST_CASE("the first-build triangle budget spreads builds over frames, and one object larger than it still builds") {
+    TestScene t;
+    // A second mesh of 240 triangles (a 12 x 10 grid), over the budget alone.
+    Mesh big;
+    big.name = "big";
+    const Geometry g = makeGrid({1.0f, 1.0f}, {12, 10}, 0);
+    big.lods.push_back({{g}});
+    t.scene.meshes.push_back(big);
+    const uint32_t large = t.add({0, 0, 2}, Motion::Dynamic);  // nearest: first in line
+    t.scene.instances[large].mesh = 1;
+    for (uint32_t i = 0; i < 10; ++i) t.add({float(i) * 2.0f, 0.0f, 20.0f}, Motion::Dynamic);
+    t.prepare();
+    const uint32_t bigTriangles = g.triangleCount();
+    REQUIRE(bigTriangles == 240u);
+    BvhSettings settings;
+    settings.maxFirstBuildTrianglesPerFrame = 30;  // five coarse boxes of 6 triangles
+    BvhPlanner planner(settings);
+    const BvhPlan first = planner.plan(t.scene, {0, 0, 0}, 0);
+    // The large object alone: over the budget, but the first of the frame.
+    REQUIRE(first.builds.size() == 1u);
+    CHECK(first.find(first.builds[0].blas)->instance == int32_t(large));
+    CHECK(first.stats.builtTriangles == bigTriangles);
+    const BvhPlan second = planner.plan(t.scene, {0, 0, 0}, 1);
+    CHECK(second.builds.size() == 5u);
+    CHECK(second.stats.builtTriangles == 30u);
+    const BvhPlan third = planner.plan(t.scene, {0, 0, 0}, 2);
+    CHECK(third.builds.size() == 5u);
+    CHECK(third.complete());
 }
 
 TEST_CASE("the particle TLAS exists only when there are particles") {

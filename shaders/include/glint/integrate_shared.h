@@ -51,13 +51,27 @@ GLINT_FUNC vec4 integrateSourceColour(uint source) {
 // environment map. One definition: integrate picks its source with it and
 // the particle trace (passes/particles.h) its ray's length, so particles
 // are composited exactly up to the surface the reflection shows.
+// rtTrusted: the ray-traced result may override a partial SSLR hit. A miss
+// is not, while the BVH is still building objects in range (their rays pass
+// through where they stand; scene::BvhPlan::complete): SSLR is the fallback
+// while the BVH builds (the Far Cry 6 talk).
 GLINT_CONST uint kTraceNone = 0u;
 GLINT_CONST uint kTraceSslr = 1u;
 GLINT_CONST uint kTraceRt = 2u;
 
-GLINT_FUNC uint chooseReflectionTrace(float sslrConfidence, float confidenceThreshold, bool rtTraced) {
+// While the BVH builds, an SSLR hit the trace gave no confidence (near the
+// screen's border, near its thickness, a back face) still ranks above a
+// ray-traced miss: it is at least the reflection of something on screen.
+GLINT_CONST float kSslrFallbackConfidence = 1.0f / 1024.0f;
+
+// The confidence integrate and the particle trace give an SSLR hit.
+GLINT_FUNC float sslrHitConfidence(float stored, bool rtMissesTrusted) {
+    return rtMissesTrusted ? stored : max(stored, kSslrFallbackConfidence);
+}
+
+GLINT_FUNC uint chooseReflectionTrace(float sslrConfidence, float confidenceThreshold, bool rtTraced, bool rtTrusted) {
     if (sslrConfidence >= confidenceThreshold) return kTraceSslr;
-    if (rtTraced) return kTraceRt;
+    if (rtTraced && (rtTrusted || !(sslrConfidence > 0.0f))) return kTraceRt;
     if (sslrConfidence > 0.0f) return kTraceSslr;
     return kTraceNone;
 }
@@ -72,7 +86,7 @@ struct IntegrateConstants {
     uvec2 tiles;                 // 8x8 tiles in x and y
     float confidenceThreshold;   // SSLR confidence that counts as a hit
     uint particlesBound;         // 1: composite the particle trace (passes/particles.h) over the reflection
-    uint pad1;
+    uint rtMissesTrusted;        // 0 while the BVH builds objects in range (IntegrateSettings::rtMissesTrusted)
     uint pad2;
 };
 

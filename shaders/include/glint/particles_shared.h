@@ -133,7 +133,7 @@ struct ParticleTraceConstants {
     // whose reflection integrate takes from SSLR carry them already and
     // are not traced here (ParticleTraceSettings::sslrSeesParticles).
     uint sslrSeesParticles;
-    uint pad1;
+    uint rtMissesTrusted;        // integrate's (ParticleTraceSettings::rtMissesTrusted)
 };
 
 GLINT_END

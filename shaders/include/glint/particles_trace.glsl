@@ -142,7 +142,7 @@ float particleReflectionDistance(ivec2 p, uint pixelClass, vec3 position, out ui
         const vec2 hitUv = texelFetch(sslrHitTexture, p, 0).xy;
         if (radiance.a > 0.5 && particleFinite(radiance.rgb) && particleFinite(c) && particleFinite(hitUv.x) &&
             particleFinite(hitUv.y)) {
-            confidence = clamp(c, 0.0, 1.0);
+            confidence = sslrHitConfidence(clamp(c, 0.0, 1.0), C.rtMissesTrusted != 0u);
             sslrHitUv = hitUv;
         }
     }
@@ -154,7 +154,8 @@ float particleReflectionDistance(ivec2 p, uint pixelClass, vec3 position, out ui
         rtTraced = radiance.a > 0.5 && particleFinite(radiance.rgb);
         rtHitDistance = particleFinite(d) ? clamp(d, 0.0, kMissHitDistance) : kMissHitDistance;
     }
-    trace = chooseReflectionTrace(confidence, C.confidenceThreshold, rtTraced);
+    trace = chooseReflectionTrace(confidence, C.confidenceThreshold, rtTraced,
+                                  C.rtMissesTrusted != 0u || rtHitDistance < kMissHitDistance);
     if (trace == kTraceRt) {
         return rtHitDistance;
     }

@@ -111,6 +111,7 @@ GLINT_CONST uint kRayGenReuse = 1u << 2u;      // rough quads share one ray
 GLINT_CONST uint kRayGenTileModes = 1u << 3u;  // hybrid pixels follow the feedback's tile modes
 GLINT_CONST uint kRayGenCheckerboard = 1u << 4u;  // half the smooth hybrid and RT pixels share a neighbour's ray
 GLINT_CONST uint kRayGenBlueNoise = 1u << 5u;  // GGX samples and the hybrid share from the blue noise (glint/sampling.glsl)
+GLINT_CONST uint kRayGenSslrFirst = 1u << 6u;  // hybrid mode: RT pixels try SSLR first (the BVH is building)
 
 GLINT_END
 
