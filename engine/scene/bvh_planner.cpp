@@ -187,7 +187,7 @@ BvhPlan BvhPlanner::plan(const Scene& scene, const glm::vec3& cameraPosition, ui
         if (mesh.lods.empty()) {
             continue;
         }
-        lodOf[m] = reflectionLodIndex(mesh);
+        lodOf[m] = settings_.reflectionLods ? reflectionLodIndex(mesh) : 0;
         partsOf[m] = partitionGeometries(mesh.lods[lodOf[m]], settings_.maxGeometriesPerBlas);
         // A geometry without triangles would be an empty BLAS geometry.
         for (std::vector<uint32_t>& part : partsOf[m]) {

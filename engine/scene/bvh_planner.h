@@ -48,6 +48,10 @@ struct BvhSettings {
     uint32_t maxRebuildsPerFrame = 16;         // FC6
     uint32_t maxSkinnedRebuildsPerFrame = 12;  // FC6
     uint32_t maxGeometriesPerBlas = 32;        // FC6
+    // false: every BLAS from full detail (lods[0]) instead of the reflection
+    // LOD; the converged reference's choice, so that error is measured
+    // against the full-detail scene.
+    bool reflectionLods = true;
     // First builds per frame: at most this many BLASes and triangles (one
     // BLAS is always built, however large). Glint's values: above what the
     // built-in scenes and the shared glTF scenes build on their first frame

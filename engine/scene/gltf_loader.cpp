@@ -584,6 +584,13 @@ Scene loadGltf(const std::filesystem::path& path, const GltfLoadOptions& options
 
     Scene scene = gltf::convertModel(model, context);
     scene.name = file;
+    if (options.reflectionLods) {
+        const ReflectionLodStats lods = generateReflectionLods(scene, *options.reflectionLods);
+        if (lods.meshes > 0) {
+            spdlog::info("{}: reflection LODs for {} meshes: {} -> {} triangles (largest relative error {:.4f})", file,
+                         lods.meshes, lods.trianglesBefore, lods.trianglesAfter, lods.largestError);
+        }
+    }
     prepareScene(scene);
     if (scene.cameraPath.keys.empty()) {
         frameBounds(scene);

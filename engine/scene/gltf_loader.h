@@ -25,10 +25,12 @@
 // weights (animation.h, morphedGeometry) for the G-buffer's and the BVH's
 // vertex data.
 
+#include "scene/reflection_lod.h"
 #include "scene/scene.h"
 
 #include <cstdint>
 #include <filesystem>
+#include <optional>
 
 namespace glint::scene {
 
@@ -44,6 +46,10 @@ struct GltfLoadOptions {
     uint32_t maxJsonDepth = 64;
     // false: skip image decoding; materials keep their factors only.
     bool loadTextures = true;
+    // A reflection LOD for every mesh (glTF gives one level of detail),
+    // which the BVH builds from (scene/reflection_lod.h); unset: the BVH
+    // builds from full detail.
+    std::optional<ReflectionLodSettings> reflectionLods = ReflectionLodSettings{};
 };
 
 // Loads `path` (.gltf or .glb, recognised by content), prepares the scene

@@ -253,7 +253,7 @@ int main(int argc, char** argv) {
             ctx.waitIdle();
             return app::validationClean(ctx) ? 0 : 2;
         }
-        scene::Scene scene = scene::loadScene(sceneName);
+        scene::Scene scene = scene::loadScene(sceneName, args.gltfOptions());
 
         // Every configuration, so progress can say "k of n".
         std::vector<Configuration> configurations;

@@ -89,8 +89,9 @@ double passMilliseconds(const rg::Executor& executor) {
     throw std::runtime_error("no timing for the bvh_update pass");
 }
 
-SceneResult measure(gpu::Context& ctx, const std::string& name, uint32_t frames) {
-    scene::Scene s = scene::loadScene(name);
+SceneResult measure(gpu::Context& ctx, const std::string& name, uint32_t frames,
+                    const scene::GltfLoadOptions& loadOptions) {
+    scene::Scene s = scene::loadScene(name, loadOptions);
     scene::BvhPlanner planner;
     rg::Executor executor(ctx);
     passes::BvhManager bvh(ctx, s);
@@ -549,7 +550,7 @@ int main(int argc, char** argv) {
                     "scr_MiB");
         std::optional<SceneResult> plaza;
         for (const std::string& name : scenes) {
-            const SceneResult r = measure(ctx, name, frames);
+            const SceneResult r = measure(ctx, name, frames, args.gltfOptions());
             const passes::BvhGpuStats& m = r.memory;
             std::printf("%-34s %8llu %5u %5u %9.3f %9s %8.1f %9s %8.2f %8.2f %8.2f %8.2f %8.2f\n", r.name.c_str(),
                         static_cast<unsigned long long>(r.triangles), r.blases, r.tlasInstances, r.firstMs,

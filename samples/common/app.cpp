@@ -17,6 +17,30 @@ namespace {
 struct UsageError : std::runtime_error {
     using std::runtime_error::runtime_error;
 };
+
+// "off", "RATIO" or "RATIO:ERROR" (scene::ReflectionLodSettings).
+std::optional<scene::ReflectionLodSettings> parseReflectionLods(const std::string& text) {
+    if (text == "off") return std::nullopt;
+    scene::ReflectionLodSettings settings;
+    const auto number = [&](const std::string& part, float low, float high, bool openLow) {
+        size_t used = 0;
+        double v = 0.0;
+        try {
+            v = std::stod(part, &used);
+        } catch (const std::exception&) {
+            used = 0;
+        }
+        if (used == 0 || used != part.size() || !(openLow ? v > low : v >= low) || !(v <= high)) {
+            throw UsageError("--reflection-lods " + text + ": expected off, RATIO or RATIO:ERROR with RATIO in (0, 1] "
+                             "and ERROR in [0, 1]");
+        }
+        return float(v);
+    };
+    const size_t colon = text.find(':');
+    settings.targetRatio = number(text.substr(0, colon), 0.0f, 1.0f, true);
+    if (colon != std::string::npos) settings.maxError = number(text.substr(colon + 1), 0.0f, 1.0f, false);
+    return settings;
+}
 } // namespace
 
 Args::Args(int argc, char** argv, const std::string& usage, const std::vector<std::string>& knownFlags,
@@ -34,7 +58,8 @@ Args::Args(int argc, char** argv, const std::string& usage, const std::vector<st
         };
         if (a == "--help" || a == "-h") {
             std::cout << usage << "\n"
-                      << "common: --validate  --device NAME  --log LEVEL (trace|debug|info|warn|error)  --no-ray-query\n";
+                      << "common: --validate  --device NAME  --log LEVEL (trace|debug|info|warn|error)  --no-ray-query\n"
+                      << "        --reflection-lods RATIO[:ERROR]|off  (glTF meshes' reflection LODs; default 0.25:0.01)\n";
             std::exit(0);
         } else if (a == "--validate") {
             common_.validate = true;
@@ -44,6 +69,8 @@ Args::Args(int argc, char** argv, const std::string& usage, const std::vector<st
             common_.logLevel = value();
         } else if (a == "--no-ray-query") {
             common_.pipelineOnly = true;
+        } else if (a == "--reflection-lods") {
+            common_.reflectionLods = parseReflectionLods(value());
         } else if (a.rfind("--", 0) == 0 && known(knownFlags, a.substr(2))) {
             values_[a.substr(2)] = value();
         } else if (a.rfind("--", 0) == 0 && known(knownSwitches, a.substr(2))) {
@@ -79,6 +106,12 @@ uint32_t Args::getUint(const std::string& name, uint32_t fallback) const {
     } catch (const std::exception&) {
         throw UsageError("--" + name + " " + it->second + ": not a non-negative integer");
     }
+}
+
+scene::GltfLoadOptions Args::gltfOptions() const {
+    scene::GltfLoadOptions o;
+    o.reflectionLods = common_.reflectionLods;
+    return o;
 }
 
 gpu::ContextOptions Args::contextOptions() const {

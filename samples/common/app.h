@@ -4,9 +4,11 @@
 // non-zero exit.
 
 #include "gpu/context.h"
+#include "scene/gltf_loader.h"
 
 #include <functional>
 #include <map>
+#include <optional>
 #include <string>
 #include <utility>
 #include <vector>
@@ -18,6 +20,10 @@ struct CommonOptions {
     std::string device;          // --device NAME (overrides GLINT_DEVICE)
     std::string logLevel = "info";
     bool pipelineOnly = false;   // --no-ray-query: use the ray tracing pipeline even where ray query exists
+    // --reflection-lods RATIO[:ERROR]: the reflection LODs generated for
+    // glTF meshes (scene::ReflectionLodSettings: triangle share, relative
+    // error); "off": the BVH builds them from full detail.
+    std::optional<scene::ReflectionLodSettings> reflectionLods = scene::ReflectionLodSettings{};
 };
 
 // Flags after the common ones: "--name value" or "--name" (value "1").
@@ -31,6 +37,8 @@ public:
     uint32_t getUint(const std::string& name, uint32_t fallback) const;
 
     gpu::ContextOptions contextOptions() const;
+    // How scene files are loaded (the reflection LODs).
+    scene::GltfLoadOptions gltfOptions() const;
 
 private:
     CommonOptions common_;

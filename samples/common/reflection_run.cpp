@@ -200,6 +200,11 @@ ReflectionRunOptions referenceSettings(const ReflectionRunOptions& in) {
     o.frame.rays.roughnessCutoff = 1.0f;  // rough pixels are traced too: the environment is an approximation
     o.renderer.bvh.radius = std::numeric_limits<float>::max();
     o.renderer.bvh.longRangeRadius = std::numeric_limits<float>::max();
+    // Full detail: the reference is the scene itself, not its reflection LODs.
+    o.renderer.bvh.reflectionLods = false;
+    // Every BLAS on the first frame: the reference accumulates from there.
+    o.renderer.bvh.maxFirstBuildsPerFrame = std::numeric_limits<uint32_t>::max();
+    o.renderer.bvh.maxFirstBuildTrianglesPerFrame = std::numeric_limits<uint64_t>::max();
     o.frame.rt.maxDistance = 1e30f;
     o.frame.temporal.maxHistoryFrames = float(r.maxFrames);
     o.frame.temporal.neighbourhoodClamp = false;

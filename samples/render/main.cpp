@@ -165,7 +165,7 @@ int main(int argc, char** argv) {
         if (sceneName == "smoke") {
             return renderSmoke(ctx, out.extension() == ".png" ? out.parent_path() : out, width, height);
         }
-        scene::Scene scene = scene::loadScene(sceneName);
+        scene::Scene scene = scene::loadScene(sceneName, args.gltfOptions());
         if (args.has("environment")) {
             // Errors name the file (scene::SceneError): missing, unreadable, not 2:1.
             const scene::Environment image = scene::loadEquirectangularEnvironment(args.get("environment", ""));

@@ -634,7 +634,7 @@ int main(int argc, char** argv) {
         gpu::Context ctx(contextOptions);
         const Surface surface(ctx, window);
 
-        scene::Scene scene = scene::loadScene(options.scene);
+        scene::Scene scene = scene::loadScene(options.scene, args.gltfOptions());
         // As glint-render: 3 s along the plaza's path looks down the plaza.
         const float startSeconds = options.scene == "plaza" ? 3.0f : 0.0f;
         spdlog::info("{}: {} on {}", scene.name, options.scene, ctx.caps().deviceName);
