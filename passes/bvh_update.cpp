@@ -627,8 +627,18 @@ std::shared_ptr<BvhManager::FrameWork> BvhManager::prepare(const scene::BvhPlan&
             }
         }
         const auto transform = scene::rowMajor3x4(ti.transform);
+        // glTF's front faces wind counter-clockwise in its right-handed
+        // space, which is Vulkan's default facing (clockwise seen from the
+        // ray origin in a left-handed space; FRONT_COUNTERCLOCKWISE would
+        // flip it: measured on lavapipe, the backs of single-sided panels
+        // then stayed and their fronts were culled). The facing is decided
+        // in object space, so a mirroring transform keeps glTF's front faces
+        // front ("an instance transform does not change the winding").
+        // Reflection rays cull back faces except on double-sided geometry.
+        const VkGeometryInstanceFlagsKHR flags =
+            ti.doubleSided ? VK_GEOMETRY_INSTANCE_TRIANGLE_FACING_CULL_DISABLE_BIT_KHR : 0;
         work->instances.push_back(gpu::makeInstance(it->second->structure, transform.data(), ti.customIndex, ti.mask,
-                                                    ti.sbtOffset));
+                                                    ti.sbtOffset, flags));
     }
     stats_.tlasInstances = uint32_t(work->instances.size());
     work->tlasBuild = gpu::AccelBuild::topLevel(ctx_, instanceBuffers_[work->slot].address(),

@@ -256,6 +256,10 @@ struct GBufferRenderer::FrameWork {
     // frustum) and into the shadow map (they meet the map's box).
     std::vector<uint8_t> visible;
     std::vector<uint8_t> castsShadow;
+    // Per instance: its transform mirrors (a negative determinant), so its
+    // front faces wind clockwise on screen (glTF: the determinant sets the
+    // winding).
+    std::vector<uint8_t> mirrored;
     std::vector<glm::mat4> joints;
     std::vector<glm::mat4> previousJoints;
     // Morphing instances: the mesh's vertices with the instance's weights
@@ -272,10 +276,11 @@ GBufferRenderer::GBufferRenderer(gpu::Context& ctx, const scene::Scene& scene, u
     surface.fragmentShader = "gbuffer/gbuffer.frag";
     surface.bindings = gbufferBindings();
     surface.pushConstantBytes = sizeof(shader::GBufferDraw);
-    // No culling: glTF leaves winding to the asset only for single-sided
-    // materials, and the built-in scenes include open and double-sided
-    // geometry; depth testing hides the back faces of closed meshes.
-    surface.cullMode = VK_CULL_MODE_NONE;
+    // Per draw (glTF): back faces culled for single-sided materials, none
+    // for double-sided ones; front faces wind counter-clockwise on screen
+    // (the projection flips Y with the framebuffer), clockwise under a
+    // mirroring transform.
+    surface.dynamicCulling = true;
     surface.colorFormats.assign(kColorFormats.begin(), kColorFormats.end());
     surface.depthFormat = kGBufferDepthFormat;
     surface.name = "gbuffer.surface";
@@ -287,6 +292,8 @@ GBufferRenderer::GBufferRenderer(gpu::Context& ctx, const scene::Scene& scene, u
     // At depth 0 the GREATER_OR_EQUAL test passes only where the clear value
     // survived; writing would change nothing.
     sky.depthWrite = false;
+    sky.dynamicCulling = false;
+    sky.cullMode = VK_CULL_MODE_NONE;
     sky.name = "gbuffer.sky";
     skyPipeline_ = gpu::createGraphicsPipeline(ctx, sky);
 
@@ -510,6 +517,7 @@ std::shared_ptr<GBufferRenderer::FrameWork> GBufferRenderer::prepare(const GBuff
         }
         work->visible.push_back(drawn ? 1 : 0);
         work->castsShadow.push_back(casts ? 1 : 0);
+        work->mirrored.push_back(glm::determinant(glm::mat3(inst.transform)) < 0.0f ? 1 : 0);
         shader::GBufferInstance gi{};
         gi.transform = inst.transform;
         gi.previousTransform = inst.previousTransform;
@@ -740,11 +748,26 @@ void GBufferRenderer::record(const FrameWork& work, rg::PassContext& pc, const G
     MaterialTextures boundTextures = fallbacks;
     pushBindings(surfacePipeline_, *boundVertices, boundTextures);
     vkCmdBindIndexBuffer(cmd, indices_.handle(), 0, VK_INDEX_TYPE_UINT32);
+    VkCullModeFlags cullMode = VK_CULL_MODE_NONE;
+    VkFrontFace frontFace = VK_FRONT_FACE_COUNTER_CLOCKWISE;
+    vkCmdSetCullMode(cmd, cullMode);
+    vkCmdSetFrontFace(cmd, frontFace);
     for (size_t i = 0; i < work.instances.size(); ++i) {
         if (!work.visible[i]) continue;
         const auto [vertices, vertexShift] = vertexSource(work, i, slot);
+        const VkFrontFace instanceFront =
+            work.mirrored[i] ? VK_FRONT_FACE_CLOCKWISE : VK_FRONT_FACE_COUNTER_CLOCKWISE;
+        if (instanceFront != frontFace) {
+            frontFace = instanceFront;
+            vkCmdSetFrontFace(cmd, frontFace);
+        }
         for (const DrawRange& range : meshDraws_.at(work.meshes[i])) {
             if (range.indexCount == 0) continue;
+            const VkCullModeFlags rangeCull = range.doubleSided ? VK_CULL_MODE_NONE : VK_CULL_MODE_BACK_BIT;
+            if (rangeCull != cullMode) {
+                cullMode = rangeCull;
+                vkCmdSetCullMode(cmd, cullMode);
+            }
             // A slot the draw does not sample keeps whatever is bound.
             MaterialTextures textures = boundTextures;
             bool textured = false;

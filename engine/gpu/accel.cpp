@@ -120,13 +120,14 @@ AccelerationStructure buildNow(Context& ctx, AccelBuild& build, const std::strin
 }
 
 VkAccelerationStructureInstanceKHR makeInstance(const AccelerationStructure& blas, const float transform[12],
-                                                uint32_t customIndex, uint8_t mask, uint32_t sbtOffset) {
+                                                uint32_t customIndex, uint8_t mask, uint32_t sbtOffset,
+                                                VkGeometryInstanceFlagsKHR flags) {
     VkAccelerationStructureInstanceKHR instance{};
     std::memcpy(&instance.transform, transform, sizeof(float) * 12);
     instance.instanceCustomIndex = customIndex & 0xffffffu;
     instance.mask = mask;
     instance.instanceShaderBindingTableRecordOffset = sbtOffset & 0xffffffu;
-    instance.flags = 0;
+    instance.flags = flags & 0xffu;
     instance.accelerationStructureReference = blas.address();
     return instance;
 }

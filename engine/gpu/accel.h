@@ -85,8 +85,10 @@ private:
 // one-time static builds and tests (per-frame builds go through the graph).
 AccelerationStructure buildNow(Context& ctx, AccelBuild& build, const std::string& name);
 
-// A VkAccelerationStructureInstanceKHR for `blas` with a row-major 3x4 transform.
+// A VkAccelerationStructureInstanceKHR for `blas` with a row-major 3x4
+// transform. flags: VkGeometryInstanceFlagBitsKHR.
 VkAccelerationStructureInstanceKHR makeInstance(const AccelerationStructure& blas, const float transform[12],
-                                                uint32_t customIndex, uint8_t mask = 0xff, uint32_t sbtOffset = 0);
+                                                uint32_t customIndex, uint8_t mask = 0xff, uint32_t sbtOffset = 0,
+                                                VkGeometryInstanceFlagsKHR flags = 0);
 
 } // namespace glint::gpu

@@ -75,6 +75,9 @@ struct GraphicsPipelineDesc {
     VkPrimitiveTopology topology = VK_PRIMITIVE_TOPOLOGY_TRIANGLE_LIST;
     VkCullModeFlags cullMode = VK_CULL_MODE_BACK_BIT;
     VkFrontFace frontFace = VK_FRONT_FACE_COUNTER_CLOCKWISE;
+    // Cull mode and front face set per draw (vkCmdSetCullMode,
+    // vkCmdSetFrontFace; Vulkan 1.3) instead of the two fields above.
+    bool dynamicCulling = false;
     std::vector<VkFormat> colorFormats;
     VkFormat depthFormat = VK_FORMAT_UNDEFINED;
     bool depthTest = true;

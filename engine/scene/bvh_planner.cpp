@@ -5,6 +5,7 @@
 #include "glint/packing.h"
 
 #include <algorithm>
+#include <iterator>
 #include <set>
 #include <sstream>
 
@@ -188,12 +189,23 @@ BvhPlan BvhPlanner::plan(const Scene& scene, const glm::vec3& cameraPosition, ui
             continue;
         }
         lodOf[m] = settings_.reflectionLods ? reflectionLodIndex(mesh) : 0;
-        partsOf[m] = partitionGeometries(mesh.lods[lodOf[m]], settings_.maxGeometriesPerBlas);
-        // A geometry without triangles would be an empty BLAS geometry.
-        for (std::vector<uint32_t>& part : partsOf[m]) {
-            std::erase_if(part, [&](uint32_t g) { return mesh.lods[lodOf[m]].geometries[g].triangleCount() == 0; });
+        const MeshLod& lod = mesh.lods[lodOf[m]];
+        // A part mixing single- and double-sided materials splits in two:
+        // back-face culling is an instance's, not a geometry's.
+        const auto doubleSided = [&](uint32_t g) {
+            const uint32_t material = lod.geometries[g].material;
+            return material < scene.materials.size() && scene.materials[material].doubleSided;
+        };
+        for (std::vector<uint32_t>& part : partitionGeometries(lod, settings_.maxGeometriesPerBlas)) {
+            // A geometry without triangles would be an empty BLAS geometry.
+            std::erase_if(part, [&](uint32_t g) { return lod.geometries[g].triangleCount() == 0; });
+            std::vector<uint32_t> twoSided;
+            std::copy_if(part.begin(), part.end(), std::back_inserter(twoSided), doubleSided);
+            std::erase_if(part, doubleSided);
+            for (std::vector<uint32_t>* p : {&part, &twoSided}) {
+                if (!p->empty()) partsOf[m].push_back(std::move(*p));
+            }
         }
-        std::erase_if(partsOf[m], [](const std::vector<uint32_t>& part) { return part.empty(); });
     }
 
     // --- Which instance is in range, and which BLAS keys exist. -----------
@@ -319,6 +331,8 @@ BvhPlan BvhPlanner::plan(const Scene& scene, const glm::vec3& cameraPosition, ui
             desc.geometries.push_back({g, lod.geometries[g].material, lod.geometries[g].triangleCount(), 0});
             desc.triangleCount += lod.geometries[g].triangleCount();
         }
+        const uint32_t firstMaterial = desc.geometries.front().material;
+        desc.doubleSided = firstMaterial < scene.materials.size() && scene.materials[firstMaterial].doubleSided;
         desc.poolOffset = pool_.allocate(desc.triangleCount);
         uint32_t offset = desc.poolOffset;
         for (BlasGeometry& g : desc.geometries) {
@@ -443,6 +457,7 @@ BvhPlan BvhPlanner::plan(const Scene& scene, const glm::vec3& cameraPosition, ui
             t.customIndex = uint32_t(plan.primitiveOffsets.size());
             t.sbtOffset = shader::kSbtOffsetPackedPrimitives;
             t.mask = mask;
+            t.doubleSided = desc.doubleSided;
             if (t.customIndex + desc.geometries.size() > (1u << 24)) {
                 throw SceneError(scene.name, "BVH planner", "primitive offset table exceeds the 24-bit custom index");
             }

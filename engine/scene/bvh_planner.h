@@ -7,7 +7,10 @@
 //
 // Policy (Far Cry 6, GDC 2022 "Performant Reflective Beauty"; DESIGN.md 3):
 //  - one BLAS per object, split per material only when an object has more
-//    than 32 geometries; reflection BLASes use the mesh's lower LOD;
+//    than 32 geometries, and into its single- and double-sided geometries
+//    when it has both (a reflection ray passes through the back of a
+//    single-sided triangle, glTF's doubleSided: culling is per instance);
+//    reflection BLASes use the mesh's lower LOD;
 //  - static BLASes are built once (and shared by the instances of a mesh);
 //  - dynamic and skinned BLASes are rebuilt in a round-robin loop of at most
 //    16 rebuilds per frame, at most 12 of them skinned, and only when the
@@ -101,6 +104,9 @@ struct BlasDesc {
     uint32_t poolOffset = 0;  // first triangle of its pool range
     uint32_t triangleCount = 0;
     std::vector<BlasGeometry> geometries;  // BLAS geometry index = position here
+    // Its geometries' materials are double-sided (all or none are): rays
+    // hit their back faces too; single-sided ones they pass through.
+    bool doubleSided = false;
 };
 
 struct BlasBuild {
@@ -120,6 +126,7 @@ struct TlasInstance {
     uint32_t customIndex = 0;   // first row of this instance in BvhPlan::primitiveOffsets (24 bits)
     uint32_t sbtOffset = 0;     // hit group record offset (glint/packing.h)
     uint8_t mask = 0;           // one group bit (glint/packing.h kInstanceMask*)
+    bool doubleSided = false;   // its BLAS's: back faces are not culled
 };
 
 struct BvhStats {

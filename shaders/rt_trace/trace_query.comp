@@ -13,7 +13,10 @@ layout(local_size_x = kRtTraceGroupSize) in;
 
 RtHit rtTraceClosest(vec3 origin, vec3 direction, float tMax) {
     rayQueryEXT query;
-    rayQueryInitializeEXT(query, tlas, gl_RayFlagsOpaqueEXT, rt.instanceMask, origin, 0.0, direction, tMax);
+    // Through the back of single-sided triangles (glTF doubleSided false;
+    // double-sided instances disable the culling, passes/bvh_update.cpp).
+    rayQueryInitializeEXT(query, tlas, gl_RayFlagsOpaqueEXT | gl_RayFlagsCullBackFacingTrianglesEXT, rt.instanceMask,
+                          origin, 0.0, direction, tMax);
     while (rayQueryProceedEXT(query)) {
     }
     RtHit h;

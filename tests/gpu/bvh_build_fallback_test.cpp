@@ -13,6 +13,7 @@
 // nothing in the frame with the BVH still building (its ray passed where an
 // unbuilt box stands).
 #include "support/gpu_test.h"
+#include "support/graph_readback.h"
 
 #include "graph/executor.h"
 #include "graph/graph.h"
@@ -88,8 +89,7 @@ class Sequence {
 public:
     Sequence(gpu::Context& ctx, const scene::Scene& s, uint32_t firstBuildBudget)
         : ctx_(ctx), scene_(s), executor_(ctx), renderer_(ctx, scene_, options(firstBuildBudget)) {
-        readback_ = gpu::Buffer(ctx, {VkDeviceSize(kWidth) * kHeight * 4, VK_BUFFER_USAGE_TRANSFER_DST_BIT,
-                                      gpu::MemoryUsage::Readback, "bvh_fallback_test.readback"});
+        readback_ = test::readbackBuffer(ctx, kWidth, kHeight, 4, "bvh_fallback_test.readback");
         camera_.resolution = {kWidth, kHeight};
         camera_.lens = {glm::radians(60.0f), 0.1f, scene::kInfiniteFar};
         camera_.jitter = false;
@@ -110,7 +110,8 @@ public:
         const passes::ReflectionFrame f = renderer_.addFrame(graph, camera_, settings);
         rg::FrameResources resources;
         renderer_.bind(resources, f);
-        addReadback(graph, f.integrate.hitDistance, resources);
+        test::addReadback(graph, f.integrate.hitDistance, kWidth, kHeight, readback_, resources,
+                          "bvh_fallback_test.readback");
         executor_.run(graph.compile(executor_.compileOptions()), resources);
         executor_.waitIdle();
         FrameResult r;
@@ -126,33 +127,6 @@ private:
         passes::ReflectionRendererOptions o;
         o.bvh.maxFirstBuildsPerFrame = firstBuildBudget;
         return o;
-    }
-
-    void addReadback(rg::Graph& graph, rg::Texture texture, rg::FrameResources& resources) {
-        const rg::BoundaryState lastCopy = rg::BoundaryState::of(rg::Access::TransferDst);
-        const rg::BoundaryState hostRead = rg::BoundaryState::raw(VK_PIPELINE_STAGE_2_HOST_BIT,
-                                                                  VK_ACCESS_2_HOST_READ_BIT, VK_IMAGE_LAYOUT_UNDEFINED);
-        const rg::Buffer target = graph.importBuffer("bvh_fallback_test.readback", {{readback_.size()}, lastCopy, hostRead});
-        resources.bind(target, readback_);
-        struct Data {
-            rg::Texture source;
-            rg::Buffer target;
-        };
-        const Data& data = graph.addPass<Data>(
-            "bvh_fallback_test.readback", rg::Queue::Graphics,
-            [&](rg::Builder& b, Data& d) {
-                d.source = b.read(texture, rg::Access::TransferSrc);
-                d.target = b.write(target, rg::Access::TransferDst);
-            },
-            [](const Data& d, rg::PassContext& pc) {
-                const gpu::Image& image = pc.image(d.source);
-                VkBufferImageCopy region{};
-                region.imageSubresource = {image.aspect(), 0, 0, 1};
-                region.imageExtent = {kWidth, kHeight, 1};
-                vkCmdCopyImageToBuffer(pc.cmd(), image.handle(), VK_IMAGE_LAYOUT_TRANSFER_SRC_OPTIMAL,
-                                       pc.buffer(d.target).handle(), 1, &region);
-            });
-        graph.markOutput(data.target);
     }
 
     gpu::Context& ctx_;

@@ -124,6 +124,8 @@ struct CpuTriangle {
     shader::SurfaceVertex truth[3]{};
     glm::mat3 normalMatrix{1.0f};  // object -> world for normals
     uint32_t instance = 0;
+    bool doubleSided = false;  // its material's: otherwise rays pass through its back
+    bool mirrored = false;     // its instance's transform has a negative determinant
 };
 
 struct CpuHit {
@@ -152,6 +154,8 @@ public:
                     t.packed = u.primitives[p];
                     t.normalMatrix = normalMatrix;
                     t.instance = i;
+                    t.doubleSided = g.material < s.materials.size() && s.materials[g.material].doubleSided;
+                    t.mirrored = glm::determinant(glm::mat3(inst.transform)) < 0.0f;
                     triangles_.push_back(t);
                 }
             }
@@ -159,13 +163,19 @@ public:
     }
 
     // Möller and Trumbore, in double: the closest hit with t in (tMin, tMax).
-    CpuHit trace(glm::dvec3 origin, glm::dvec3 dir, double tMin, double tMax) const {
+    // As the reflection rays do, it passes through the backs of
+    // single-sided triangles: det > 0 where the triangle winds
+    // counter-clockwise seen from the origin (glTF's front), the other way
+    // round under a mirroring transform. Shadow rays (cullBackFaces false)
+    // stop at either side.
+    CpuHit trace(glm::dvec3 origin, glm::dvec3 dir, double tMin, double tMax, bool cullBackFaces = true) const {
         CpuHit best;
         for (const CpuTriangle& tri : triangles_) {
             const glm::dvec3 e1 = tri.v[1] - tri.v[0], e2 = tri.v[2] - tri.v[0];
             const glm::dvec3 p = glm::cross(dir, e2);
             const double det = glm::dot(e1, p);
             if (std::abs(det) < 1e-300) continue;
+            if (cullBackFaces && !tri.doubleSided && (det > 0.0) == tri.mirrored) continue;
             const glm::dvec3 s = origin - tri.v[0];
             const double u = glm::dot(s, p) / det;
             const glm::dvec3 q = glm::cross(s, e1);
@@ -456,6 +466,9 @@ scene::Scene hitScene() {
     target.roughnessFactor = 0.4f;
     target.metallicFactor = 0.2f;
     target.reflectance = 0.6f;
+    // Double-sided: some rays reach it from behind (the quad is turned),
+    // where a single-sided quad lets them through.
+    target.doubleSided = true;
     scene::Material roof;
     roof.baseColorFactor = {0.3f, 0.3f, 0.3f, 1.0f};
     roof.roughnessFactor = 0.9f;
@@ -681,7 +694,7 @@ TEST_CASE("RT hits interpolate the packed triangle and light it as the CPU does;
             const glm::dvec3 lift = face * (glm::dot(face, glm::dvec3(kSun)) > 0.0 ? 1e-4 : -1e-4);
             bool anyOccluded = false, allOccluded = true;
             for (const glm::dvec3 offset : {glm::dvec3(0), 0.05 * e1, -0.05 * e1, 0.05 * e2, -0.05 * e2}) {
-                const bool occluded = cpu.trace(glm::dvec3(position) + offset + lift, glm::dvec3(kSun), 0.0, 200.0).hit;
+                const bool occluded = cpu.trace(glm::dvec3(position) + offset + lift, glm::dvec3(kSun), 0.0, 200.0, false).hit;
                 anyOccluded = anyOccluded || occluded;
                 allOccluded = allOccluded && occluded;
             }
@@ -723,7 +736,7 @@ TEST_CASE("without shadows the roof's shadow is gone; rougher surfaces trace sho
         const glm::vec3 expected = shadeSurface(lit, hitSurface(h, position, r.direction, true), -r.direction, 1.0f);
         CHECK(near(glm::vec3(f.radiance[pixelIndex(r.pixel)]), expected, 3e-3f, 3e-4f));
         ++checked;
-        if (cpu.trace(glm::dvec3(position), glm::dvec3(kSun), 1e-3, 200.0).hit) ++underRoof;
+        if (cpu.trace(glm::dvec3(position), glm::dvec3(kSun), 1e-3, 200.0, false).hit) ++underRoof;
     }
     CHECK(checked > 40);
     CHECK(underRoof > 10);  // hits the roof shadows when shadows are on
@@ -796,7 +809,9 @@ TEST_CASE("ray query and the ray tracing pipeline write bit-identical radiance a
     }
     MESSAGE(hits << " hits and " << misses << " misses compared");
     CHECK(differing == 0);
-    CHECK(hits > 500);
+    // 358 measured: the roof is single-sided and faces up, so the rays
+    // from below pass through it (833 before back faces were culled).
+    CHECK(hits > 300);
     CHECK(misses > 500);
 }
 
@@ -822,6 +837,10 @@ void checkNoSelfIntersection(test::GpuTest& gpu, double centre, bool rawMustSelf
     scene::Material plane;
     plane.roughnessFactor = 0.0f;
     plane.metallicFactor = 1.0f;
+    // Double-sided: reflection rays cull the backs of single-sided
+    // triangles, which would hide the raw origins' self hits this test
+    // counts (a double-sided surface has them).
+    plane.doubleSided = true;
     scene::Material wall;
     wall.baseColorFactor = {0.7f, 0.7f, 0.7f, 1.0f};
     wall.roughnessFactor = 0.5f;

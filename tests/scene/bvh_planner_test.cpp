@@ -398,6 +398,35 @@ TEST_CASE("the first-build triangle budget spreads builds over frames, and one o
     CHECK(third.complete());
 }
 
+TEST_CASE("an object mixing single- and double-sided materials gets a BLAS for each, the double-sided one's TLAS "
+          "instance marked so (back-face culling is per instance)") {
+    TestScene t;
+    t.scene.materials[1].doubleSided = true;
+    Mesh mixed;
+    mixed.name = "mixed";
+    mixed.lods.push_back({{makeBox(glm::vec3(1.0f), 0), makeBox(glm::vec3(0.5f), 1), makeBox(glm::vec3(0.2f), 2)}});
+    t.scene.meshes.push_back(mixed);
+    const uint32_t i = t.add({0, 0, 0});
+    t.scene.instances[i].mesh = 1;
+    const uint32_t plain = t.add({3, 0, 0});
+    t.prepare();
+    BvhPlanner planner;
+    const BvhPlan plan = planner.plan(t.scene, {0, 0, 0}, 0);
+    std::vector<const TlasInstance*> ofMixed;
+    for (const TlasInstance& ti : plan.tlas) {
+        if (ti.sceneInstance == i) ofMixed.push_back(&ti);
+        if (ti.sceneInstance == plain) CHECK_FALSE(ti.doubleSided);
+    }
+    REQUIRE(ofMixed.size() == 2u);
+    for (const TlasInstance* ti : ofMixed) {
+        const BlasDesc* d = plan.find(ti->blas);
+        REQUIRE(d != nullptr);
+        CHECK(ti->doubleSided == d->doubleSided);
+        for (const BlasGeometry& g : d->geometries) CHECK(t.scene.materials[g.material].doubleSided == d->doubleSided);
+        CHECK(d->geometries.size() == (d->doubleSided ? 1u : 2u));
+    }
+}
+
 TEST_CASE("the particle TLAS exists only when there are particles") {
     TestScene t;
     t.add({0, 0, 0});

@@ -120,10 +120,10 @@ bool rtSetupRay(uint index, out RtRay ray) {
     return true;
 }
 
-// The packed surface at a hit, in world space. Back faces are lit as
-// front faces (the normal turned towards the ray): the pool keeps no
-// double-sidedness, and a ray that reaches a back face of closed geometry
-// has leaked anyway.
+// The packed surface at a hit, in world space. Reflection rays pass
+// through the backs of single-sided triangles (traversal culls them), so a
+// back face hit is double-sided: lit as a front face, the normal turned
+// towards the ray, as the G-buffer turns a double-sided back face's.
 Surface rtHitSurface(RtRay ray, RtHit hit) {
     const uint slot = primitiveOffsetSlot(hit.customIndex, hit.geometry);
     const SurfaceVertex v = interpolateSurface(pool[primitiveOffsets[slot] + hit.primitive], hit.barycentrics);
