@@ -265,6 +265,11 @@ BvhPlan BvhPlanner::plan(const Scene& scene, const glm::vec3& cameraPosition, ui
         float screenSize = 0.0f;  // bounding radius over distance
         float distance = 0.0f;
     };
+    const auto better = [](const Candidate& a, const Candidate& b) {
+        if (a.firstPerson != b.firstPerson) return a.firstPerson;
+        if (a.screenSize != b.screenSize) return a.screenSize > b.screenSize;
+        return a.distance < b.distance;
+    };
     std::map<Key, Candidate> candidates;
     for (size_t i = 0; i < scene.instances.size(); ++i) {
         if (!views[i].inRange) {
@@ -277,11 +282,6 @@ BvhPlan BvhPlanner::plan(const Scene& scene, const glm::vec3& cameraPosition, ui
         c.firstPerson = inst.firstPerson;
         c.distance = distanceToBounds(box, cameraPosition);
         c.screenSize = 0.5f * glm::length(box.max - box.min) / std::max(c.distance, 1e-3f);
-        const auto better = [](const Candidate& a, const Candidate& b) {
-            if (a.firstPerson != b.firstPerson) return a.firstPerson;
-            if (a.screenSize != b.screenSize) return a.screenSize > b.screenSize;
-            return a.distance < b.distance;
-        };
         for (const Key& key : views[i].keys) {
             if (resident_.count(key)) {
                 continue;
@@ -295,11 +295,7 @@ BvhPlan BvhPlanner::plan(const Scene& scene, const glm::vec3& cameraPosition, ui
     }
     std::vector<Candidate> order;
     for (const auto& [key, c] : candidates) order.push_back(c);
-    std::stable_sort(order.begin(), order.end(), [](const Candidate& a, const Candidate& b) {
-        if (a.firstPerson != b.firstPerson) return a.firstPerson;
-        if (a.screenSize != b.screenSize) return a.screenSize > b.screenSize;
-        return a.distance < b.distance;
-    });
+    std::stable_sort(order.begin(), order.end(), better);
     std::set<BlasId> builtThisFrame;
     uint32_t firstBuilds = 0;
     uint64_t firstBuildTriangles = 0;
