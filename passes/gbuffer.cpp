@@ -228,6 +228,7 @@ struct GBufferRenderer::DrawRange {
     uint32_t indexCount = 0;
     int32_t vertexOffset = 0;
     bool doubleSided = false;
+    bool masked = false;  // glTF alphaMode MASK: drawn with the alpha-tested pipelines
     // The draw's push constants less the instance; per MaterialSlot the
     // image (kNoImage: the slot's fallback) and sampler it binds.
     shader::GBufferDraw material{};
@@ -285,6 +286,10 @@ GBufferRenderer::GBufferRenderer(gpu::Context& ctx, const scene::Scene& scene, u
     surface.depthFormat = kGBufferDepthFormat;
     surface.name = "gbuffer.surface";
     surfacePipeline_ = gpu::createGraphicsPipeline(ctx, surface);
+    gpu::GraphicsPipelineDesc masked = surface;
+    masked.fragmentShader = "gbuffer/gbuffer_masked.frag";
+    masked.name = "gbuffer.surface_masked";
+    surfaceMaskedPipeline_ = gpu::createGraphicsPipeline(ctx, masked);
 
     gpu::GraphicsPipelineDesc sky = surface;
     sky.vertexShader = "gbuffer/sky.vert";
@@ -308,6 +313,14 @@ GBufferRenderer::GBufferRenderer(gpu::Context& ctx, const scene::Scene& scene, u
     shadow.depthFormat = kGBufferShadowMapFormat;
     shadow.name = "gbuffer.shadow_map";
     shadowPipeline_ = gpu::createGraphicsPipeline(ctx, shadow);
+    // Alpha-tested casters read the base colour texture's alpha, at the
+    // binding the G-buffer samples it from.
+    gpu::GraphicsPipelineDesc shadowMasked = shadow;
+    shadowMasked.fragmentShader = "gbuffer/shadow_masked.frag";
+    shadowMasked.bindings.push_back({kFirstMaterialTextureBinding + kBaseColorSlot,
+                                     VK_DESCRIPTOR_TYPE_COMBINED_IMAGE_SAMPLER, VK_SHADER_STAGE_FRAGMENT_BIT});
+    shadowMasked.name = "gbuffer.shadow_map_masked";
+    shadowMaskedPipeline_ = gpu::createGraphicsPipeline(ctx, shadowMasked);
 
     nearest_ = gpu::Sampler(ctx, {VK_FILTER_NEAREST, VK_SAMPLER_MIPMAP_MODE_NEAREST,
                                   VK_SAMPLER_ADDRESS_MODE_CLAMP_TO_EDGE, 0.0f, "gbuffer.nearest"});
@@ -377,6 +390,7 @@ GBufferRenderer::GBufferRenderer(gpu::Context& ctx, const scene::Scene& scene, u
             range.vertexOffset = int32_t(vertices.size());
             const scene::Material& material = scene.materials.at(g.material);
             range.doubleSided = material.doubleSided;
+            range.masked = material.alphaMode == scene::AlphaMode::Mask;
             // A slot samples its texture when `wanted` and the texture has an
             // image: its coordinate set (+1; 0 = not sampled), transform and
             // sampler go to the draw.
@@ -390,6 +404,7 @@ GBufferRenderer::GBufferRenderer(gpu::Context& ctx, const scene::Scene& scene, u
                 return true;
             };
             shader::GBufferDraw& draw = range.material;
+            draw.alphaCutoff = range.masked ? material.alphaCutoff : -1.0f;
             if (useSlot(kNormalSlot, material.normalTexture, VK_FORMAT_R8G8B8A8_UNORM, "normal_map",
                         g.tangents.size() == g.vertexCount(), draw.normalMap, draw.normalUvTransform)) {
                 draw.normalScale = material.normalScale;
@@ -435,6 +450,8 @@ GBufferRenderer::GBufferRenderer(gpu::Context& ctx, const scene::Scene& scene, u
                 out.tangent = v < g.tangents.size() ? g.tangents[v] : glm::vec4(1.0f, 0.0f, 0.0f, 1.0f);
                 out.uv0 = v < g.texcoords0.size() ? g.texcoords0[v] : glm::vec2(0.0f);
                 out.uv1 = v < g.texcoords1.size() ? g.texcoords1[v] : glm::vec2(0.0f);
+                out.alpha = std::clamp(material.baseColorFactor.a * (v < g.colors.size() ? g.colors[v].a : 1.0f),
+                                       0.0f, 1.0f);
                 vertices.push_back(out);
             }
             indices.insert(indices.end(), g.indices.begin(), g.indices.end());
@@ -634,33 +651,51 @@ void GBufferRenderer::recordShadowMap(const FrameWork& work, rg::PassContext& pc
         const VkRect2D scissor{{0, 0}, {size, size}};
         vkCmdSetViewport(cmd, 0, 1, &viewport);
         vkCmdSetScissor(cmd, 0, 1, &scissor);
-        shadowPipeline_.bind(cmd);
-        const auto pushBindings = [&](const gpu::Buffer& vertices) {
-            gpu::PushDescriptors(shadowPipeline_)
-                .storageBuffer(0, slot.frame)
-                .storageBuffer(1, slot.instances)
-                .storageBuffer(2, vertices)
-                .storageBuffer(3, slot.joints)
-                .storageBuffer(4, slot.previousJoints)
-                .push(ctx_, cmd);
-        };
-        const gpu::Buffer* boundVertices = &vertices_;
-        pushBindings(*boundVertices);
+        // Opaque casters, then alpha-tested ones (their own pipeline reads
+        // the base colour texture's alpha and discards).
         vkCmdBindIndexBuffer(cmd, indices_.handle(), 0, VK_INDEX_TYPE_UINT32);
-        for (size_t i = 0; i < work.instances.size(); ++i) {
-            if (!work.castsShadow[i]) continue;
-            const auto [vertices, vertexShift] = vertexSource(work, i, slot);
-            if (vertices != boundVertices) {
-                boundVertices = vertices;
-                pushBindings(*boundVertices);
-            }
-            for (const DrawRange& range : meshDraws_.at(work.meshes[i])) {
-                if (range.indexCount == 0) continue;
-                shader::GBufferDraw draw{};
-                draw.instance = uint32_t(i);
-                shadowPipeline_.pushConstants(cmd, draw);
-                vkCmdDrawIndexed(cmd, range.indexCount, 1, range.firstIndex, range.vertexOffset + vertexShift, 0);
-                ++stats_.shadowDraws;
+        for (const bool masked : {false, true}) {
+            const gpu::Pipeline& pipeline = masked ? shadowMaskedPipeline_ : shadowPipeline_;
+            pipeline.bind(cmd);
+            const gpu::Buffer* boundVertices = nullptr;
+            const gpu::Image* boundImage = nullptr;
+            const gpu::Sampler* boundSampler = nullptr;
+            for (size_t i = 0; i < work.instances.size(); ++i) {
+                if (!work.castsShadow[i]) continue;
+                const auto [vertices, vertexShift] = vertexSource(work, i, slot);
+                for (const DrawRange& range : meshDraws_.at(work.meshes[i])) {
+                    if (range.indexCount == 0 || range.masked != masked) continue;
+                    const size_t image = range.image[kBaseColorSlot];
+                    const gpu::Image* baseColor = image == kNoImage ? &white_ : &textureImages_[image];
+                    const gpu::Sampler* sampler =
+                        image == kNoImage ? &textureSamplers_[0] : &textureSamplers_[range.sampler[kBaseColorSlot]];
+                    if (vertices != boundVertices || (masked && (baseColor != boundImage || sampler != boundSampler))) {
+                        boundVertices = vertices;
+                        boundImage = baseColor;
+                        boundSampler = sampler;
+                        gpu::PushDescriptors push(pipeline);
+                        push.storageBuffer(0, slot.frame)
+                            .storageBuffer(1, slot.instances)
+                            .storageBuffer(2, *vertices)
+                            .storageBuffer(3, slot.joints)
+                            .storageBuffer(4, slot.previousJoints);
+                        if (masked) {
+                            push.sampledImage(kFirstMaterialTextureBinding + kBaseColorSlot, baseColor->view(),
+                                              sampler->handle());
+                        }
+                        push.push(ctx_, cmd);
+                    }
+                    shader::GBufferDraw draw{};
+                    draw.instance = uint32_t(i);
+                    if (masked) {
+                        draw.alphaCutoff = range.material.alphaCutoff;
+                        draw.baseColorMap = range.material.baseColorMap;
+                        draw.baseColorUvTransform = range.material.baseColorUvTransform;
+                    }
+                    pipeline.pushConstants(cmd, draw);
+                    vkCmdDrawIndexed(cmd, range.indexCount, 1, range.firstIndex, range.vertexOffset + vertexShift, 0);
+                    ++stats_.shadowDraws;
+                }
             }
         }
     }
@@ -743,53 +778,61 @@ void GBufferRenderer::record(const FrameWork& work, rg::PassContext& pc, const G
     stats_.triangles = 0;
     stats_.normalMappedDraws = 0;
     stats_.texturedDraws = 0;
-    surfacePipeline_.bind(cmd);
-    const gpu::Buffer* boundVertices = &vertices_;
-    MaterialTextures boundTextures = fallbacks;
-    pushBindings(surfacePipeline_, *boundVertices, boundTextures);
+    stats_.maskedDraws = 0;
     vkCmdBindIndexBuffer(cmd, indices_.handle(), 0, VK_INDEX_TYPE_UINT32);
     VkCullModeFlags cullMode = VK_CULL_MODE_NONE;
     VkFrontFace frontFace = VK_FRONT_FACE_COUNTER_CLOCKWISE;
-    vkCmdSetCullMode(cmd, cullMode);
-    vkCmdSetFrontFace(cmd, frontFace);
-    for (size_t i = 0; i < work.instances.size(); ++i) {
-        if (!work.visible[i]) continue;
-        const auto [vertices, vertexShift] = vertexSource(work, i, slot);
-        const VkFrontFace instanceFront =
-            work.mirrored[i] ? VK_FRONT_FACE_CLOCKWISE : VK_FRONT_FACE_COUNTER_CLOCKWISE;
-        if (instanceFront != frontFace) {
-            frontFace = instanceFront;
-            vkCmdSetFrontFace(cmd, frontFace);
-        }
-        for (const DrawRange& range : meshDraws_.at(work.meshes[i])) {
-            if (range.indexCount == 0) continue;
-            const VkCullModeFlags rangeCull = range.doubleSided ? VK_CULL_MODE_NONE : VK_CULL_MODE_BACK_BIT;
-            if (rangeCull != cullMode) {
-                cullMode = rangeCull;
-                vkCmdSetCullMode(cmd, cullMode);
+    // Opaque draws first, then the alpha-tested ones with their own
+    // pipeline: the discard costs early depth testing only where it exists,
+    // and the opaque depth already rejects what the cutouts hide behind.
+    for (const bool masked : {false, true}) {
+        const gpu::Pipeline& pipeline = masked ? surfaceMaskedPipeline_ : surfacePipeline_;
+        pipeline.bind(cmd);
+        vkCmdSetCullMode(cmd, cullMode);
+        vkCmdSetFrontFace(cmd, frontFace);
+        const gpu::Buffer* boundVertices = &vertices_;
+        MaterialTextures boundTextures = fallbacks;
+        pushBindings(pipeline, *boundVertices, boundTextures);
+        for (size_t i = 0; i < work.instances.size(); ++i) {
+            if (!work.visible[i]) continue;
+            const auto [vertices, vertexShift] = vertexSource(work, i, slot);
+            const VkFrontFace instanceFront =
+                work.mirrored[i] ? VK_FRONT_FACE_CLOCKWISE : VK_FRONT_FACE_COUNTER_CLOCKWISE;
+            for (const DrawRange& range : meshDraws_.at(work.meshes[i])) {
+                if (range.indexCount == 0 || range.masked != masked) continue;
+                if (instanceFront != frontFace) {
+                    frontFace = instanceFront;
+                    vkCmdSetFrontFace(cmd, frontFace);
+                }
+                const VkCullModeFlags rangeCull = range.doubleSided ? VK_CULL_MODE_NONE : VK_CULL_MODE_BACK_BIT;
+                if (rangeCull != cullMode) {
+                    cullMode = rangeCull;
+                    vkCmdSetCullMode(cmd, cullMode);
+                }
+                // A slot the draw does not sample keeps whatever is bound.
+                MaterialTextures textures = boundTextures;
+                bool textured = false;
+                for (size_t t = 0; t < kMaterialSlots; ++t) {
+                    if (range.image[t] == kNoImage) continue;
+                    textures[t] = {&textureImages_[range.image[t]], &textureSamplers_[range.sampler[t]]};
+                    textured = true;
+                }
+                stats_.normalMappedDraws += range.material.normalMap != 0 ? 1u : 0u;
+                stats_.texturedDraws += textured ? 1u : 0u;
+                stats_.maskedDraws += masked ? 1u : 0u;
+                if (vertices != boundVertices || textures != boundTextures) {
+                    boundVertices = vertices;
+                    boundTextures = textures;
+                    pushBindings(pipeline, *boundVertices, boundTextures);
+                }
+                shader::GBufferDraw draw = range.material;
+                draw.instance = uint32_t(i);
+                draw.doubleSided = range.doubleSided ? 1u : 0u;
+                pipeline.pushConstants(cmd, draw);
+                vkCmdDrawIndexed(cmd, range.indexCount, 1, range.firstIndex, range.vertexOffset + vertexShift, 0);
+                ++stats_.draws;
+                stats_.triangles += range.indexCount / 3;
             }
-            // A slot the draw does not sample keeps whatever is bound.
-            MaterialTextures textures = boundTextures;
-            bool textured = false;
-            for (size_t t = 0; t < kMaterialSlots; ++t) {
-                if (range.image[t] == kNoImage) continue;
-                textures[t] = {&textureImages_[range.image[t]], &textureSamplers_[range.sampler[t]]};
-                textured = true;
-            }
-            stats_.normalMappedDraws += range.material.normalMap != 0 ? 1u : 0u;
-            stats_.texturedDraws += textured ? 1u : 0u;
-            if (vertices != boundVertices || textures != boundTextures) {
-                boundVertices = vertices;
-                boundTextures = textures;
-                pushBindings(surfacePipeline_, *boundVertices, boundTextures);
-            }
-            shader::GBufferDraw draw = range.material;
-            draw.instance = uint32_t(i);
-            draw.doubleSided = range.doubleSided ? 1u : 0u;
-            surfacePipeline_.pushConstants(cmd, draw);
-            vkCmdDrawIndexed(cmd, range.indexCount, 1, range.firstIndex, range.vertexOffset + vertexShift, 0);
-            ++stats_.draws;
-            stats_.triangles += range.indexCount / 3;
         }
     }
     if (work.drawSky) {

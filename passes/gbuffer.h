@@ -159,6 +159,7 @@ struct GBufferStats {
     uint32_t normalMaps = 0;      // of them, normal textures
     uint32_t normalMappedDraws = 0;  // this frame
     uint32_t texturedDraws = 0;   // this frame: draws sampling any material texture
+    uint32_t maskedDraws = 0;     // this frame: alpha-tested draws (glTF alphaMode MASK)
 };
 
 // Owns the scene's GPU geometry (every mesh's LOD 0, uploaded once into one
@@ -208,8 +209,10 @@ private:
     uint32_t framesInFlight_;
     uint64_t frame_ = 0;
     gpu::Pipeline surfacePipeline_;
+    gpu::Pipeline surfaceMaskedPipeline_;  // glTF alphaMode MASK: the alpha test (gbuffer_masked.frag)
     gpu::Pipeline skyPipeline_;
     gpu::Pipeline shadowPipeline_;
+    gpu::Pipeline shadowMaskedPipeline_;   // the same test in the shadow map (shadow_masked.frag)
     gpu::Sampler nearest_;  // completes the shadow map's descriptor; reads are texelFetch
     gpu::Sampler environmentSampler_;
     // Material textures: one image per scene texture and colour space some

@@ -10,7 +10,7 @@
 
 layout(location = 0) out vec3 outWorldPosition;
 layout(location = 1) out vec3 outNormal;
-layout(location = 2) out vec3 outAlbedo;
+layout(location = 2) out vec4 outAlbedo;     // rgb, a = coverage
 layout(location = 3) out vec3 outMaterial;  // roughness, metallic, reflectance
 layout(location = 4) out vec4 outClip;      // unjittered, this frame
 layout(location = 5) out vec4 outPreviousClip;
@@ -48,7 +48,7 @@ void main() {
     outTangent = vec4(linear * tangent, determinant(linear) < 0.0 ? -v.tangent.w : v.tangent.w);
     outUv = vec4(v.uv0, v.uv1);
     outWorldPosition = world.xyz;
-    outAlbedo = v.albedo;
+    outAlbedo = vec4(v.albedo, v.alpha);
     outEmissive = v.emissive;
     outMaterial = vec3(v.roughness, v.metallic, v.reflectance);
     outClip = frame.viewProjection * world;

@@ -1199,3 +1199,122 @@ TEST_CASE("emission adds to the lit colour of a sunlit plane; a material that do
     }
     CHECK(covered > kSize * kSize / 2);
 }
+
+// ---------------------------------------------------------------------------
+// Alpha-tested materials (glTF alphaMode MASK)
+// ---------------------------------------------------------------------------
+
+TEST_CASE("an alpha-tested plane leaves no surface where its base colour alpha is below the cutoff; an opaque one "
+          "covers everything") {
+    // Cells 1 and 3 transparent (alpha 0), 0 and 2 opaque.
+    const std::array<glm::u8vec4, 4> cells = {glm::u8vec4(200, 40, 90, 255), glm::u8vec4(30, 180, 250, 0),
+                                              glm::u8vec4(120, 120, 20, 255), glm::u8vec4(250, 250, 250, 0)};
+    test::GpuTest gpu;
+    for (const scene::AlphaMode mode : {scene::AlphaMode::Mask, scene::AlphaMode::Opaque}) {
+        CAPTURE(int(mode));
+        scene::Material material;
+        material.baseColorTexture.texture = 0;
+        material.alphaMode = mode;
+        material.alphaCutoff = 0.5f;
+        const scene::Scene scene = checkerPlaneScene(checkerTexture(cells), material);
+        passes::GBufferStats stats;
+        const GBufferImage img = render(gpu, scene, {testCamera()}, &stats);
+        CHECK(stats.maskedDraws == (mode == scene::AlphaMode::Mask ? 1u : 0u));
+        std::array<int, 4> covered{}, empty{};
+        for (uint32_t y = 0; y < kSize; ++y) {
+            for (uint32_t x = 0; x < kSize; ++x) {
+                const int cell = checkerCellAt(material.baseColorTexture, x, y, 2.0f / 64.0f);
+                if (cell < 0) continue;
+                const bool surface = img.normal[img.at(x, y)].w > 0.5f && img.depth[img.at(x, y)] > 0.0f;
+                (surface ? covered : empty)[size_t(cell)]++;
+            }
+        }
+        CAPTURE(covered[0]);
+        CAPTURE(covered[1]);
+        for (size_t c = 0; c < 4; ++c) {
+            const bool transparent = mode == scene::AlphaMode::Mask && cells[c].a == 0;
+            CHECK((transparent ? covered : empty)[c] == 0);
+            CHECK((transparent ? empty : covered)[c] > 100);
+        }
+    }
+}
+
+TEST_CASE("the alpha test reads the factor and COLOR_0 alpha too: a plane at 0.4 against a 0.5 cutoff vanishes, at "
+          "0.6 it stays") {
+    test::GpuTest gpu;
+    for (const float alpha : {0.4f, 0.6f}) {
+        CAPTURE(alpha);
+        scene::Material material;
+        material.alphaMode = scene::AlphaMode::Mask;
+        material.alphaCutoff = 0.5f;
+        material.baseColorFactor = {0.5f, 0.5f, 0.5f, alpha};
+        scene::Geometry plane = square({0, 0, -5}, {1, 0, 0}, {0, 1, 0}, 5.0f);
+        const GBufferImage img = render(gpu, singleObjectScene(plane, material), {testCamera()});
+        uint32_t covered = 0;
+        for (const glm::vec4& n : img.normal) covered += n.w > 0.5f ? 1u : 0u;
+        CHECK(covered == (alpha > 0.5f ? kSize * kSize : 0u));
+    }
+}
+
+TEST_CASE("an alpha-tested plate casts the shadow of its opaque half only") {
+    test::GpuTest gpu;
+    scene::Scene scene = floorAndPlateScene(60.0f, 160.0f);
+    // The plate's left half (x < 0) opaque, its right half cut out.
+    scene::Geometry& plate = scene.meshes[1].lods[0].geometries[0];
+    for (const glm::vec3& p : plate.positions) {
+        plate.texcoords0.push_back({(p.x - kPlateCentre.x) / (2.0f * kPlateHalfSize) + 0.5f, 0.5f});
+    }
+    scene::Texture halves;
+    halves.name = "halves";
+    halves.width = 64;
+    halves.height = 4;
+    for (uint32_t y = 0; y < halves.height; ++y) {
+        for (uint32_t x = 0; x < halves.width; ++x) {
+            halves.rgba8.insert(halves.rgba8.end(), {128, 128, 128, uint8_t(x < 32 ? 255 : 0)});
+        }
+    }
+    scene.textures.push_back(halves);
+    scene::Material cutout = scene.materials[0];
+    cutout.baseColorTexture.texture = 0;
+    cutout.alphaMode = scene::AlphaMode::Mask;
+    cutout.doubleSided = true;
+    scene.materials.push_back(cutout);
+    plate.material = 1;
+    scene::prepareScene(scene);
+
+    const scene::Camera camera = shadowTestCamera();
+    passes::GBufferSettings settings;
+    passes::GBufferSettings off = settings;
+    off.shadow.enabled = false;
+    const GBufferImage shadowed = render(gpu, scene, {camera}, nullptr, settings);
+    const GBufferImage unshadowed = render(gpu, scene, {camera}, nullptr, off);
+    const shader::GBufferShadow fit = passes::fitSunShadow(scene, camera, settings.shadow);
+    const glm::vec3 ambient = floorAmbient(scene);
+    // The analytic shadows of the two halves on the floor.
+    const auto halfQuad = [&](float x0, float x1) {
+        std::array<glm::vec2, 4> q;
+        const glm::vec2 corners[4] = {{x0, -1}, {x1, -1}, {x1, 1}, {x0, 1}};
+        for (size_t i = 0; i < 4; ++i) {
+            q[i] = shadowTexel(fit, kPlateCentre + kPlateHalfSize * glm::vec3(corners[i].x, 0.0f, corners[i].y));
+        }
+        return q;
+    };
+    const auto opaqueHalf = halfQuad(-1.0f, 0.0f), cutHalf = halfQuad(0.0f, 1.0f);
+    uint32_t inOpaque = 0, inCut = 0;
+    for (const FloorPixel& p : floorPixels(camera, fit, shadowed, unshadowed)) {
+        const glm::vec3 world = worldAt(camera, shadowed, p.x, p.y);
+        const glm::vec2 texel = shadowTexel(fit, world);
+        if (signedDistanceToQuad(texel, opaqueHalf) < -kPenumbraTexels) {
+            INFO("pixel " << p.x << ", " << p.y << " under the opaque half");
+            REQUIRE(near(p.lit, ambient));
+            ++inOpaque;
+        } else if (signedDistanceToQuad(texel, cutHalf) < -kPenumbraTexels &&
+                   signedDistanceToQuad(texel, opaqueHalf) > kPenumbraTexels) {
+            INFO("pixel " << p.x << ", " << p.y << " under the cut-out half");
+            REQUIRE(near(p.lit, p.unshadowed));
+            ++inCut;
+        }
+    }
+    CHECK(inOpaque > 30u);
+    CHECK(inCut > 30u);
+}

@@ -54,6 +54,10 @@ struct GBufferVertex {
     // emissive texture at the vertex where it is not sampled per pixel),
     // times SceneLighting's emissive scale in the shader.
     vec3 emissive;
+    // Coverage: baseColorFactor.a x COLOR_0.a (the base colour texture's
+    // alpha multiplies it per pixel); alpha-tested draws compare it with
+    // GBufferDraw::alphaCutoff.
+    float alpha;
 };
 
 // One scene instance this frame and last (144 bytes).
@@ -151,14 +155,19 @@ struct GBufferDraw {
     UvTransform baseColorUvTransform;
     UvTransform metalRoughUvTransform;
     UvTransform emissiveUvTransform;
+    // glTF alphaMode MASK: fragments whose alpha (the vertex's times the
+    // base colour texel's) is below it are discarded, in the G-buffer and
+    // in the shadow map; only the alpha-tested pipelines read it (opaque
+    // draws keep early depth testing).
+    float alphaCutoff;
 };
 
 GLINT_END
 
 #ifdef __cplusplus
-static_assert(sizeof(glint::shader::GBufferVertex) == 116);
+static_assert(sizeof(glint::shader::GBufferVertex) == 120);
 static_assert(sizeof(glint::shader::GBufferInstance) == 144);
-static_assert(sizeof(glint::shader::GBufferDraw) == 124);
+static_assert(sizeof(glint::shader::GBufferDraw) == 128);  // Vulkan's guaranteed push constant space
 static_assert(sizeof(glint::shader::GBufferShadow) == 112);
 static_assert(sizeof(glint::shader::SceneLighting) == 240);
 #endif

@@ -1,0 +1,7 @@
+#version 460
+// The G-buffer's surface shader for alpha-tested materials (glTF alphaMode
+// MASK; gbuffer_surface.glsl).
+#extension GL_GOOGLE_include_directive : require
+
+#define GLINT_ALPHA_TEST 1
+#include "gbuffer_surface.glsl"
