@@ -144,7 +144,8 @@ ReflectionFrame ReflectionRenderer::addFrame(rg::Graph& graph, const scene::Came
 
     // 0. BVH: only when something traces; on the async compute queue.
     if (traces) {
-        const scene::BvhPlan plan = planner_.plan(scene_, camera);
+        scene::BvhPlan plan = planner_.plan(scene_, camera);
+        plan.particleTlas = plan.particleTlas && settings.reflectParticles;
         lastPlanStats_ = plan.stats;
         f.bvhComplete = plan.complete();
         f.bvh = addBvhUpdatePass(graph, bvh_, plan, camera);

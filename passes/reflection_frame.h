@@ -79,6 +79,10 @@ struct ReflectionFrameSettings {
     // (ParticleTraceSettings::sslrSeesParticles). Off: drawn after SSLR,
     // and every traced reflection takes its particles from the trace.
     bool sslrParticles = false;
+    // Particles in the reflections: off, no particle TLAS is built and no
+    // particle trace runs (the direct view still draws the particles); what
+    // reflected particles cost is the difference.
+    bool reflectParticles = true;
     // While the BVH is still building objects in range (its first-build
     // budget, scene::BvhSettings), SSLR is the fallback (the Far Cry 6
     // talk): in hybrid mode every pixel tries SSLR first, and a ray-traced

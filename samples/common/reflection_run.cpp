@@ -78,7 +78,7 @@ struct ParameterSlot {
     bool* (*boolField)(ReflectionRunOptions&) = nullptr;  // 0 or 1
 };
 
-const std::array<ParameterSlot, 15> kParameters = {{
+const std::array<ParameterSlot, 16> kParameters = {{
     {{"sslr_threshold", "SslrSettings::confidenceThreshold"},
      [](ReflectionRunOptions& o) { return &o.frame.sslr.confidenceThreshold; }, nullptr},
     {{"sslr_steps", "SslrSettings::linearSteps"}, nullptr,
@@ -106,6 +106,8 @@ const std::array<ParameterSlot, 15> kParameters = {{
      [](ReflectionRunOptions& o) { return &o.frame.feedback.rtHitFraction; }, nullptr},
     {{"sslr_particles", "ReflectionFrameSettings::sslrParticles (0 or 1)"}, nullptr, nullptr,
      [](ReflectionRunOptions& o) { return &o.frame.sslrParticles; }},
+    {{"reflect_particles", "ReflectionFrameSettings::reflectParticles (0 or 1)"}, nullptr, nullptr,
+     [](ReflectionRunOptions& o) { return &o.frame.reflectParticles; }},
     {{"blue_noise", "RayGenerationSettings::blueNoise (1: spatiotemporal blue noise, 0: hashed sequences)"}, nullptr,
      nullptr, [](ReflectionRunOptions& o) { return &o.frame.rays.blueNoise; }},
 }};

@@ -31,6 +31,7 @@ constexpr RangeRow kRanges[] = {
     {"rt_checkerboard", 0.0f, 1.0f, true},      // on or off
     {"feedback_rt_hit_fraction", 0.0f, 1.0f, false}, // default 0 (the talk)
     {"sslr_particles", 0.0f, 1.0f, true},       // on or off
+    {"reflect_particles", 0.0f, 1.0f, true},    // on or off
     {"blue_noise", 0.0f, 1.0f, true},           // blue noise or the hashed sequences
 };
 
