@@ -35,7 +35,7 @@ uint64_t grownCapacity(uint64_t needed, uint64_t minimum) {
 constexpr uint64_t kMinScratchBytes = 64 * 1024;
 constexpr uint32_t kMinTlasInstances = 64;
 constexpr uint32_t kMinOffsetEntries = 256;
-constexpr VkDeviceSize kEmissionEntryBytes = 3 * sizeof(float);  // glm::vec3, scalar layout
+constexpr VkDeviceSize kMaterialRowBytes = sizeof(shader::RtGeometryMaterial);
 constexpr uint32_t kMinParticles = 64;
 
 // The pack pass's source vertices of `g`. Material attributes are sampled
@@ -127,7 +127,7 @@ struct BvhManager::FrameWork {
     std::vector<Build> builds;
     std::vector<VkAccelerationStructureInstanceKHR> instances;
     std::vector<uint32_t> offsets;
-    std::vector<glm::vec3> emission;  // parallel to offsets
+    std::vector<shader::RtGeometryMaterial> materials;  // parallel to offsets
     std::vector<glm::mat4> joints;  // the palette as it was when the frame was declared
     std::optional<gpu::AccelBuild> tlasBuild;
     std::shared_ptr<gpu::Buffer> poolCopySource;  // the outgrown pool, copied into the new one first
@@ -167,7 +167,11 @@ void BvhManager::collectRetired() {
 
 BvhManager::BvhManager(gpu::Context& ctx, const scene::Scene& scene, uint32_t framesInFlight,
                        const BvhUpdateOptions& options)
-    : ctx_(ctx), scene_(scene), framesInFlight_(std::max(framesInFlight, 1u)), options_(options) {
+    : ctx_(ctx),
+      scene_(scene),
+      framesInFlight_(std::max(framesInFlight, 1u)),
+      options_(options),
+      hitMaterials_(ctx, scene, options.hitMaterials) {
     const VkShaderStageFlags cs = VK_SHADER_STAGE_COMPUTE_BIT;
     packPipeline_ = gpu::createComputePipeline(
         ctx, {"bvh/pack_primitives.comp",
@@ -187,13 +191,7 @@ BvhManager::BvhManager(gpu::Context& ctx, const scene::Scene& scene, uint32_t fr
     particleStaging_.resize(framesInFlight_);
     particleInstances_.resize(framesInFlight_);
     offsetStaging_.resize(framesInFlight_);
-    emissionStaging_.resize(framesInFlight_);
-    // O(texels) per emissive texture, once: the hits' emission is a
-    // material's mean (scene::meanEmission).
-    materialEmission_.reserve(scene.materials.size());
-    for (const scene::Material& material : scene.materials) {
-        materialEmission_.push_back(scene::meanEmission(scene, material));
-    }
+    materialStaging_.resize(framesInFlight_);
     instanceBuffers_.resize(framesInFlight_);
     jointPalettes_.resize(framesInFlight_);
 }
@@ -213,7 +211,9 @@ void BvhManager::bind(rg::FrameResources& resources, const BvhUpdateOutputs& out
     resources.bind(outputs.tlas, *tlas_);
     resources.bind(outputs.primitivePool, pool_);
     resources.bind(outputs.primitiveOffsets, offsets_);
-    resources.bind(outputs.emission, emission_);
+    resources.bind(outputs.materials, materials_);
+    resources.bind(outputs.alphaTriangles, hitMaterials_.alphaTriangles());
+    resources.bind(outputs.alphaMasks, hitMaterials_.alphaMasks());
     if (outputs.particleTlas.valid()) {
         resources.bind(outputs.particleTlas, *particleTlas_);
         resources.bind(outputs.particles, particleData_);
@@ -284,9 +284,9 @@ BvhManager::ResidentBlas& BvhManager::createBlas(const scene::BlasDesc& desc, Fr
         t.vertices = blas->positions.address() + first * sizeof(glm::vec3);
         t.vertexCount = 3 * g.triangleCount;
         t.triangleCount = g.triangleCount;
-        // Alpha-tested foliage would need any-hit; the packed-primitive path
-        // has no texture to test against, so every reflection triangle is opaque.
-        t.opaque = true;
+        // Alpha-tested geometry runs the any-hit test (glint/alpha_test.h);
+        // everything else stays opaque, so rays never stop on it for a test.
+        t.opaque = !hitMaterials_.alphaTested(desc.mesh, desc.lod, g.meshGeometry);
         triangles.push_back(t);
         first += 3 * VkDeviceSize(g.triangleCount);
     }
@@ -355,15 +355,15 @@ void BvhManager::ensureOffsets(size_t entries) {
         staging = gpu::Buffer(ctx_, {capacity, VK_BUFFER_USAGE_TRANSFER_SRC_BIT, gpu::MemoryUsage::Upload,
                                      "bvh.primitive_offsets.staging", true});
     }
-    // The emission table has as many entries, three floats each.
-    const VkDeviceSize emissionCapacity = capacity / sizeof(uint32_t) * kEmissionEntryBytes;
-    if (emission_) retire(std::move(emission_));
-    emission_ = gpu::Buffer(ctx_, {emissionCapacity, VK_BUFFER_USAGE_STORAGE_BUFFER_BIT | VK_BUFFER_USAGE_TRANSFER_DST_BIT,
-                                   gpu::MemoryUsage::DeviceLocal, "bvh.emission", true});
-    for (gpu::Buffer& staging : emissionStaging_) {
+    // The material table has as many rows.
+    const VkDeviceSize materialCapacity = capacity / sizeof(uint32_t) * kMaterialRowBytes;
+    if (materials_) retire(std::move(materials_));
+    materials_ = gpu::Buffer(ctx_, {materialCapacity, VK_BUFFER_USAGE_STORAGE_BUFFER_BIT | VK_BUFFER_USAGE_TRANSFER_DST_BIT,
+                                    gpu::MemoryUsage::DeviceLocal, "bvh.materials", true});
+    for (gpu::Buffer& staging : materialStaging_) {
         if (staging) retire(std::move(staging));
-        staging = gpu::Buffer(ctx_, {emissionCapacity, VK_BUFFER_USAGE_TRANSFER_SRC_BIT, gpu::MemoryUsage::Upload,
-                                     "bvh.emission.staging", true});
+        staging = gpu::Buffer(ctx_, {materialCapacity, VK_BUFFER_USAGE_TRANSFER_SRC_BIT, gpu::MemoryUsage::Upload,
+                                     "bvh.materials.staging", true});
     }
 }
 
@@ -610,7 +610,10 @@ std::shared_ptr<BvhManager::FrameWork> BvhManager::prepare(const scene::BvhPlan&
     ensureTlas(uint32_t(plan.tlas.size()));
     ensureOffsets(plan.primitiveOffsets.size());
     work->offsets = plan.primitiveOffsets;
-    work->emission.assign(plan.primitiveOffsets.size(), glm::vec3(0.0f));
+    shader::RtGeometryMaterial unused{};
+    unused.alphaTriangles = shader::kAlphaOpaque;
+    unused.alphaMask = shader::kAlphaNoMask;
+    work->materials.assign(plan.primitiveOffsets.size(), unused);
     work->instances.reserve(plan.tlas.size());
     for (const scene::TlasInstance& ti : plan.tlas) {
         const auto it = blases_.find(ti.blas);
@@ -618,12 +621,12 @@ std::shared_ptr<BvhManager::FrameWork> BvhManager::prepare(const scene::BvhPlan&
             throw gpu::GpuError("BVH update: TLAS instance of scene instance " + std::to_string(ti.sceneInstance) +
                                 " uses BLAS " + std::to_string(ti.blas) + ", which was never built");
         }
-        // The emission rows beside the offset rows the planner wrote.
-        const std::vector<scene::BlasGeometry>& geometries = it->second->desc.geometries;
-        for (size_t g = 0; g < geometries.size(); ++g) {
+        // The material rows beside the offset rows the planner wrote.
+        const scene::BlasDesc& desc = it->second->desc;
+        for (size_t g = 0; g < desc.geometries.size(); ++g) {
             const size_t row = shader::primitiveOffsetSlot(ti.customIndex, uint32_t(g));
-            if (row < work->emission.size() && geometries[g].material < materialEmission_.size()) {
-                work->emission[row] = materialEmission_[geometries[g].material];
+            if (row < work->materials.size()) {
+                work->materials[row] = hitMaterials_.row(desc.mesh, desc.lod, desc.geometries[g].meshGeometry);
             }
         }
         const auto transform = scene::rowMajor3x4(ti.transform);
@@ -673,7 +676,7 @@ void BvhManager::record(FrameWork& work, rg::PassContext& pc, const BvhUpdateOut
     // when the frame was declared).
     const gpu::Buffer& pool = pc.buffer(handles.primitivePool);
     const gpu::Buffer& offsets = pc.buffer(handles.primitiveOffsets);
-    const gpu::Buffer& emission = pc.buffer(handles.emission);
+    const gpu::Buffer& materials = pc.buffer(handles.materials);
     const gpu::Buffer& scratch = pc.buffer(handles.scratch);
     const gpu::AccelerationStructure& tlas = pc.accel(handles.tlas);
     const uint32_t slot = work.slot;
@@ -690,7 +693,7 @@ void BvhManager::record(FrameWork& work, rg::PassContext& pc, const BvhUpdateOut
     }
     if (!work.offsets.empty()) {
         std::memcpy(offsetStaging_[slot].mapped(), work.offsets.data(), work.offsets.size() * sizeof(uint32_t));
-        std::memcpy(emissionStaging_[slot].mapped(), work.emission.data(), work.emission.size() * kEmissionEntryBytes);
+        std::memcpy(materialStaging_[slot].mapped(), work.materials.data(), work.materials.size() * kMaterialRowBytes);
     }
     for (const FrameWork::Pack& pack : work.packs) {
         if (pack.vertices && !pack.morphed.empty()) {
@@ -734,8 +737,8 @@ void BvhManager::record(FrameWork& work, rg::PassContext& pc, const BvhUpdateOut
         if (!work.offsets.empty()) {
             const VkBufferCopy region{0, 0, work.offsets.size() * sizeof(uint32_t)};
             vkCmdCopyBuffer(cmd, offsetStaging_[slot].handle(), offsets.handle(), 1, &region);
-            const VkBufferCopy emissionRegion{0, 0, work.emission.size() * kEmissionEntryBytes};
-            vkCmdCopyBuffer(cmd, emissionStaging_[slot].handle(), emission.handle(), 1, &emissionRegion);
+            const VkBufferCopy materialRegion{0, 0, work.materials.size() * kMaterialRowBytes};
+            vkCmdCopyBuffer(cmd, materialStaging_[slot].handle(), materials.handle(), 1, &materialRegion);
         }
         if (particles) {
             const VkBufferCopy region{0, 0, work.particles.size() * sizeof(shader::ParticleData)};
@@ -831,8 +834,8 @@ BvhUpdateOutputs BvhManager::declare(rg::Graph& graph, BvhManager& manager, cons
         graph.importBuffer("bvh.primitive_pool", {{manager.pool_.size()}, bufferState, bufferState});
     const rg::Buffer offsets =
         graph.importBuffer("bvh.primitive_offsets", {{manager.offsets_.size()}, bufferState, bufferState});
-    const rg::Buffer emission =
-        graph.importBuffer("bvh.emission", {{manager.emission_.size()}, bufferState, bufferState});
+    const rg::Buffer materials =
+        graph.importBuffer("bvh.materials", {{manager.materials_.size()}, bufferState, bufferState});
     const uint64_t scratchBytes = manager.scratchCapacity_;
     const bool particles = !work->particles.empty();
     rg::AccelStruct particleTlas;
@@ -849,7 +852,7 @@ BvhUpdateOutputs BvhManager::declare(rg::Graph& graph, BvhManager& manager, cons
             d.tlas = b.write(tlas, rg::Access::AccelBuildWrite);
             d.primitivePool = b.write(pool, rg::Access::StorageWrite);
             d.primitiveOffsets = b.write(offsets, rg::Access::TransferDst);
-            d.emission = b.write(emission, rg::Access::TransferDst);
+            d.materials = b.write(materials, rg::Access::TransferDst);
             d.scratch = b.write(b.createBuffer("bvh.scratch", {scratchBytes}), rg::Access::AccelBuildWrite);
             if (particles) {
                 d.particleTlas = b.write(particleTlas, rg::Access::AccelBuildWrite);
@@ -863,7 +866,22 @@ BvhUpdateOutputs BvhManager::declare(rg::Graph& graph, BvhManager& manager, cons
         [&manager, work](const BvhUpdateOutputs& d, rg::PassContext& pc) {
             manager.record(*work, pc, d);
         });
-    return out;
+    // The alpha test's data never changes after start-up: imported for the
+    // traces to read, written by no pass.
+    BvhUpdateOutputs outputs = out;
+    const HitMaterials& hit = manager.hitMaterials_;
+    outputs.alphaTriangles =
+        graph.importBuffer("bvh.alpha_triangles", {{hit.alphaTriangles().size()}, bufferState, bufferState});
+    const gpu::ImageDesc& masks = hit.alphaMasks().desc();
+    const rg::BoundaryState sampled = rg::BoundaryState::of(rg::Access::SampledRead);
+    outputs.alphaMasks = graph.importTexture("bvh.alpha_masks", {{.width = masks.width,
+                                                                  .height = masks.height,
+                                                                  .layers = masks.layers,
+                                                                  .mips = masks.mips,
+                                                                  .format = masks.format},
+                                                                 sampled,
+                                                                 sampled});
+    return outputs;
 }
 
 } // namespace glint::passes

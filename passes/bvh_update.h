@@ -9,8 +9,9 @@
 // targets applied on the CPU, per build), one AccelerationStructure per
 // resident BLAS, the unwrapped build positions of the deformable ones, the
 // one primitive pool (PackedPrimitive per triangle, glint/packing.h), the
-// primitive offset buffer and its parallel emission table, the TLAS and its
-// per-frame instance buffers.
+// primitive offset buffer and its parallel material table (emission and
+// the alpha test, passes/bvh_hit_materials.h: alpha-tested geometry is not
+// opaque in its BLAS), the TLAS and its per-frame instance buffers.
 //
 // addBvhUpdatePass() declares the frame's builds as ONE render-graph pass on
 // the async compute queue (the graphics queue on one-queue devices, or where
@@ -58,6 +59,7 @@
 #include "gpu/resources.h"
 #include "graph/executor.h"
 #include "graph/graph.h"
+#include "passes/bvh_hit_materials.h"
 #include "scene/bvh_planner.h"
 #include "scene/camera.h"
 #include "scene/scene.h"
@@ -77,11 +79,17 @@ struct BvhUpdateOutputs {
     rg::AccelStruct tlas;          // built; read it with Access::AccelRead
     rg::Buffer primitivePool;      // PackedPrimitive per triangle; Access::StorageRead
     rg::Buffer primitiveOffsets;   // uint per (custom index + geometry); Access::StorageRead
-    // Parallel to primitiveOffsets: the geometry's material emission, a
-    // vec3 (three floats, scalar layout) in glTF units (emissiveFactor x
-    // strength x the emissive texture's mean, scene::meanEmission); the
-    // packed primitives have no room for it. Access::StorageRead.
-    rg::Buffer emission;
+    // Parallel to primitiveOffsets: shader::RtGeometryMaterial per row, the
+    // geometry's material emission in glTF units (emissiveFactor x strength
+    // x the emissive texture's mean, scene::meanEmission) and its alpha
+    // test; the packed primitives have no room for them. Access::StorageRead.
+    rg::Buffer materials;
+    // The alpha test's data (passes/bvh_hit_materials.h), imported, never
+    // written: shader::AlphaTriangle per alpha-tested triangle
+    // (Access::StorageRead) and the alpha mask array (Access::SampledRead,
+    // with HitMaterials::alphaSampler()).
+    rg::Buffer alphaTriangles;
+    rg::Texture alphaMasks;
     rg::Buffer scratch;            // the builds' scratch (transient)
     // Invalid when the frame has no particles (or was declared without a
     // camera): the particle TLAS (Access::AccelRead; one instance, SBT
@@ -140,6 +148,7 @@ struct BvhUpdateOptions {
     // lifetime: the pass orders itself after its own earlier frames by a
     // barrier on this one queue.
     rg::Queue queue = rg::Queue::AsyncCompute;
+    HitMaterialOptions hitMaterials;  // the alpha test's mask size
 };
 
 class BvhManager {
@@ -162,7 +171,8 @@ public:
     // The current objects, for tools and tests (valid after addBvhUpdatePass).
     const gpu::Buffer& primitivePool() const { return pool_; }
     const gpu::Buffer& primitiveOffsets() const { return offsets_; }
-    const gpu::Buffer& emission() const { return emission_; }
+    const gpu::Buffer& materials() const { return materials_; }
+    const HitMaterials& hitMaterials() const { return hitMaterials_; }
     const gpu::AccelerationStructure& tlas() const { return *tlas_; }
     // Nullptr when the BLAS is not resident.
     const gpu::AccelerationStructure* blas(scene::BlasId id) const;
@@ -207,11 +217,11 @@ private:
     gpu::Buffer pool_;
     gpu::Buffer offsets_;                         // device-local, read by the traces
     std::vector<gpu::Buffer> offsetStaging_;      // host-visible, one per frame in flight
-    // Per offset row, its material's emission (BvhUpdateOutputs::emission),
-    // sized with the offsets; from materialEmission_, computed once.
-    gpu::Buffer emission_;
-    std::vector<gpu::Buffer> emissionStaging_;
-    std::vector<glm::vec3> materialEmission_;     // per scene material: scene::meanEmission
+    // Per offset row, its geometry's material row (BvhUpdateOutputs::materials),
+    // sized with the offsets; the rows come from hitMaterials_, built once.
+    HitMaterials hitMaterials_;
+    gpu::Buffer materials_;
+    std::vector<gpu::Buffer> materialStaging_;
     std::vector<gpu::Buffer> instanceBuffers_;    // host-visible TLAS instances, one per frame in flight
     std::vector<gpu::Buffer> jointPalettes_;      // host-visible joint matrices, one per frame in flight
     std::unique_ptr<gpu::AccelerationStructure> tlas_;

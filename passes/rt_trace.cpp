@@ -38,18 +38,24 @@ enum Binding : uint32_t {
     kRadiance,
     kHitDistance,
     kEnvironment,
-    kEmission,
+    kMaterials,       // glint/rt_geometry.glsl from here on
+    kAlphaTriangles,
+    kAlphaMasks,
     kBindingCount
 };
 
-std::vector<gpu::Binding> traceBindings(VkShaderStageFlags stages) {
+// `stages` read every binding; `alphaStages` also read the material rows
+// and the alpha test's data (the pipeline's any-hit shader).
+std::vector<gpu::Binding> traceBindings(VkShaderStageFlags stages, VkShaderStageFlags alphaStages = 0) {
     std::vector<gpu::Binding> bindings;
     for (uint32_t i = 0; i < kBindingCount; ++i) {
         VkDescriptorType type = VK_DESCRIPTOR_TYPE_STORAGE_BUFFER;
         if (i == kTlas) type = VK_DESCRIPTOR_TYPE_ACCELERATION_STRUCTURE_KHR;
-        if ((i >= kDepth && i <= kRoughnessMetal) || i == kEnvironment) type = VK_DESCRIPTOR_TYPE_COMBINED_IMAGE_SAMPLER;
+        if ((i >= kDepth && i <= kRoughnessMetal) || i == kEnvironment || i == kAlphaMasks) {
+            type = VK_DESCRIPTOR_TYPE_COMBINED_IMAGE_SAMPLER;
+        }
         if (i == kRadiance || i == kHitDistance) type = VK_DESCRIPTOR_TYPE_STORAGE_IMAGE;
-        bindings.push_back({i, type, stages});
+        bindings.push_back({i, type, stages | (i >= kMaterials ? alphaStages : 0)});
     }
     return bindings;
 }
@@ -116,6 +122,11 @@ RtTracePipelines::RtTracePipelines(gpu::Context& ctx, RtBackend backend)
       nearest_(ctx, {VK_FILTER_NEAREST, VK_SAMPLER_MIPMAP_MODE_NEAREST, VK_SAMPLER_ADDRESS_MODE_CLAMP_TO_EDGE, 0.0f,
                      "rt_trace.nearest"}),
       environmentSampler_(createEnvironmentSampler(ctx, "rt_trace.environment")),
+      // The alpha masks' wrap modes are applied in the shader (one layer
+      // per texture); repeating here lets bilinear filtering of a repeating
+      // texture blend across its edge.
+      alphaSampler_(ctx, {VK_FILTER_LINEAR, VK_SAMPLER_MIPMAP_MODE_LINEAR, VK_SAMPLER_ADDRESS_MODE_REPEAT,
+                          VK_LOD_CLAMP_NONE, "rt_trace.alpha_masks"}),
       clearer_(ctx) {
     VkPhysicalDeviceProperties properties{};
     vkGetPhysicalDeviceProperties(ctx.physicalDevice(), &properties);
@@ -144,12 +155,13 @@ RtBackend RtTracePipelines::prepare(RtBackend requested) {
     }
     if (backend == RtBackend::Pipeline && !pipeline_) {
         // Depth 1: the ray generation shader traces both rays and shades;
-        // the hit shader traces nothing.
+        // the hit shaders trace nothing. The any-hit shader runs only on
+        // alpha-tested geometry (the rest is opaque in its BLAS).
         pipeline_ = gpu::createRayTracingPipeline(
             ctx_, {"rt_trace/trace.rgen",
                    {"rt_trace/trace.rmiss"},
-                   {{"rt_trace/trace.rchit", ""}},
-                   traceBindings(VK_SHADER_STAGE_RAYGEN_BIT_KHR),
+                   {{"rt_trace/trace.rchit", "rt_trace/trace.rahit"}},
+                   traceBindings(VK_SHADER_STAGE_RAYGEN_BIT_KHR, VK_SHADER_STAGE_ANY_HIT_BIT_KHR),
                    0,
                    1,
                    "rt_trace.pipeline"});
@@ -176,8 +188,9 @@ RtTraceOutputs addRtTracePass(rg::Graph& graph, RtTracePipelines& pipelines, con
         throw gpu::GpuError("addRtTracePass: the RT ray list and its args are required");
     }
     if (!inputs.bvh.tlas.valid() || !inputs.bvh.primitivePool.valid() || !inputs.bvh.primitiveOffsets.valid() ||
-        !inputs.bvh.emission.valid()) {
-        throw gpu::GpuError("addRtTracePass: the BVH update's TLAS, primitive pool, offsets and emission are required");
+        !inputs.bvh.materials.valid() || !inputs.bvh.alphaTriangles.valid() || !inputs.bvh.alphaMasks.valid()) {
+        throw gpu::GpuError("addRtTracePass: the BVH update's TLAS, primitive pool, offsets, material rows and alpha "
+                            "test data are required");
     }
     if (!(settings.maxDistance > 0.0f) || !(settings.shortRangeFraction >= 0.0f) ||
         !(settings.shadowDistance >= 0.0f) || !(settings.originOffsetScale >= 0.0f)) {
@@ -212,6 +225,7 @@ RtTraceOutputs addRtTracePass(rg::Graph& graph, RtTracePipelines& pipelines, con
         rtRasterErrorPerDistance(inputs.camera.projection, gbuf.width, gbuf.height, pipelines.subPixelPrecisionBits_);
     constants.shadows = settings.shadows ? 1u : 0u;
     constants.instanceMask = settings.instanceMask & 0xFFu;
+    constants.alphaTest = settings.alphaTest ? 1u : 0u;
 
     // This frame's constants, which are larger than push constants
     // guarantee. The outputs are written at the listed rays' pixels only,
@@ -255,7 +269,8 @@ RtTraceOutputs addRtTracePass(rg::Graph& graph, RtTracePipelines& pipelines, con
     struct TraceData {
         rg::Texture depth, normal, roughnessMetal;
         rg::Texture environment;  // the prefiltered image, or the normal as a stand-in (never read)
-        rg::Buffer rayList, rayListArgs, pool, offsets, emission, constants;
+        rg::Texture alphaMasks;
+        rg::Buffer rayList, rayListArgs, pool, offsets, materials, alphaTriangles, constants;
         rg::AccelStruct tlas;
         RtTraceOutputs out;
     };
@@ -276,7 +291,9 @@ RtTraceOutputs addRtTracePass(rg::Graph& graph, RtTracePipelines& pipelines, con
             d.tlas = b.read(inputs.bvh.tlas, rg::Access::AccelRead);
             d.pool = b.read(inputs.bvh.primitivePool, rg::Access::StorageRead);
             d.offsets = b.read(inputs.bvh.primitiveOffsets, rg::Access::StorageRead);
-            d.emission = b.read(inputs.bvh.emission, rg::Access::StorageRead);
+            d.materials = b.read(inputs.bvh.materials, rg::Access::StorageRead);
+            d.alphaTriangles = b.read(inputs.bvh.alphaTriangles, rg::Access::StorageRead);
+            d.alphaMasks = b.read(inputs.bvh.alphaMasks, rg::Access::SampledRead);
             d.constants = b.read(upload.constants, rg::Access::StorageRead);
             d.out.width = gbuf.width;
             d.out.height = gbuf.height;
@@ -299,7 +316,9 @@ RtTraceOutputs addRtTracePass(rg::Graph& graph, RtTracePipelines& pipelines, con
                 .storageBuffer(kRayListArgs, pc.buffer(d.rayListArgs))
                 .storageBuffer(kPool, pc.buffer(d.pool))
                 .storageBuffer(kOffsets, pc.buffer(d.offsets))
-                .storageBuffer(kEmission, pc.buffer(d.emission))
+                .storageBuffer(kMaterials, pc.buffer(d.materials))
+                .storageBuffer(kAlphaTriangles, pc.buffer(d.alphaTriangles))
+                .sampledImage(kAlphaMasks, pc.view(d.alphaMasks), pipelines.alphaSampler_.handle(), pc.layout(d.alphaMasks))
                 .storageBuffer(kConstants, pc.buffer(d.constants))
                 .storageImage(kRadiance, pc.view(d.out.radiance))
                 .storageImage(kHitDistance, pc.view(d.out.hitDistance))

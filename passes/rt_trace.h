@@ -56,7 +56,9 @@ struct RtTraceInputs {
     GBufferOutputs gbuffer;          // depth, normal, roughnessMetal read (SampledRead)
     rg::Buffer rayList;              // shader::PackedRay entries (glint/ray_generation_shared.h)
     rg::Buffer rayListArgs;          // kRayListArgsWords uints, layout in ray_generation_shared.h (IndirectArgs)
-    BvhUpdateOutputs bvh;            // tlas (AccelRead), primitivePool, primitiveOffsets, emission (StorageRead)
+    // tlas (AccelRead); primitivePool, primitiveOffsets, materials,
+    // alphaTriangles (StorageRead); alphaMasks (SampledRead).
+    BvhUpdateOutputs bvh;
     shader::SceneLighting lighting;  // EnvironmentMap::lighting or passes::sceneLighting(scene, gbufferSettings.lighting)
     // The G-buffer's camera. Origins are reconstructed with the jittered
     // matrices it was rasterised with (passes/rt_trace.cpp says why).
@@ -99,6 +101,10 @@ struct RtTraceSettings {
     float originOffsetScale = 1.0f;
     // TLAS instance groups the rays see (glint/packing.h kInstanceMask*).
     uint32_t instanceMask = 0xFFu;
+    // Rays pass through the cut-outs of alpha-tested geometry (glTF alphaMode
+    // MASK; passes/bvh_hit_materials.h). Off, every triangle is opaque to
+    // them (no any-hit shader runs): what the test costs is the difference.
+    bool alphaTest = true;
     // Zero the outputs before the trace, so that pixels it does not trace
     // read as "not traced" (debug views). Integrate and the particle trace
     // read only the pixels whose rays were listed and need no clear.
@@ -149,6 +155,7 @@ private:
     std::optional<gpu::ShaderBindingTable> sbt_;
     gpu::Sampler nearest_;
     gpu::Sampler environmentSampler_;
+    gpu::Sampler alphaSampler_;  // the alpha masks: linear, repeating
     ImageClearer clearer_;
 };
 

@@ -217,15 +217,15 @@ Image createSampledImageWithMips(Context& ctx, const ImageDesc& desc, const void
     d.mips = uint32_t(std::bit_width(std::max(d.width, d.height)));
     d.usage |= VK_IMAGE_USAGE_SAMPLED_BIT | VK_IMAGE_USAGE_TRANSFER_SRC_BIT | VK_IMAGE_USAGE_TRANSFER_DST_BIT;
     Image image(ctx, d);
-    const VkDeviceSize bytes = VkDeviceSize(d.width) * d.height * bytesPerTexel(d.format);
+    const VkDeviceSize bytes = VkDeviceSize(d.width) * d.height * d.layers * bytesPerTexel(d.format);
     Buffer staging(ctx, {bytes, VK_BUFFER_USAGE_TRANSFER_SRC_BIT, MemoryUsage::Upload, d.name + ".staging"});
     std::memcpy(staging.mapped(), texels, bytes);
     submitAndWait(ctx, ctx.graphicsQueue(), "upload " + d.name, [&](VkCommandBuffer cmd) {
         const auto mipBarrier = [&](uint32_t mip, VkImageLayout from, VkImageLayout to, VkPipelineStageFlags2 srcStage,
                                     VkAccessFlags2 srcAccess, VkPipelineStageFlags2 dstStage,
                                     VkAccessFlags2 dstAccess) {
-            imageBarrier(cmd, image, {VK_IMAGE_ASPECT_COLOR_BIT, mip, 1, 0, 1}, from, to, srcStage, srcAccess, dstStage,
-                         dstAccess);
+            imageBarrier(cmd, image, {VK_IMAGE_ASPECT_COLOR_BIT, mip, 1, 0, d.layers}, from, to, srcStage, srcAccess,
+                         dstStage, dstAccess);
         };
         // Every mip to TRANSFER_DST; mip 0 gets the texels.
         for (uint32_t mip = 0; mip < d.mips; ++mip) {
@@ -233,7 +233,7 @@ Image createSampledImageWithMips(Context& ctx, const ImageDesc& desc, const void
                        VK_PIPELINE_STAGE_2_ALL_TRANSFER_BIT, VK_ACCESS_2_TRANSFER_WRITE_BIT);
         }
         VkBufferImageCopy region{};
-        region.imageSubresource = {VK_IMAGE_ASPECT_COLOR_BIT, 0, 0, 1};
+        region.imageSubresource = {VK_IMAGE_ASPECT_COLOR_BIT, 0, 0, d.layers};
         region.imageExtent = {d.width, d.height, 1};
         vkCmdCopyBufferToImage(cmd, staging.handle(), image.handle(), VK_IMAGE_LAYOUT_TRANSFER_DST_OPTIMAL, 1, &region);
         // Each mip from the one above it, which then becomes readable.
@@ -246,9 +246,9 @@ Image createSampledImageWithMips(Context& ctx, const ImageDesc& desc, const void
             const int32_t dstW = int32_t(std::max(d.width >> mip, 1u));
             const int32_t dstH = int32_t(std::max(d.height >> mip, 1u));
             VkImageBlit blit{};
-            blit.srcSubresource = {VK_IMAGE_ASPECT_COLOR_BIT, mip - 1, 0, 1};
+            blit.srcSubresource = {VK_IMAGE_ASPECT_COLOR_BIT, mip - 1, 0, d.layers};
             blit.srcOffsets[1] = {srcW, srcH, 1};
-            blit.dstSubresource = {VK_IMAGE_ASPECT_COLOR_BIT, mip, 0, 1};
+            blit.dstSubresource = {VK_IMAGE_ASPECT_COLOR_BIT, mip, 0, d.layers};
             blit.dstOffsets[1] = {dstW, dstH, 1};
             vkCmdBlitImage(cmd, image.handle(), VK_IMAGE_LAYOUT_TRANSFER_SRC_OPTIMAL, image.handle(),
                            VK_IMAGE_LAYOUT_TRANSFER_DST_OPTIMAL, 1, &blit, VK_FILTER_LINEAR);

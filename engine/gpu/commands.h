@@ -96,7 +96,7 @@ template <typename T> void uploadBuffer(Context& ctx, const Buffer& dst, std::sp
 Buffer createBufferWithData(Context& ctx, const BufferDesc& desc, const void* data);
 
 // A sampled 2D image of `desc` (usage and mips are set here: the full chain)
-// holding `texels` (tightly packed rows of mip 0), the smaller mips
+// holding `texels` (tightly packed rows of mip 0, layer after layer), the smaller mips
 // filtered down by linear blits; left in SHADER_READ_ONLY_OPTIMAL, visible
 // to every later command. `desc.format` must support linear blits.
 Image createSampledImageWithMips(Context& ctx, const ImageDesc& desc, const void* texels);

@@ -187,7 +187,7 @@ void Image::createViews(Context& ctx) {
     VkImageViewCreateInfo viewInfo{VK_STRUCTURE_TYPE_IMAGE_VIEW_CREATE_INFO};
     viewInfo.image = image;
     viewInfo.viewType = desc_.depth > 1   ? VK_IMAGE_VIEW_TYPE_3D
-                        : desc_.layers > 1 ? VK_IMAGE_VIEW_TYPE_2D_ARRAY
+                        : desc_.layers > 1 || desc_.arrayView ? VK_IMAGE_VIEW_TYPE_2D_ARRAY
                                            : VK_IMAGE_VIEW_TYPE_2D;
     viewInfo.format = desc_.format;
     viewInfo.subresourceRange = fullRange();

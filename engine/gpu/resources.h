@@ -72,6 +72,9 @@ struct ImageDesc {
     VkImageUsageFlags usage = 0;
     std::string name;
     bool sharedAcrossQueues = false;  // as BufferDesc::sharedAcrossQueues
+    // A 2D array view even of one layer (shaders declaring an array of a
+    // runtime number of layers).
+    bool arrayView = false;
 };
 
 class Image {

@@ -78,7 +78,7 @@ struct ParameterSlot {
     bool* (*boolField)(ReflectionRunOptions&) = nullptr;  // 0 or 1
 };
 
-const std::array<ParameterSlot, 16> kParameters = {{
+const std::array<ParameterSlot, 17> kParameters = {{
     {{"sslr_threshold", "SslrSettings::confidenceThreshold"},
      [](ReflectionRunOptions& o) { return &o.frame.sslr.confidenceThreshold; }, nullptr},
     {{"sslr_steps", "SslrSettings::linearSteps"}, nullptr,
@@ -108,6 +108,8 @@ const std::array<ParameterSlot, 16> kParameters = {{
      [](ReflectionRunOptions& o) { return &o.frame.sslrParticles; }},
     {{"reflect_particles", "ReflectionFrameSettings::reflectParticles (0 or 1)"}, nullptr, nullptr,
      [](ReflectionRunOptions& o) { return &o.frame.reflectParticles; }},
+    {{"alpha_test", "RtTraceSettings::alphaTest (0 or 1)"}, nullptr, nullptr,
+     [](ReflectionRunOptions& o) { return &o.frame.rt.alphaTest; }},
     {{"blue_noise", "RayGenerationSettings::blueNoise (1: spatiotemporal blue noise, 0: hashed sequences)"}, nullptr,
      nullptr, [](ReflectionRunOptions& o) { return &o.frame.rays.blueNoise; }},
 }};

@@ -32,6 +32,7 @@ constexpr RangeRow kRanges[] = {
     {"feedback_rt_hit_fraction", 0.0f, 1.0f, false}, // default 0 (the talk)
     {"sslr_particles", 0.0f, 1.0f, true},       // on or off
     {"reflect_particles", 0.0f, 1.0f, true},    // on or off
+    {"alpha_test", 0.0f, 1.0f, true},           // rays through alpha-tested cut-outs, or all opaque
     {"blue_noise", 0.0f, 1.0f, true},           // blue noise or the hashed sequences
 };
 

@@ -11,14 +11,29 @@
 
 layout(local_size_x = kRtTraceGroupSize) in;
 
+// Traversal: the only candidates are triangles of alpha-tested (not opaque)
+// geometry; each one that covers its point is committed, as the pipeline's
+// any-hit shader accepts it (a ray that terminates on its first hit then
+// stops).
+void rtProceed(rayQueryEXT query) {
+    while (rayQueryProceedEXT(query)) {
+        if (rayQueryGetIntersectionTypeEXT(query, false) == gl_RayQueryCandidateIntersectionTriangleEXT &&
+            rtAlphaCovers(rayQueryGetIntersectionInstanceCustomIndexEXT(query, false),
+                          rayQueryGetIntersectionGeometryIndexEXT(query, false),
+                          rayQueryGetIntersectionPrimitiveIndexEXT(query, false),
+                          rayQueryGetIntersectionBarycentricsEXT(query, false))) {
+            rayQueryConfirmIntersectionEXT(query);
+        }
+    }
+}
+
 RtHit rtTraceClosest(vec3 origin, vec3 direction, float tMax) {
     rayQueryEXT query;
     // Through the back of single-sided triangles (glTF doubleSided false;
     // double-sided instances disable the culling, passes/bvh_update.cpp).
-    rayQueryInitializeEXT(query, tlas, gl_RayFlagsOpaqueEXT | gl_RayFlagsCullBackFacingTrianglesEXT, rt.instanceMask,
+    rayQueryInitializeEXT(query, tlas, rtRayFlags() | gl_RayFlagsCullBackFacingTrianglesEXT, rt.instanceMask,
                           origin, 0.0, direction, tMax);
-    while (rayQueryProceedEXT(query)) {
-    }
+    rtProceed(query);
     RtHit h;
     h.hit = 0u;
     h.customIndex = 0u;
@@ -41,10 +56,9 @@ RtHit rtTraceClosest(vec3 origin, vec3 direction, float tMax) {
 
 bool rtTraceOccluded(vec3 origin, vec3 direction, float tMax) {
     rayQueryEXT query;
-    rayQueryInitializeEXT(query, tlas, gl_RayFlagsOpaqueEXT | gl_RayFlagsTerminateOnFirstHitEXT, rt.instanceMask,
+    rayQueryInitializeEXT(query, tlas, rtRayFlags() | gl_RayFlagsTerminateOnFirstHitEXT, rt.instanceMask,
                           origin, 0.0, direction, tMax);
-    while (rayQueryProceedEXT(query)) {
-    }
+    rtProceed(query);
     return rayQueryGetIntersectionTypeEXT(query, true) != gl_RayQueryCommittedIntersectionNoneEXT;
 }
 

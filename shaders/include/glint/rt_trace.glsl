@@ -12,7 +12,8 @@
 // lit with the G-buffer's own lighting (glint/brdf.glsl's shadeSurface),
 // the sun's visibility from a shadow ray, plus its geometry's emission (one
 // colour per geometry: the material's mean, scaled as the G-buffer scales
-// emission); a miss takes the environment.
+// emission); a miss takes the environment. Both rays pass through the
+// cut-outs of alpha-tested geometry (glint/rt_geometry.glsl).
 #ifndef GLINT_RT_TRACE_GLSL
 #define GLINT_RT_TRACE_GLSL
 
@@ -40,12 +41,13 @@ layout(set = 0, binding = 7, scalar) readonly buffer Offsets { uint primitiveOff
 layout(set = 0, binding = 8, scalar) readonly buffer Constants { RtTraceConstants rt; };
 layout(set = 0, binding = 9, rgba16f) uniform writeonly image2D radianceImage;
 layout(set = 0, binding = 10, r32f) uniform writeonly image2D hitDistanceImage;
-// Parallel to the offsets: each geometry's material emission in glTF units
-// (passes/bvh_update.h's BvhUpdateOutputs::emission).
-layout(set = 0, binding = 12, scalar) readonly buffer Emission { vec3 primitiveEmission[]; };
+// Bindings 12-14: the material rows and the alpha test.
+#include "glint/rt_geometry.glsl"
 
-// The backend's traversals. Both rays are opaque (the pool has no alpha)
-// and use rt.instanceMask.
+// The backend's traversals, both with rt.instanceMask and rtRayFlags():
+// alpha-tested geometry is not opaque in its BLAS, and a candidate counts
+// only where rtAlphaCovers() says so (an any-hit shader, or the ray query's
+// candidate loop).
 RtHit rtTraceClosest(vec3 origin, vec3 direction, float tMax);
 // Whether anything lies on the segment (it may stop at the first hit).
 bool rtTraceOccluded(vec3 origin, vec3 direction, float tMax);
@@ -57,6 +59,10 @@ struct RtRay {
     float tMax;
     float roughness;  // perceptual, of the surface the ray leaves
 };
+
+// With the alpha test off (RtTraceSettings::alphaTest) every triangle is
+// opaque, whatever its BLAS says: no any-hit shader runs.
+uint rtRayFlags() { return rt.alphaTest != 0u ? gl_RayFlagsNoneEXT : gl_RayFlagsOpaqueEXT; }
 
 float rtMax3(vec3 v) { return max(v.x, max(v.y, v.z)); }
 
@@ -165,8 +171,7 @@ void rtTraceListEntry(uint index) {
         sunVisibility = rtTraceOccluded(shadowOrigin, toSun, rt.shadowDistance) ? 0.0 : 1.0;
     }
     // Emission, unlit and unshadowed as in the G-buffer's lit colour.
-    const vec3 emission = primitiveEmission[primitiveOffsetSlot(hit.customIndex, hit.geometry)] *
-                          rt.lighting.sunDirection.w;
+    const vec3 emission = rtGeometryMaterial(hit.customIndex, hit.geometry).emission * rt.lighting.sunDirection.w;
     rtWriteResult(ray, shadeSurface(rt.lighting, s, -ray.direction, sunVisibility) + emission, hit.t);
 }
 

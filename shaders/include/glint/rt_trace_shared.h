@@ -78,12 +78,13 @@ struct RtTraceConstants {
     float rasterErrorPerDistance;  // pixel angle * 2^-subPixelPrecisionBits (robust origins, above)
     uint shadows;                // 1: trace a shadow ray towards the sun
     uint instanceMask;           // cull mask of every ray (glint/packing.h kInstanceMask*)
+    uint alphaTest;              // 1: rays pass through alpha-tested cut-outs; 0: every triangle opaque
 };
 
 GLINT_END
 
 #ifdef __cplusplus
-static_assert(sizeof(glint::shader::RtTraceConstants) == 360);
+static_assert(sizeof(glint::shader::RtTraceConstants) == 364);
 #endif
 
 #endif

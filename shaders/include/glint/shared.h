@@ -13,6 +13,7 @@ using vec2 = glm::vec2;
 using vec3 = glm::vec3;
 using vec4 = glm::vec4;
 using uvec2 = glm::uvec2;
+using uvec3 = glm::uvec3;
 using uvec4 = glm::uvec4;
 using mat4 = glm::mat4;
 } // namespace glint::shader
