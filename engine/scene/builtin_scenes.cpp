@@ -2,6 +2,7 @@
 
 #include "scene/animation.h"
 #include "scene/error.h"
+#include "scene/foliage.h"
 #include "scene/mesh_tools.h"
 #include "scene/procedural_meshes.h"
 #include "scene/scene_builder.h"
@@ -77,7 +78,7 @@ float hillHeight(float x, float z) {
 }
 
 struct PlazaMaterials {
-    uint32_t paving, asphalt, plaster, plasterBlue, tiles, glass, chrome, copper, redPlastic, wood, trunk, leaves, neon,
+    uint32_t paving, asphalt, plaster, plasterBlue, tiles, glass, chrome, copper, redPlastic, wood, trunk, neon,
         carPaint, tyre, flag, cloth, hills, tower, mirrorTower, water, brass, lampGlow, skinTone;
 };
 
@@ -98,7 +99,6 @@ PlazaMaterials plazaMaterials(SceneBuilder& b) {
     m.redPlastic = b.material(makeMaterial("red plastic", {0.7f, 0.05f, 0.04f}, 0.0f, 0.35f));
     m.wood = b.material(makeMaterial("bench wood", {0.35f, 0.2f, 0.1f}, 0.0f, 0.7f));
     m.trunk = b.material(makeMaterial("palm trunk", {0.3f, 0.22f, 0.15f}, 0.0f, 0.9f));
-    m.leaves = b.material(makeMaterial("palm leaves", {0.08f, 0.3f, 0.06f}, 0.0f, 0.6f));
     // Emission is in lit units at LightingSettings::emissiveScale 1, where
     // a sunlit white wall is ~2.5 and the default exposure's tonemap (PBR
     // Neutral) whitens a peak of 4 by a third: a neon tube (~10^4 nits,
@@ -146,6 +146,7 @@ std::vector<Geometry> buildingGeometry(const glm::vec3& size, uint32_t wall, uin
 Scene buildPlaza() {
     SceneBuilder b("plaza");
     const PlazaMaterials mat = plazaMaterials(b);
+    const FoliageMaterials foliage = foliageMaterials(b, 128);
     Scene& s = b.scene;
 
     // --- Ground: the puddled plaza (mirror-like where wet) beside a rough street.
@@ -219,6 +220,16 @@ Scene buildPlaza() {
     for (int i = 0; i < 6; ++i) {
         b.place("street lamp " + std::to_string(i), lamp, {19.5f, 0, -30.0f + 12.0f * float(i)});
     }
+
+    // Foliage (alpha-tested, foliage.h): grass around the foot of four
+    // palms and a chain-link fence across the plaza's north-west corner,
+    // over the puddles the camera path passes.
+    const uint32_t grass = b.mesh("grass patch", {{makeGrassPatch(16, 0.4f, 1.6f, 21u, foliage.grass)}});
+    for (const glm::vec3 at : {glm::vec3{-17, 0, 0}, glm::vec3{0, 0, 17}, glm::vec3{-3, 0, -17}, glm::vec3{-16, 0, 18}}) {
+        b.place("grass at " + std::to_string(int(at.x)) + "," + std::to_string(int(at.z)), grass, at);
+    }
+    const uint32_t fence = b.mesh("fence", {{makeFencePanel(7.0f, 1.4f, foliage.fence)}});
+    b.place("fence", fence, {-15.0f, 0, -2.0f});
 
     // --- Far away: towers beyond the 100 m BVH radius (some enter it along
     // the camera path, some never do) and long-range hills.
@@ -338,15 +349,15 @@ Scene buildPlaza() {
         for (size_t p = 0; p < palms.size(); ++p) {
             const std::string name = "palm " + std::to_string(p);
             const float height = 6.0f + 0.5f * float(p % 3);
+            // Alpha-tested fronds: leaflets cut out of curved strips, rising
+            // from the crown and drooping (foliage.h).
             Geometry leaves;
-            leaves.material = mat.leaves;
-            for (int k = 0; k < 7; ++k) {
-                // Long flat cones pointing out and drooping.
-                const glm::mat4 m = translation({0, height, 0}) *
-                                    glm::rotate(glm::mat4(1.0f), glm::two_pi<float>() * float(k) / 7.0f, {0, 1, 0}) *
-                                    glm::rotate(glm::mat4(1.0f), -1.9f, {0, 0, 1}) *
-                                    glm::scale(glm::mat4(1.0f), {1.0f, 1.0f, 0.25f});
-                appendGeometry(leaves, transformed(makeCone(0.35f, 2.4f, 8, mat.leaves), m));
+            leaves.material = foliage.frond;
+            for (int k = 0; k < 9; ++k) {
+                const float turn = glm::two_pi<float>() * (float(k) + 0.3f * float(p % 2)) / 9.0f;
+                const glm::mat4 m = translation({0, height, 0}) * glm::rotate(glm::mat4(1.0f), turn, {0, 1, 0}) *
+                                    glm::rotate(glm::mat4(1.0f), 0.45f - 0.1f * float(k % 3), {0, 0, 1});
+                appendGeometry(leaves, transformed(makeFrond(2.8f, 1.0f, 1.6f, 6, foliage.frond), m));
             }
             bindToJoint(leaves, 3);
             const uint32_t palmMesh = b.mesh(name, {{makeSkinnedTube(0.18f, height, 12, 16, 4, mat.trunk), leaves}});

@@ -58,7 +58,7 @@ struct BvhSettings {
     // First builds per frame: at most this many BLASes and triangles (one
     // BLAS is always built, however large). Glint's values: above what the
     // built-in scenes and the shared glTF scenes build on their first frame
-    // (the plaza 41 BLASes, 31k triangles), about 2 ms of builds on the
+    // (the plaza 51 BLASes, 31k triangles), about 2 ms of builds on the
     // H200 (1M triangles build in 1.2-2.4 ms there).
     uint32_t maxFirstBuildsPerFrame = 64;
     uint64_t maxFirstBuildTrianglesPerFrame = 1'000'000;
