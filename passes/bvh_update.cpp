@@ -869,6 +869,16 @@ BvhUpdateOutputs BvhManager::declare(rg::Graph& graph, BvhManager& manager, cons
     // The alpha test's data never changes after start-up: imported for the
     // traces to read, written by no pass.
     BvhUpdateOutputs outputs = out;
+    for (const shader::ParticleData& p : work->particles) {
+        // A quad of half side r turned any way stays within r * sqrt(2).
+        const glm::vec3 reach(p.radius * 1.4143f);
+        outputs.particleBoundsMin = outputs.particleBoundsMax.x < outputs.particleBoundsMin.x
+                                        ? p.position - reach
+                                        : glm::min(outputs.particleBoundsMin, p.position - reach);
+        outputs.particleBoundsMax = outputs.particleBoundsMax.x < outputs.particleBoundsMin.x
+                                        ? p.position + reach
+                                        : glm::max(outputs.particleBoundsMax, p.position + reach);
+    }
     const HitMaterials& hit = manager.hitMaterials_;
     outputs.alphaTriangles =
         graph.importBuffer("bvh.alpha_triangles", {{hit.alphaTriangles().size()}, bufferState, bufferState});

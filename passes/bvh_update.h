@@ -98,6 +98,11 @@ struct BvhUpdateOutputs {
     // Access::StorageRead), indexed by primitive / 2.
     rg::AccelStruct particleTlas;
     rg::Buffer particles;
+    // The box around every particle's quads (world, min and max; empty,
+    // min > max, without particles): rays that miss it skip the particle
+    // TLAS altogether.
+    glm::vec3 particleBoundsMin{1.0f};
+    glm::vec3 particleBoundsMax{-1.0f};
 };
 
 // What the GPU side did this frame and holds now.

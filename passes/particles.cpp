@@ -194,6 +194,8 @@ ParticleTraceOutputs addParticleTracePass(rg::Graph& graph, ParticlePipelines& p
     constants.rtBound = hasRt ? 1u : 0u;
     constants.sslrSeesParticles = settings.sslrSeesParticles ? 1u : 0u;
     constants.rtMissesTrusted = settings.rtMissesTrusted ? 1u : 0u;
+    constants.boundsMin = glm::vec4(inputs.bvh.particleBoundsMin, 0.0f);
+    constants.boundsMax = glm::vec4(inputs.bvh.particleBoundsMax, 0.0f);
 
     struct UploadData {
         rg::Buffer constants;

@@ -134,6 +134,10 @@ struct ParticleTraceConstants {
     // are not traced here (ParticleTraceSettings::sslrSeesParticles).
     uint sslrSeesParticles;
     uint rtMissesTrusted;        // integrate's (ParticleTraceSettings::rtMissesTrusted)
+    // Every particle's quads lie in this world box (xyz; BvhUpdateOutputs'
+    // particle bounds): a segment that misses it traces nothing.
+    vec4 boundsMin;
+    vec4 boundsMax;
 };
 
 GLINT_END
@@ -141,7 +145,7 @@ GLINT_END
 #ifdef __cplusplus
 static_assert(sizeof(glint::shader::ParticleData) == 32);
 static_assert(sizeof(glint::shader::ParticleBillboardParams) == 48);
-static_assert(sizeof(glint::shader::ParticleTraceConstants) == 160);
+static_assert(sizeof(glint::shader::ParticleTraceConstants) == 192);
 #endif
 
 #endif

@@ -117,6 +117,19 @@ uint particleCullMask(vec3 direction) {
     return particleAxisMask(particleQuadAxis(view));
 }
 
+// Whether the segment from `origin` along `direction` (unit) to tMax meets
+// the particles' box (slab test; a zero component divides to +-infinity,
+// which the slabs handle).
+bool particleSegmentMeetsBounds(vec3 origin, vec3 direction, float tMax) {
+    const vec3 inverse = 1.0 / direction;
+    const vec3 a = (C.boundsMin.xyz - origin) * inverse;
+    const vec3 b = (C.boundsMax.xyz - origin) * inverse;
+    const vec3 near = min(a, b), far = max(a, b);
+    const float enter = max(max(near.x, near.y), max(near.z, 0.0));
+    const float leave = min(min(far.x, far.y), min(far.z, tMax));
+    return enter <= leave;
+}
+
 bool particleFinite(float x) { return (floatBitsToUint(x) & 0x7F800000u) != 0x7F800000u; }
 bool particleFinite(vec3 v) { return particleFinite(v.x) && particleFinite(v.y) && particleFinite(v.z); }
 
@@ -204,7 +217,8 @@ void particleTracePixel(uvec2 pixel) {
             // What SSLR resolved already shows the particles it saw in the
             // lit colour: each particle reaches a pixel by one road.
             const bool seenBySslr = C.sslrSeesParticles != 0u && trace == kTraceSslr;
-            if (!seenBySslr && tMax > 0.0 && particleFinite(position)) {
+            if (!seenBySslr && tMax > 0.0 && particleFinite(position) &&
+                particleSegmentMeetsBounds(position, direction, tMax)) {
                 const ParticleHits hits = particleTraceSegment(position, direction, tMax, particleCullMask(direction));
                 result = particleComposite(hits, position, direction);
             }
