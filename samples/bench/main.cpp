@@ -71,7 +71,7 @@ struct Sweep {
     std::array<bool, 3> modes;  // passes::ReflectionMode order: hybrid, ssr, rt
 };
 
-const std::array<Sweep, 13> kSweeps = {{
+const std::array<Sweep, 14> kSweeps = {{
     // The talk's 0.9 (default) bracketed from "trust SSLR often" to "almost never".
     {"sslr_threshold", {0.5, 0.7, 0.8, 0.95, 0.99}, {0.7}, {true, false, false}},
     // FidelityFX's 0.22 (default): lower sends more pixels to the environment, higher traces more.
@@ -99,6 +99,8 @@ const std::array<Sweep, 13> kSweeps = {{
     {"reflect_particles", {0}, {0}, {true, false, true}},
     // Rays see alpha-tested geometry opaque (default: through its cut-outs): the test's cost.
     {"alpha_test", {0}, {0}, {true, false, true}},
+    // BLASes from full detail instead of the reflection LODs (default on): what the LODs cost in error.
+    {"reflection_lods", {0}, {0}, {true, false, true}},
     // Spatiotemporal blue noise (default) against the hashed low-discrepancy sequences.
     {"blue_noise", {0}, {0}, {true, true, true}},
 }};

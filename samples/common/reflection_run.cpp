@@ -78,7 +78,7 @@ struct ParameterSlot {
     bool* (*boolField)(ReflectionRunOptions&) = nullptr;  // 0 or 1
 };
 
-const std::array<ParameterSlot, 17> kParameters = {{
+const std::array<ParameterSlot, 18> kParameters = {{
     {{"sslr_threshold", "SslrSettings::confidenceThreshold"},
      [](ReflectionRunOptions& o) { return &o.frame.sslr.confidenceThreshold; }, nullptr},
     {{"sslr_steps", "SslrSettings::linearSteps"}, nullptr,
@@ -110,6 +110,8 @@ const std::array<ParameterSlot, 17> kParameters = {{
      [](ReflectionRunOptions& o) { return &o.frame.reflectParticles; }},
     {{"alpha_test", "RtTraceSettings::alphaTest (0 or 1)"}, nullptr, nullptr,
      [](ReflectionRunOptions& o) { return &o.frame.rt.alphaTest; }},
+    {{"reflection_lods", "BvhSettings::reflectionLods (0: BLASes from full detail)"}, nullptr, nullptr,
+     [](ReflectionRunOptions& o) { return &o.renderer.bvh.reflectionLods; }},
     {{"blue_noise", "RayGenerationSettings::blueNoise (1: spatiotemporal blue noise, 0: hashed sequences)"}, nullptr,
      nullptr, [](ReflectionRunOptions& o) { return &o.frame.rays.blueNoise; }},
 }};

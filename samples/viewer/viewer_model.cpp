@@ -33,6 +33,7 @@ constexpr RangeRow kRanges[] = {
     {"sslr_particles", 0.0f, 1.0f, true},       // on or off
     {"reflect_particles", 0.0f, 1.0f, true},    // on or off
     {"alpha_test", 0.0f, 1.0f, true},           // rays through alpha-tested cut-outs, or all opaque
+    {"reflection_lods", 0.0f, 1.0f, true},      // BLASes from the reflection LODs, or full detail
     {"blue_noise", 0.0f, 1.0f, true},           // blue noise or the hashed sequences
 };
 
@@ -125,7 +126,7 @@ void applySlider(app::ReflectionRunOptions& options, const ParameterSlider& slid
     float v = std::clamp(std::isfinite(value) ? value : slider.min, slider.min, slider.max);
     char text[32];
     if (slider.integer) {
-        std::snprintf(text, sizeof text, "%u", unsigned(std::lround(std::max(v, 1.0f))));
+        std::snprintf(text, sizeof text, "%u", unsigned(std::lround(v)));
     } else {
         std::snprintf(text, sizeof text, "%.9g", double(v));
     }
@@ -133,7 +134,7 @@ void applySlider(app::ReflectionRunOptions& options, const ParameterSlider& slid
 }
 
 bool rendererOptionsDiffer(const passes::ReflectionRendererOptions& a, const passes::ReflectionRendererOptions& b) {
-    return a.backend != b.backend || a.bvh.radius != b.bvh.radius;
+    return a.backend != b.backend || a.bvh.radius != b.bvh.radius || a.bvh.reflectionLods != b.bvh.reflectionLods;
 }
 
 // ---- fly camera

@@ -101,14 +101,19 @@ TEST_CASE("a slider sets its parameter through setParameter, clamped and rounded
     CHECK(o.frame.sslr.linearSteps == 1u);
 }
 
-TEST_CASE("only the BVH radius among the parameters needs a new renderer") {
+TEST_CASE("only the BVH's parameters (radius, reflection LODs) need a new renderer") {
     for (const viewer::ParameterSlider& s : viewer::parameterSliders()) {
         INFO(s.parameter.name);
-        CHECK(s.rendererOption == (s.parameter.name == "bvh_radius"));
-        app::ReflectionRunOptions o;
-        const passes::ReflectionRendererOptions before = o.renderer;
-        viewer::applySlider(o, s, s.max);
-        CHECK(viewer::rendererOptionsDiffer(before, o.renderer) == s.rendererOption);
+        CHECK(s.rendererOption == (s.parameter.name == "bvh_radius" || s.parameter.name == "reflection_lods"));
+        // One end of the range or the other moves the field off its default.
+        bool differs = false;
+        for (const float value : {s.min, s.max}) {
+            app::ReflectionRunOptions o;
+            const passes::ReflectionRendererOptions before = o.renderer;
+            viewer::applySlider(o, s, value);
+            differs = differs || viewer::rendererOptionsDiffer(before, o.renderer);
+        }
+        CHECK(differs == s.rendererOption);
     }
 }
 
