@@ -59,52 +59,6 @@ constexpr const char* kUsage =
     "  options) at each number of buildings, each with its own reference, every mode with its defaults;\n"
     "  writes DIR/city_scale.{csv,json,png} (reflection_ms against instanced triangles, log axis).";
 
-// One parameter sweep. Values equal to the default are skipped (the mode's
-// default row has them). `modes` are those where the parameter changes the
-// image: the threshold only decides between SSLR and RT (hybrid), the step
-// count needs SSLR (hybrid, ssr), the BVH radius a ray tracer (hybrid, rt);
-// the roughness cutoff and quad sharing are ray generation's (every mode).
-struct Sweep {
-    std::string_view param;
-    std::vector<double> values;
-    std::vector<double> quickValues;
-    std::array<bool, 3> modes;  // passes::ReflectionMode order: hybrid, ssr, rt
-};
-
-const std::array<Sweep, 14> kSweeps = {{
-    // The talk's 0.9 (default) bracketed from "trust SSLR often" to "almost never".
-    {"sslr_threshold", {0.5, 0.7, 0.8, 0.95, 0.99}, {0.7}, {true, false, false}},
-    // FidelityFX's 0.22 (default): lower sends more pixels to the environment, higher traces more.
-    {"roughness_cutoff", {0.1, 0.15, 0.3, 0.5}, {0.5}, {true, true, true}},
-    // 64 linear steps (default) against fewer and more.
-    {"sslr_steps", {16, 32, 96, 128}, {16, 32}, {true, true, false}},
-    // Steps no finer than a pixel (default 1); 0: 64 steps whatever the ray's screen length.
-    {"sslr_min_step_pixels", {0, 2, 4}, {0, 2}, {true, true, false}},
-    // Samples per quad: quads at or above this roughness share one ray. 0: every traced quad
-    // shares (1 sample per quad); 1 (above any traced roughness): none does (4 per quad).
-    {"reuse_roughness", {0.0, 0.05, 0.15, 1.0}, {0.0}, {true, true, true}},
-    // The talk's 100 (default) around the camera; smaller radii drop distant BLASes.
-    {"bvh_radius", {10, 25, 50, 200}, {25}, {true, false, true}},
-    // Pixels nearer than this go straight to RT (default 3): 0 tries SSLR first everywhere.
-    {"rt_near_distance", {0, 1, 6, 10}, {0}, {true, false, false}},
-    // Half-rate RT on a checkerboard (default off).
-    {"rt_checkerboard", {1}, {1}, {true, false, true}},
-    // A tile goes RT-only when at most this share of its SSLR rays hit (default 0, the talk's
-    // rule): higher stops paying for SSLR where it rarely succeeds.
-    {"feedback_rt_hit_fraction", {0.05, 0.1, 0.25}, {0.1}, {true, false, false}},
-    // Particles drawn before SSLR, which reflects them where it resolves the ray; the
-    // particle trace only where it does not (default off: every particle traced).
-    {"sslr_particles", {1}, {1}, {true, true, false}},
-    // No particles in the reflections (default on): what the particle TLAS and trace cost.
-    {"reflect_particles", {0}, {0}, {true, false, true}},
-    // Rays see alpha-tested geometry opaque (default: through its cut-outs): the test's cost.
-    {"alpha_test", {0}, {0}, {true, false, true}},
-    // BLASes from full detail instead of the reflection LODs (default on): what the LODs cost in error.
-    {"reflection_lods", {0}, {0}, {true, false, true}},
-    // Spatiotemporal blue noise (default) against the hashed low-discrepancy sequences.
-    {"blue_noise", {0}, {0}, {true, true, true}},
-}};
-
 double parsePositive(const std::string& flag, const std::string& text, bool allowZero) {
     try {
         size_t used = 0;
@@ -264,14 +218,16 @@ int main(int argc, char** argv) {
         // Every configuration, so progress can say "k of n".
         std::vector<Configuration> configurations;
         for (const passes::ReflectionMode mode : modes) configurations.push_back({mode, std::string(bench::kDefaultParam)});
-        for (const Sweep& sweep : kSweeps) {
+        // The sweeps come with the parameters (app::Parameter): values equal
+        // to the default are skipped, the mode's default row has them.
+        for (const app::Parameter& sweep : app::parameters()) {
             for (const passes::ReflectionMode mode : modes) {
-                if (!sweep.modes[size_t(mode)]) continue;
+                if (!sweep.sweepModes[size_t(mode)]) continue;
                 if (std::find(sweepModes.begin(), sweepModes.end(), mode) == sweepModes.end()) continue;
-                const double defaultValue = app::getParameter(base, sweep.param);
-                for (const double v : quick ? sweep.quickValues : sweep.values) {
+                const double defaultValue = app::getParameter(base, sweep.name);
+                for (const double v : quick ? sweep.quickSweep : sweep.sweep) {
                     if (float(v) == float(defaultValue)) continue;
-                    configurations.push_back({mode, std::string(sweep.param), v});
+                    configurations.push_back({mode, std::string(sweep.name), v});
                 }
             }
         }

@@ -78,42 +78,89 @@ struct ParameterSlot {
     bool* (*boolField)(ReflectionRunOptions&) = nullptr;  // 0 or 1
 };
 
+// Modes a sweep runs in (hybrid, ssr, rt).
+constexpr std::array<bool, 3> kHybrid{true, false, false};
+constexpr std::array<bool, 3> kScreenSpace{true, true, false};
+constexpr std::array<bool, 3> kTraced{true, false, true};
+constexpr std::array<bool, 3> kEveryMode{true, true, true};
+
+// The one table of parameters: name, field, the viewer's range, the
+// bench's sweep, and where the value lives.
 const std::array<ParameterSlot, 18> kParameters = {{
-    {{"sslr_threshold", "SslrSettings::confidenceThreshold"},
+    // A confidence; the talk's 0.9 (default) bracketed from "trust SSLR
+    // often" to "almost never".
+    {{"sslr_threshold", "SslrSettings::confidenceThreshold", 0.0f, 1.0f, false, {0.5, 0.7, 0.8, 0.95, 0.99}, {0.7},
+      kHybrid},
      [](ReflectionRunOptions& o) { return &o.frame.sslr.confidenceThreshold; }, nullptr},
-    {{"sslr_steps", "SslrSettings::linearSteps"}, nullptr,
-     [](ReflectionRunOptions& o) { return &o.frame.sslr.linearSteps; }},
-    {{"sslr_min_step_pixels", "SslrSettings::minStepPixels"},
+    // 64 linear steps (default, the talk) against fewer and more.
+    {{"sslr_steps", "SslrSettings::linearSteps", 1.0f, 256.0f, true, {16, 32, 96, 128}, {16, 32}, kScreenSpace},
+     nullptr, [](ReflectionRunOptions& o) { return &o.frame.sslr.linearSteps; }},
+    // Steps no finer than a pixel (default 1); 0: every step whatever the
+    // ray's screen length.
+    {{"sslr_min_step_pixels", "SslrSettings::minStepPixels", 0.0f, 8.0f, false, {0, 2, 4}, {0, 2}, kScreenSpace},
      [](ReflectionRunOptions& o) { return &o.frame.sslr.minStepPixels; }, nullptr},
-    {{"sslr_thickness", "SslrSettings::thickness"},
+    // Default 0.02 view-space units.
+    {{"sslr_thickness", "SslrSettings::thickness", 0.001f, 0.5f, false, {}, {}, {}},
      [](ReflectionRunOptions& o) { return &o.frame.sslr.thickness; }, nullptr},
-    {{"roughness_cutoff", "RayGenerationSettings::roughnessCutoff"},
+    // A roughness; FidelityFX's 0.22 (default): lower sends more pixels to
+    // the environment, higher traces more.
+    {{"roughness_cutoff", "RayGenerationSettings::roughnessCutoff", 0.0f, 1.0f, false, {0.1, 0.15, 0.3, 0.5}, {0.5},
+      kEveryMode},
      [](ReflectionRunOptions& o) { return &o.frame.rays.roughnessCutoff; }, nullptr},
-    {{"reuse_roughness", "RayGenerationSettings::reuseRoughness (samples per quad: 1 above it, 4 below)"},
+    // Quads at or above this roughness share one ray: 0, every traced quad
+    // shares (1 sample per quad); 1 (above any traced roughness), none does
+    // (4 per quad).
+    {{"reuse_roughness", "RayGenerationSettings::reuseRoughness (samples per quad: 1 above it, 4 below)", 0.0f, 1.0f,
+      false, {0.0, 0.05, 0.15, 1.0}, {0.0}, kEveryMode},
      [](ReflectionRunOptions& o) { return &o.frame.rays.reuseRoughness; }, nullptr},
-    {{"rt_near_distance", "RayGenerationSettings::rtMaxDistance"},
+    // Pixels nearer than this go straight to RT (default 3 world units): 0
+    // tries SSLR first everywhere.
+    {{"rt_near_distance", "RayGenerationSettings::rtMaxDistance", 0.0f, 50.0f, false, {0, 1, 6, 10}, {0}, kHybrid},
      [](ReflectionRunOptions& o) { return &o.frame.rays.rtMaxDistance; }, nullptr},
-    {{"sslr_far_distance", "RayGenerationSettings::sslrMinDistance"},
+    // Default 100.
+    {{"sslr_far_distance", "RayGenerationSettings::sslrMinDistance", 0.0f, 500.0f, false, {}, {}, {}},
      [](ReflectionRunOptions& o) { return &o.frame.rays.sslrMinDistance; }, nullptr},
-    {{"bvh_radius", "BvhSettings::radius"}, [](ReflectionRunOptions& o) { return &o.renderer.bvh.radius; }, nullptr},
-    {{"rt_max_distance", "RtTraceSettings::maxDistance"},
+    // The talk's 100 (default) around the camera; smaller radii drop
+    // distant BLASes.
+    {{"bvh_radius", "BvhSettings::radius", 1.0f, 500.0f, false, {10, 25, 50, 200}, {25}, kTraced},
+     [](ReflectionRunOptions& o) { return &o.renderer.bvh.radius; }, nullptr},
+    // Default 100 (the talk).
+    {{"rt_max_distance", "RtTraceSettings::maxDistance", 1.0f, 500.0f, false, {}, {}, {}},
      [](ReflectionRunOptions& o) { return &o.frame.rt.maxDistance; }, nullptr},
-    {{"frustum_culling", "GBufferSettings::frustumCulling (0 or 1)"}, nullptr, nullptr,
+    {{"frustum_culling", "GBufferSettings::frustumCulling (0 or 1)", 0.0f, 1.0f, true, {}, {}, {}}, nullptr, nullptr,
      [](ReflectionRunOptions& o) { return &o.frame.gbuffer.frustumCulling; }},
-    {{"rt_checkerboard", "RayGenerationSettings::checkerboard (0 or 1)"}, nullptr, nullptr,
-     [](ReflectionRunOptions& o) { return &o.frame.rays.checkerboard; }},
-    {{"feedback_rt_hit_fraction", "FeedbackSettings::rtHitFraction"},
+    // Half-rate RT on a checkerboard (default off).
+    {{"rt_checkerboard", "RayGenerationSettings::checkerboard (0 or 1)", 0.0f, 1.0f, true, {1}, {1}, kTraced}, nullptr,
+     nullptr, [](ReflectionRunOptions& o) { return &o.frame.rays.checkerboard; }},
+    // A tile goes RT-only when at most this share of its SSLR rays hit
+    // (default 0, the talk's rule): higher stops paying for SSLR where it
+    // rarely succeeds.
+    {{"feedback_rt_hit_fraction", "FeedbackSettings::rtHitFraction", 0.0f, 1.0f, false, {0.05, 0.1, 0.25}, {0.1},
+      kHybrid},
      [](ReflectionRunOptions& o) { return &o.frame.feedback.rtHitFraction; }, nullptr},
-    {{"sslr_particles", "ReflectionFrameSettings::sslrParticles (0 or 1)"}, nullptr, nullptr,
-     [](ReflectionRunOptions& o) { return &o.frame.sslrParticles; }},
-    {{"reflect_particles", "ReflectionFrameSettings::reflectParticles (0 or 1)"}, nullptr, nullptr,
-     [](ReflectionRunOptions& o) { return &o.frame.reflectParticles; }},
-    {{"alpha_test", "RtTraceSettings::alphaTest (0 or 1)"}, nullptr, nullptr,
+    // Particles drawn before SSLR, which reflects them where it resolves
+    // the ray; the particle trace only where it does not (default off:
+    // every particle traced).
+    {{"sslr_particles", "ReflectionFrameSettings::sslrParticles (0 or 1)", 0.0f, 1.0f, true, {1}, {1}, kScreenSpace},
+     nullptr, nullptr, [](ReflectionRunOptions& o) { return &o.frame.sslrParticles; }},
+    // No particles in the reflections (default on): what the particle TLAS
+    // and trace cost.
+    {{"reflect_particles", "ReflectionFrameSettings::reflectParticles (0 or 1)", 0.0f, 1.0f, true, {0}, {0}, kTraced},
+     nullptr, nullptr, [](ReflectionRunOptions& o) { return &o.frame.reflectParticles; }},
+    // Rays see alpha-tested geometry opaque (default: through its
+    // cut-outs): what the test costs.
+    {{"alpha_test", "RtTraceSettings::alphaTest (0 or 1)", 0.0f, 1.0f, true, {0}, {0}, kTraced}, nullptr, nullptr,
      [](ReflectionRunOptions& o) { return &o.frame.rt.alphaTest; }},
-    {{"reflection_lods", "BvhSettings::reflectionLods (0: BLASes from full detail)"}, nullptr, nullptr,
-     [](ReflectionRunOptions& o) { return &o.renderer.bvh.reflectionLods; }},
-    {{"blue_noise", "RayGenerationSettings::blueNoise (1: spatiotemporal blue noise, 0: hashed sequences)"}, nullptr,
-     nullptr, [](ReflectionRunOptions& o) { return &o.frame.rays.blueNoise; }},
+    // BLASes from full detail instead of the reflection LODs (default on):
+    // what the LODs cost in error.
+    {{"reflection_lods", "BvhSettings::reflectionLods (0: BLASes from full detail)", 0.0f, 1.0f, true, {0}, {0},
+      kTraced},
+     nullptr, nullptr, [](ReflectionRunOptions& o) { return &o.renderer.bvh.reflectionLods; }},
+    // Spatiotemporal blue noise (default) against the hashed
+    // low-discrepancy sequences.
+    {{"blue_noise", "RayGenerationSettings::blueNoise (1: spatiotemporal blue noise, 0: hashed sequences)", 0.0f,
+      1.0f, true, {0}, {0}, kEveryMode},
+     nullptr, nullptr, [](ReflectionRunOptions& o) { return &o.frame.rays.blueNoise; }},
 }};
 
 const ParameterSlot& findParameter(std::string_view name) {

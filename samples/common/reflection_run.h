@@ -10,6 +10,7 @@
 #include "scene/camera.h"
 #include "scene/scene.h"
 
+#include <array>
 #include <optional>
 #include <span>
 #include <string_view>
@@ -112,9 +113,23 @@ scene::CameraPose cameraPoseAt(const scene::Scene& scene, const ReflectionRunOpt
 
 // The tunable parameters by name (glint-render --set NAME=VALUE, the
 // benchmark's sweeps): what each means is documented at its settings field.
+// One tunable setting, stated once: what `--set` and `--list-parameters`,
+// the viewer's sliders and the bench's sweeps are all made from.
 struct Parameter {
     std::string_view name;
     std::string_view field;  // the settings field it sets, for --help
+    // The range the viewer's slider offers; integer for counts and for
+    // switches (0 or 1).
+    float min = 0.0f;
+    float max = 1.0f;
+    bool integer = false;
+    // The bench's sweep: the values tried (quickSweep with --quick; values
+    // equal to the default are skipped), in the modes where the parameter
+    // changes the image (hybrid, ssr, rt: passes::ReflectionMode order).
+    // Empty: not swept.
+    std::vector<double> sweep;
+    std::vector<double> quickSweep;
+    std::array<bool, 3> sweepModes{};
 };
 std::span<const Parameter> parameters();
 // Sets one parameter; throws std::invalid_argument naming the parameter and

@@ -9,34 +9,6 @@ namespace glint::viewer {
 
 namespace {
 
-// Slider ranges around the defaults each settings field documents; a
-// parameter added later without a row gets [0, 4 x its default].
-struct RangeRow {
-    std::string_view name;
-    float min, max;
-    bool integer;
-};
-constexpr RangeRow kRanges[] = {
-    {"sslr_threshold", 0.0f, 1.0f, false},      // a confidence
-    {"sslr_steps", 1.0f, 256.0f, true},         // default 64 (the talk)
-    {"sslr_thickness", 0.001f, 0.5f, false},    // default 0.02 view-space units
-    {"sslr_min_step_pixels", 0.0f, 8.0f, false}, // default 1 pixel
-    {"roughness_cutoff", 0.0f, 1.0f, false},    // a roughness
-    {"reuse_roughness", 0.0f, 1.0f, false},     // a roughness
-    {"rt_near_distance", 0.0f, 50.0f, false},   // default 3 world units
-    {"sslr_far_distance", 0.0f, 500.0f, false}, // default 100
-    {"bvh_radius", 1.0f, 500.0f, false},        // default 100 (the talk)
-    {"rt_max_distance", 1.0f, 500.0f, false},   // default 100 (the talk)
-    {"frustum_culling", 0.0f, 1.0f, true},      // on or off
-    {"rt_checkerboard", 0.0f, 1.0f, true},      // on or off
-    {"feedback_rt_hit_fraction", 0.0f, 1.0f, false}, // default 0 (the talk)
-    {"sslr_particles", 0.0f, 1.0f, true},       // on or off
-    {"reflect_particles", 0.0f, 1.0f, true},    // on or off
-    {"alpha_test", 0.0f, 1.0f, true},           // rays through alpha-tested cut-outs, or all opaque
-    {"reflection_lods", 0.0f, 1.0f, true},      // BLASes from the reflection LODs, or full detail
-    {"blue_noise", 0.0f, 1.0f, true},           // blue noise or the hashed sequences
-};
-
 bool startsWith(std::string_view s, std::string_view prefix) { return s.substr(0, prefix.size()) == prefix; }
 
 } // namespace
@@ -101,19 +73,13 @@ bool debugViewAvailable(std::string_view view, passes::ReflectionMode mode) {
 
 std::vector<ParameterSlider> parameterSliders() {
     std::vector<ParameterSlider> sliders;
-    const app::ReflectionRunOptions defaults;
     for (const app::Parameter& p : app::parameters()) {
         ParameterSlider s;
         s.parameter = p;
-        const auto row = std::find_if(std::begin(kRanges), std::end(kRanges),
-                                      [&](const RangeRow& r) { return r.name == p.name; });
-        if (row != std::end(kRanges)) {
-            s.min = row->min;
-            s.max = row->max;
-            s.integer = row->integer;
-        } else {
-            s.max = std::max(1.0f, 4.0f * float(app::getParameter(defaults, p.name)));
-        }
+        // The range lives with the parameter (app::Parameter).
+        s.min = p.min;
+        s.max = p.max;
+        s.integer = p.integer;
         // The renderer's own options (ReflectionRendererOptions::bvh and
         // ::bvhUpdate) are read once, when it is built.
         s.rendererOption = startsWith(p.field, "BvhSettings::") || startsWith(p.field, "BvhUpdateOptions::");

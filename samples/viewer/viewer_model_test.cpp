@@ -82,6 +82,28 @@ TEST_CASE("every tunable parameter has a slider whose range holds its default") 
     }
 }
 
+TEST_CASE("every parameter's bench sweep lies in its range, runs in some mode and is accepted by setParameter") {
+    uint32_t swept = 0;
+    for (const app::Parameter& p : app::parameters()) {
+        INFO(p.name);
+        CHECK(p.quickSweep.size() <= p.sweep.size());
+        const bool anyMode = p.sweepModes[0] || p.sweepModes[1] || p.sweepModes[2];
+        CHECK(anyMode == !p.sweep.empty());
+        for (const std::vector<double>* values : {&p.sweep, &p.quickSweep}) {
+            for (const double v : *values) {
+                CAPTURE(v);
+                CHECK(p.min <= v);
+                CHECK(v <= p.max);
+                app::ReflectionRunOptions o;
+                app::setParameter(o, p.name, std::to_string(v));
+                CHECK(app::getParameter(o, p.name) == doctest::Approx(v));
+            }
+        }
+        swept += p.sweep.empty() ? 0u : 1u;
+    }
+    CHECK(swept >= 10u);
+}
+
 TEST_CASE("a slider sets its parameter through setParameter, clamped and rounded") {
     const std::vector<viewer::ParameterSlider> sliders = viewer::parameterSliders();
     const auto find = [&](std::string_view name) {
