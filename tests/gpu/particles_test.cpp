@@ -779,12 +779,20 @@ TEST_CASE("the plaza's lamp glows get a particle TLAS rebuilt every frame, frame
         executor.run(graph.compile(executor.compileOptions()), resources);
         CHECK(bvh.stats().particleTlasBuilds == 1);
         CHECK(bvh.stats().particles == plaza.particles.size());
+        // The box the particle trace tests segments against holds every
+        // quad, turned any way (a corner lies r sqrt(2) from the centre).
+        for (const scene::Particle& p : plaza.particles) {
+            const glm::vec3 reach(p.radius * std::sqrt(2.0f));
+            CHECK(glm::all(glm::lessThanEqual(out.particleBoundsMin, p.position - reach)));
+            CHECK(glm::all(glm::greaterThanEqual(out.particleBoundsMax, p.position + reach)));
+        }
     }
     executor.waitIdle();
     // Without the camera the same manager builds no particle TLAS.
     rg::Graph graph(executor.queueCaps());
     const passes::BvhUpdateOutputs out = passes::addBvhUpdatePass(graph, bvh, planner.plan(plaza, camera.position, 99));
     CHECK_FALSE(passes::particlesTraced(out));
+    CHECK(out.particleBoundsMin.x > out.particleBoundsMax.x);  // empty
     CHECK(bvh.stats().particleTlasBuilds == 0);
     rg::FrameResources resources;
     bvh.bind(resources, out);
