@@ -318,7 +318,8 @@ RtTraceOutputs addRtTracePass(rg::Graph& graph, RtTracePipelines& pipelines, con
                 .storageBuffer(kOffsets, pc.buffer(d.offsets))
                 .storageBuffer(kMaterials, pc.buffer(d.materials))
                 .storageBuffer(kAlphaTriangles, pc.buffer(d.alphaTriangles))
-                .sampledImage(kAlphaMasks, pc.view(d.alphaMasks), pipelines.alphaSampler_.handle(), pc.layout(d.alphaMasks))
+                .sampledImage(kAlphaMasks, pc.view(d.alphaMasks), pipelines.alphaSampler_.handle(),
+                              pc.layout(d.alphaMasks))
                 .storageBuffer(kConstants, pc.buffer(d.constants))
                 .storageImage(kRadiance, pc.view(d.out.radiance))
                 .storageImage(kHitDistance, pc.view(d.out.hitDistance))

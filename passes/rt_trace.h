@@ -15,12 +15,17 @@
 //   - a hit reads its triangle from the packed primitive pool through the
 //     primitive offset buffer, interpolates it at the barycentrics and
 //     lights it as the G-buffer lights its surfaces (glint/brdf.glsl's
-//     shadeSurface), the sun's visibility from a shadow ray;
+//     shadeSurface), the sun's visibility from a shadow ray, plus its
+//     geometry's emission (the BVH's material rows);
+//   - both rays pass through the cut-outs of alpha-tested geometry
+//     (glint/rt_geometry.glsl, passes/bvh_hit_materials.h);
 //   - a miss takes the environment (glint/brdf.glsl's environmentRadiance).
 // Two backends with bit-identical results (one shared GLSL file,
-// glint/rt_trace.glsl): ray query in a compute shader, or a ray tracing
-// pipeline with one closest-hit and an empty miss shader (NVIDIA has no
-// ray query). Layouts: glint/rt_trace_shared.h.
+// glint/rt_trace.glsl): ray query in a compute shader (its candidate loop
+// runs the alpha test), or a ray tracing pipeline with one hit group (a
+// closest-hit shader, and an any-hit shader for the alpha test) and an
+// empty miss shader (NVIDIA has no ray query). Layouts:
+// glint/rt_trace_shared.h.
 //
 //   passes::RtTracePipelines rtPipelines(ctx);          // once
 //   each frame, after SSLR (which completes the RT list):
