@@ -94,8 +94,4 @@ shader::RtGeometryMaterial HitMaterials::row(uint32_t mesh, uint32_t lod, uint32
     return r;
 }
 
-bool HitMaterials::alphaTested(uint32_t mesh, uint32_t lod, uint32_t geometry) const {
-    return firstTriangle_.contains({mesh, lod, geometry});
-}
-
 } // namespace glint::passes

@@ -38,11 +38,10 @@ class HitMaterials {
 public:
     HitMaterials(gpu::Context& ctx, const scene::Scene& scene, const HitMaterialOptions& options = {});
 
-    // The row of geometry `geometry` of mesh `mesh`'s LOD `lod`.
+    // The row of geometry `geometry` of mesh `mesh`'s LOD `lod`. Rays run
+    // the alpha test on it (its BLAS geometry is not opaque) unless its
+    // alphaTriangles is shader::kAlphaOpaque.
     shader::RtGeometryMaterial row(uint32_t mesh, uint32_t lod, uint32_t geometry) const;
-    // Whether rays must run the alpha test on that geometry (its BLAS
-    // geometry is then not opaque).
-    bool alphaTested(uint32_t mesh, uint32_t lod, uint32_t geometry) const;
 
     // shader::AlphaTriangle per alpha-tested triangle (at least one entry).
     const gpu::Buffer& alphaTriangles() const { return triangles_; }

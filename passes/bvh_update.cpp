@@ -14,6 +14,7 @@
 #include <algorithm>
 #include <bit>
 #include <cstring>
+#include <limits>
 #include <optional>
 #include <string>
 
@@ -94,6 +95,9 @@ struct BvhManager::ResidentBlas {
     gpu::Buffer positions;
     uint64_t builtInFrame = 0;
     std::vector<const SourceGeometry*> sources;  // per BLAS geometry
+    // Per BLAS geometry, its row of the material table (HitMaterials::row),
+    // fixed for the BLAS's life: each frame copies them beside the offsets.
+    std::vector<shader::RtGeometryMaterial> materialRows;
     std::optional<gpu::AccelBuild> build;        // geometry addresses into `positions`, reused by rebuilds
     gpu::AccelerationStructure structure;
     // A morphing instance's BLAS: per frame slot and BLAS geometry, its
@@ -280,13 +284,14 @@ BvhManager::ResidentBlas& BvhManager::createBlas(const scene::BlasDesc& desc, Fr
     VkDeviceSize first = 0;
     for (const scene::BlasGeometry& g : desc.geometries) {
         blas->sources.push_back(&sourceGeometry(desc.mesh, desc.lod, g.meshGeometry, work));
+        blas->materialRows.push_back(hitMaterials_.row(desc.mesh, desc.lod, g.meshGeometry));
         gpu::TriangleGeometry t;
         t.vertices = blas->positions.address() + first * sizeof(glm::vec3);
         t.vertexCount = 3 * g.triangleCount;
         t.triangleCount = g.triangleCount;
         // Alpha-tested geometry runs the any-hit test (glint/alpha_test.h);
         // everything else stays opaque, so rays never stop on it for a test.
-        t.opaque = !hitMaterials_.alphaTested(desc.mesh, desc.lod, g.meshGeometry);
+        t.opaque = blas->materialRows.back().alphaTriangles == shader::kAlphaOpaque;
         triangles.push_back(t);
         first += 3 * VkDeviceSize(g.triangleCount);
     }
@@ -622,12 +627,10 @@ std::shared_ptr<BvhManager::FrameWork> BvhManager::prepare(const scene::BvhPlan&
                                 " uses BLAS " + std::to_string(ti.blas) + ", which was never built");
         }
         // The material rows beside the offset rows the planner wrote.
-        const scene::BlasDesc& desc = it->second->desc;
-        for (size_t g = 0; g < desc.geometries.size(); ++g) {
+        const std::vector<shader::RtGeometryMaterial>& rows = it->second->materialRows;
+        for (size_t g = 0; g < rows.size(); ++g) {
             const size_t row = shader::primitiveOffsetSlot(ti.customIndex, uint32_t(g));
-            if (row < work->materials.size()) {
-                work->materials[row] = hitMaterials_.row(desc.mesh, desc.lod, desc.geometries[g].meshGeometry);
-            }
+            if (row < work->materials.size()) work->materials[row] = rows[g];
         }
         const auto transform = scene::rowMajor3x4(ti.transform);
         // glTF's front faces wind counter-clockwise in its right-handed
@@ -869,15 +872,15 @@ BvhUpdateOutputs BvhManager::declare(rg::Graph& graph, BvhManager& manager, cons
     // The alpha test's data never changes after start-up: imported for the
     // traces to read, written by no pass.
     BvhUpdateOutputs outputs = out;
-    for (const shader::ParticleData& p : work->particles) {
-        // A quad of half side r turned any way stays within r * sqrt(2).
-        const glm::vec3 reach(p.radius * 1.4143f);
-        outputs.particleBoundsMin = outputs.particleBoundsMax.x < outputs.particleBoundsMin.x
-                                        ? p.position - reach
-                                        : glm::min(outputs.particleBoundsMin, p.position - reach);
-        outputs.particleBoundsMax = outputs.particleBoundsMax.x < outputs.particleBoundsMin.x
-                                        ? p.position + reach
-                                        : glm::max(outputs.particleBoundsMax, p.position + reach);
+    if (!work->particles.empty()) {
+        outputs.particleBoundsMin = glm::vec3(std::numeric_limits<float>::max());
+        outputs.particleBoundsMax = glm::vec3(std::numeric_limits<float>::lowest());
+        for (const shader::ParticleData& p : work->particles) {
+            // A quad of half side r turned any way stays within r * sqrt(2).
+            const glm::vec3 reach(p.radius * 1.4143f);
+            outputs.particleBoundsMin = glm::min(outputs.particleBoundsMin, p.position - reach);
+            outputs.particleBoundsMax = glm::max(outputs.particleBoundsMax, p.position + reach);
+        }
     }
     const HitMaterials& hit = manager.hitMaterials_;
     outputs.alphaTriangles =

@@ -8,17 +8,14 @@
 // passes through the cut-outs too: a sunlit floor under a striped canopy,
 // seen only in a mirror, is striped with the canopy's shadow.
 #include "support/gpu_test.h"
-#include "support/graph_readback.h"
+#include "support/frame_render.h"
 
-#include "graph/executor.h"
-#include "graph/graph.h"
 #include "passes/reflection_frame.h"
 #include "scene/animation.h"
 #include "scene/procedural_meshes.h"
 
 #include <doctest/doctest.h>
 
-#include <cstring>
 #include <string>
 #include <vector>
 
@@ -36,39 +33,24 @@ struct Run {
 
 // The last of `frames` composited frames, RGBA8.
 std::vector<uint8_t> render(gpu::Context& ctx, const scene::Scene& s, const Run& run, uint32_t frames = 3) {
-    rg::Executor executor(ctx);
+    passes::ReflectionFrameSettings settings;
+    settings.mode = run.mode;
+    settings.rt.alphaTest = run.alphaTest;
     passes::ReflectionRendererOptions options;
     options.backend = run.backend;
-    passes::ReflectionRenderer renderer(ctx, s, options);
-    const gpu::Buffer readback = test::readbackBuffer(ctx, kSize.x, kSize.y, 4, "alpha.readback");
-    scene::Camera camera;
-    camera.resolution = kSize;
-    camera.lens = s.lens;
-    camera.jitter = false;
-    const scene::CameraPose pose = s.cameraPath.evaluate(0.0f);
-    for (uint32_t i = 0; i < frames; ++i) {
-        if (i == 0) {
-            camera.reset(pose, i);
-        } else {
-            camera.advance(pose, i);
-        }
-        rg::Graph graph(executor.queueCaps());
-        passes::ReflectionFrameSettings settings;
-        settings.mode = run.mode;
-        settings.resetHistory = i == 0;
-        settings.rt.alphaTest = run.alphaTest;
-        const passes::ReflectionFrame f = renderer.addFrame(graph, camera, settings);
-        rg::FrameResources resources;
-        renderer.bind(resources, f);
-        if (i + 1 == frames) {
-            test::addReadback(graph, f.output.color, kSize.x, kSize.y, readback, resources, "alpha.readback");
-        }
-        executor.run(graph.compile(executor.compileOptions()), resources);
+    return test::renderComposited(ctx, s, kSize, frames, settings, options);
+}
+
+// 8 x 1 texels: opaque, opaque, clear, clear, ... (two stripes a period).
+scene::Texture stripesTexture() {
+    scene::Texture stripes;
+    stripes.name = "stripes";
+    stripes.width = 8;
+    stripes.height = 1;
+    for (uint32_t x = 0; x < stripes.width; ++x) {
+        stripes.rgba8.insert(stripes.rgba8.end(), {255, 255, 255, uint8_t((x / 2) % 2 == 0 ? 255 : 0)});
     }
-    executor.waitIdle();
-    std::vector<uint8_t> rgba(size_t(kSize.x) * kSize.y * 4);
-    std::memcpy(rgba.data(), readback.mapped(), rgba.size());
-    return rgba;
+    return stripes;
 }
 
 scene::Geometry quad(glm::vec3 centre, glm::vec3 u, glm::vec3 v, glm::vec2 half, uint32_t material) {
@@ -112,16 +94,7 @@ scene::Scene fenceScene(scene::AlphaMode mode) {
     fence.alphaCutoff = 0.5f;
     fence.baseColorTexture.texture = 0;
     s.materials = {floor, fence, emissive({0.02f, 1.0f, 0.02f})};
-    // 8 x 1 texels: opaque, opaque, clear, clear, ... (two stripes a period).
-    scene::Texture stripes;
-    stripes.name = "stripes";
-    stripes.width = 8;
-    stripes.height = 1;
-    for (uint32_t x = 0; x < stripes.width; ++x) {
-        const uint8_t alpha = (x / 2) % 2 == 0 ? 255 : 0;
-        stripes.rgba8.insert(stripes.rgba8.end(), {255, 255, 255, alpha});
-    }
-    s.textures = {stripes};
+    s.textures = {stripesTexture()};
     scene::Mesh floorMesh;
     floorMesh.name = "floor";
     floorMesh.lods.push_back({{scene::makeGrid({80.0f, 80.0f}, {1, 1}, 0)}});
@@ -185,14 +158,7 @@ scene::Scene canopyScene() {
     canopy.alphaMode = scene::AlphaMode::Mask;
     canopy.baseColorTexture.texture = 0;
     s.materials = {mirror, floor, canopy};
-    scene::Texture stripes;
-    stripes.name = "stripes";
-    stripes.width = 8;
-    stripes.height = 1;
-    for (uint32_t x = 0; x < stripes.width; ++x) {
-        stripes.rgba8.insert(stripes.rgba8.end(), {255, 255, 255, uint8_t((x / 2) % 2 == 0 ? 255 : 0)});
-    }
-    s.textures = {stripes};
+    s.textures = {stripesTexture()};
     scene::Mesh mirrorMesh;
     mirrorMesh.name = "mirror";
     mirrorMesh.lods.push_back({{quad({0.0f, 6.0f, -3.0f}, {1, 0, 0}, {0, 1, 0}, {30.0f, 6.0f}, 0)}});

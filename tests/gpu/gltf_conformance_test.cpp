@@ -8,10 +8,8 @@
 //    single-sided panels culled: a negative determinant flips the winding
 //    for culling and shading, in raster and in both ray backends.
 #include "support/gpu_test.h"
-#include "support/graph_readback.h"
+#include "support/frame_render.h"
 
-#include "graph/executor.h"
-#include "graph/graph.h"
 #include "passes/reflection_frame.h"
 #include "scene/animation.h"
 #include "scene/gltf_loader.h"
@@ -30,42 +28,14 @@ using namespace glint;
 
 namespace {
 
-// Renders `frames` frames of a scene from its first camera key with the
-// whole reflection frame and returns the last composited image, RGBA8.
+// The last of `frames` composited frames of `s` in `mode`, RGBA8.
 std::vector<uint8_t> render(gpu::Context& ctx, const scene::Scene& s, glm::uvec2 size, passes::ReflectionMode mode,
                             uint32_t frames, passes::RtBackend backend = passes::RtBackend::Auto) {
-    rg::Executor executor(ctx);
+    passes::ReflectionFrameSettings settings;
+    settings.mode = mode;
     passes::ReflectionRendererOptions options;
     options.backend = backend;
-    passes::ReflectionRenderer renderer(ctx, s, options);
-    const gpu::Buffer readback = test::readbackBuffer(ctx, size.x, size.y, 4, "conformance.readback");
-    scene::Camera camera;
-    camera.resolution = size;
-    camera.lens = s.lens;
-    camera.jitter = false;
-    const scene::CameraPose pose = s.cameraPath.evaluate(0.0f);
-    for (uint32_t i = 0; i < frames; ++i) {
-        if (i == 0) {
-            camera.reset(pose, i);
-        } else {
-            camera.advance(pose, i);
-        }
-        rg::Graph graph(executor.queueCaps());
-        passes::ReflectionFrameSettings settings;
-        settings.mode = mode;
-        settings.resetHistory = i == 0;
-        const passes::ReflectionFrame f = renderer.addFrame(graph, camera, settings);
-        rg::FrameResources resources;
-        renderer.bind(resources, f);
-        if (i + 1 == frames) {
-            test::addReadback(graph, f.output.color, size.x, size.y, readback, resources, "conformance.readback");
-        }
-        executor.run(graph.compile(executor.compileOptions()), resources);
-    }
-    executor.waitIdle();
-    std::vector<uint8_t> rgba(size_t(size.x) * size.y * 4);
-    std::memcpy(rgba.data(), readback.mapped(), rgba.size());
-    return rgba;
+    return test::renderComposited(ctx, s, size, frames, settings, options);
 }
 
 // The models' pass and fail marks: a green check (about 1, 127, 5 in the
