@@ -76,7 +76,7 @@ CompositeOutputs outputOf(rg::Builder& b, const char* name, uint32_t width, uint
 
 CompositePipelines::CompositePipelines(gpu::Context& ctx)
     : ctx_(ctx),
-      composite_(gpu::createComputePipeline(ctx, {"composite/composite.comp", sampledThenStorage(6),
+      composite_(gpu::createComputePipeline(ctx, {"composite/composite.comp", sampledThenStorage(7),
                                                   uint32_t(sizeof(shader::CompositeConstants)), "composite"})),
       debugView_(gpu::createComputePipeline(ctx, {"composite/debug_view.comp", sampledThenStorage(1),
                                                   uint32_t(sizeof(shader::DebugViewConstants)), "debug_view"})),
@@ -94,11 +94,13 @@ CompositeOutputs addCompositePass(rg::Graph& graph, CompositePipelines& pipeline
     if (gbuf.width == 0 || gbuf.height == 0) {
         throw gpu::GpuError("addCompositePass: the G-buffer has no pixels");
     }
-    if (inputs.reflections.valid() && inputs.reflections.graph == graph.id() &&
-        inputs.reflections.index < graph.declaration().resources.size()) {
-        const rg::TextureDesc& desc = graph.declaration().resources[inputs.reflections.index].texture;
-        if (desc.width != gbuf.width || desc.height != gbuf.height) {
-            throw gpu::GpuError("addCompositePass: the reflections must have the G-buffer's size");
+    for (const auto& [texture, what] : {std::pair{inputs.reflections, "reflections"},
+                                        std::pair{inputs.transparency, "transparent layer"}}) {
+        if (texture.valid() && texture.graph == graph.id() && texture.index < graph.declaration().resources.size()) {
+            const rg::TextureDesc& desc = graph.declaration().resources[texture.index].texture;
+            if (desc.width != gbuf.width || desc.height != gbuf.height) {
+                throw gpu::GpuError(std::string("addCompositePass: the ") + what + " must have the G-buffer's size");
+            }
         }
     }
     if (!std::isfinite(settings.exposure) || settings.exposure < 0.0f) {
@@ -112,9 +114,10 @@ CompositeOutputs addCompositePass(rg::Graph& graph, CompositePipelines& pipeline
     constants.exposure = settings.exposure;
     constants.tonemap = uint32_t(settings.tonemap);
     constants.hasReflections = inputs.reflections.valid() ? 1u : 0u;
+    constants.hasTransparency = inputs.transparency.valid() ? 1u : 0u;
 
     struct Data {
-        rg::Texture lit, albedo, normal, roughnessMetal, depth, reflections;
+        rg::Texture lit, albedo, normal, roughnessMetal, depth, reflections, transparency;
         CompositeOutputs out;
     };
     const Data& data = graph.addPass<Data>(
@@ -128,14 +131,19 @@ CompositeOutputs addCompositePass(rg::Graph& graph, CompositePipelines& pipeline
             if (inputs.reflections.valid()) {
                 d.reflections = b.read(inputs.reflections, rg::Access::SampledRead);
             }
+            if (inputs.transparency.valid()) {
+                d.transparency = b.read(inputs.transparency, rg::Access::SampledRead);
+            }
             d.out = outputOf(b, "composite.color", gbuf.width, gbuf.height);
         },
         [&pipelines, constants](const Data& d, rg::PassContext& pc) {
             const gpu::Pipeline& pipeline = pipelines.composite_;
             const VkSampler sampler = pipelines.nearest_.handle();
-            // Without reflections the binding still needs an image: the lit
-            // colour, which the shader then never reads there.
+            // Without reflections or a transparent layer the binding still
+            // needs an image: the lit colour, which the shader then never
+            // reads there.
             const rg::Texture reflections = d.reflections.valid() ? d.reflections : d.lit;
+            const rg::Texture transparency = d.transparency.valid() ? d.transparency : d.lit;
             pipeline.bind(pc.cmd());
             gpu::PushDescriptors(pipeline)
                 .sampledImage(0, pc.view(d.lit), sampler, pc.layout(d.lit))
@@ -144,7 +152,8 @@ CompositeOutputs addCompositePass(rg::Graph& graph, CompositePipelines& pipeline
                 .sampledImage(3, pc.view(d.roughnessMetal), sampler, pc.layout(d.roughnessMetal))
                 .sampledImage(4, pc.view(d.depth), sampler, pc.layout(d.depth))
                 .sampledImage(5, pc.view(reflections), sampler, pc.layout(reflections))
-                .storageImage(6, pc.view(d.out.color))
+                .sampledImage(6, pc.view(transparency), sampler, pc.layout(transparency))
+                .storageImage(7, pc.view(d.out.color))
                 .push(pipelines.ctx_, pc.cmd());
             pipeline.pushConstants(pc.cmd(), constants);
             pc.dispatch(pipeline, groups(constants.size.x), groups(constants.size.y));

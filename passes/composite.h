@@ -2,7 +2,10 @@
 // Pass 8 of the reflection pipeline (issue 5): composite and debug views.
 //
 // Composite, one compute pass:
-//   final = lit + reflection * envBRDF(F0, roughness, N.V)
+//   opaque = lit + reflection * envBRDF(F0, roughness, N.V)
+//   final = layer.rgb + (1 - layer.a) * opaque
+// (layer: the transparent pass's premultiplied blended surfaces,
+// passes/transparent.h; without one, final = opaque)
 // where envBRDF is Karis's analytic fit of the split-sum environment BRDF
 // of GGX ("Physically Based Shading on Mobile", 2014) and F0 comes from the
 // G-buffer's albedo, metallic and reflectance as glint/brdf.glsl's
@@ -51,6 +54,9 @@ struct CompositeInputs {
     GBufferOutputs gbuffer;    // lit, albedo, normal, roughnessMetal, depth
     rg::Texture reflections;   // resolved reflections, a > 0 where they exist; invalid: the lit colour alone
     scene::Camera camera;      // the G-buffer's (its matrices, position)
+    // Premultiplied blended surfaces over the opaque image (the transparent
+    // pass's layer, the G-buffer's size); invalid: none.
+    rg::Texture transparency;
 };
 
 struct CompositeSettings {

@@ -1,4 +1,5 @@
 #include "passes/gbuffer.h"
+#include "passes/gbuffer_internal.h"
 
 #include "gpu/commands.h"
 #include "gpu/descriptors.h"
@@ -26,38 +27,9 @@
 
 namespace glint::passes {
 
+using namespace gbuffer_detail;
+
 namespace {
-
-constexpr VkShaderStageFlags kRasterStages = VK_SHADER_STAGE_VERTEX_BIT | VK_SHADER_STAGE_FRAGMENT_BIT;
-
-// Bindings of shaders/gbuffer/gbuffer_common.glsl, shared by every pipeline.
-std::vector<gpu::Binding> geometryBindings() {
-    std::vector<gpu::Binding> bindings;
-    for (uint32_t b = 0; b < 5; ++b) {
-        bindings.push_back({b, VK_DESCRIPTOR_TYPE_STORAGE_BUFFER, kRasterStages});
-    }
-    return bindings;
-}
-
-// The G-buffer's pipelines add the shadow map (shaders/gbuffer/shadow.glsl);
-// the shadow map's own pipeline cannot bind what it renders.
-// and the prefiltered environment (glint/environment.glsl).
-constexpr uint32_t kShadowMapBinding = 5;
-constexpr uint32_t kEnvironmentBinding = 6;
-// The material textures a draw samples per pixel, at bindings 7 to 10
-// (gbuffer.frag), in MaterialSlot order.
-constexpr uint32_t kFirstMaterialTextureBinding = 7;
-enum MaterialSlot : size_t { kNormalSlot, kBaseColorSlot, kMetalRoughSlot, kEmissiveSlot, kMaterialSlots };
-std::vector<gpu::Binding> gbufferBindings() {
-    std::vector<gpu::Binding> bindings = geometryBindings();
-    bindings.push_back({kShadowMapBinding, VK_DESCRIPTOR_TYPE_COMBINED_IMAGE_SAMPLER, VK_SHADER_STAGE_FRAGMENT_BIT});
-    bindings.push_back({kEnvironmentBinding, VK_DESCRIPTOR_TYPE_COMBINED_IMAGE_SAMPLER, VK_SHADER_STAGE_FRAGMENT_BIT});
-    for (uint32_t slot = 0; slot < kMaterialSlots; ++slot) {
-        bindings.push_back({kFirstMaterialTextureBinding + slot, VK_DESCRIPTOR_TYPE_COMBINED_IMAGE_SAMPLER,
-                            VK_SHADER_STAGE_FRAGMENT_BIT});
-    }
-    return bindings;
-}
 
 VkSamplerAddressMode addressMode(scene::Wrap wrap) {
     switch (wrap) {
@@ -67,10 +39,6 @@ VkSamplerAddressMode addressMode(scene::Wrap wrap) {
     }
     return VK_SAMPLER_ADDRESS_MODE_REPEAT;
 }
-
-// A material texture the G-buffer does not sample per pixel (none, or not
-// 8-bit): the draw binds its slot's fallback.
-constexpr size_t kNoImage = std::numeric_limits<size_t>::max();
 
 // glTF's three wrap modes for S and T: nine samplers.
 constexpr size_t kWrapModes = 3;
@@ -222,60 +190,12 @@ shader::GBufferShadow fitSunShadow(const scene::Scene& scene, const scene::Camer
     return fit;
 }
 
-// One LOD-0 geometry in the shared vertex and index buffers.
-struct GBufferRenderer::DrawRange {
-    uint32_t firstIndex = 0;
-    uint32_t indexCount = 0;
-    int32_t vertexOffset = 0;
-    bool doubleSided = false;
-    bool masked = false;  // glTF alphaMode MASK: drawn with the alpha-tested pipelines
-    // The draw's push constants less the instance; per MaterialSlot the
-    // image (kNoImage: the slot's fallback) and sampler it binds.
-    shader::GBufferDraw material{};
-    std::array<size_t, kMaterialSlots> image{kNoImage, kNoImage, kNoImage, kNoImage};
-    std::array<size_t, kMaterialSlots> sampler{};
-};
-
-// Host-visible buffers of one frame in flight, written when the frame
-// records (the executor has waited for the slot's previous frame by then).
-struct GBufferRenderer::FrameSlot {
-    gpu::Buffer frame;
-    gpu::Buffer morphedVertices;  // this frame's morphing instances (FrameWork::morphedVertices)
-    gpu::Buffer instances;
-    gpu::Buffer joints;
-    gpu::Buffer previousJoints;
-};
-
-// What one frame draws, copied from the scene and camera at declaration.
-struct GBufferRenderer::FrameWork {
-    uint32_t slot = 0;
-    bool drawSky = true;
-    shader::GBufferFrame frame{};
-    std::vector<shader::GBufferInstance> instances;
-    std::vector<uint32_t> meshes;  // per instance
-    // Per instance: drawn into the G-buffer (its bounds meet the camera's
-    // frustum) and into the shadow map (they meet the map's box).
-    std::vector<uint8_t> visible;
-    std::vector<uint8_t> castsShadow;
-    // Per instance: its transform mirrors (a negative determinant), so its
-    // front faces wind clockwise on screen (glTF: the determinant sets the
-    // winding).
-    std::vector<uint8_t> mirrored;
-    std::vector<glm::mat4> joints;
-    std::vector<glm::mat4> previousJoints;
-    // Morphing instances: the mesh's vertices with the instance's weights
-    // applied, end to end; per instance the first of them, or -1 (the
-    // shared vertex buffer).
-    std::vector<shader::GBufferVertex> morphedVertices;
-    std::vector<int64_t> morphedFirstVertex;
-};
-
 GBufferRenderer::GBufferRenderer(gpu::Context& ctx, const scene::Scene& scene, uint32_t framesInFlight)
     : ctx_(ctx), scene_(scene), framesInFlight_(std::max(framesInFlight, 1u)) {
     gpu::GraphicsPipelineDesc surface;
     surface.vertexShader = "gbuffer/gbuffer.vert";
     surface.fragmentShader = "gbuffer/gbuffer.frag";
-    surface.bindings = gbufferBindings();
+    surface.bindings = surfaceBindings();
     surface.pushConstantBytes = sizeof(shader::GBufferDraw);
     // Per draw (glTF): back faces culled for single-sided materials, none
     // for double-sided ones; front faces wind counter-clockwise on screen
@@ -390,7 +310,11 @@ GBufferRenderer::GBufferRenderer(gpu::Context& ctx, const scene::Scene& scene, u
             range.vertexOffset = int32_t(vertices.size());
             const scene::Material& material = scene.materials.at(g.material);
             range.doubleSided = material.doubleSided;
-            range.masked = material.alphaMode == scene::AlphaMode::Mask;
+            range.coverage = material.alphaMode == scene::AlphaMode::Mask    ? Coverage::Masked
+                             : material.alphaMode == scene::AlphaMode::Blend ? Coverage::Blended
+                                                                               : Coverage::Opaque;
+            range.bounds = g.bounds;
+            hasBlended_ = hasBlended_ || (range.coverage == Coverage::Blended && range.indexCount > 0);
             // A slot samples its texture when `wanted` and the texture has an
             // image: its coordinate set (+1; 0 = not sampled), transform and
             // sampler go to the draw.
@@ -404,7 +328,7 @@ GBufferRenderer::GBufferRenderer(gpu::Context& ctx, const scene::Scene& scene, u
                 return true;
             };
             shader::GBufferDraw& draw = range.material;
-            draw.alphaCutoff = range.masked ? material.alphaCutoff : -1.0f;
+            draw.alphaCutoff = range.coverage == Coverage::Masked ? material.alphaCutoff : -1.0f;
             if (useSlot(kNormalSlot, material.normalTexture, VK_FORMAT_R8G8B8A8_UNORM, "normal_map",
                         g.tangents.size() == g.vertexCount(), draw.normalMap, draw.normalUvTransform)) {
                 draw.normalScale = material.normalScale;
@@ -472,6 +396,7 @@ GBufferRenderer::GBufferRenderer(gpu::Context& ctx, const scene::Scene& scene, u
     indices_ = gpu::createBufferWithData(ctx, {indices.size() * sizeof(uint32_t), VK_BUFFER_USAGE_INDEX_BUFFER_BIT,
                                                gpu::MemoryUsage::DeviceLocal, "gbuffer.indices"},
                                          indices.data());
+    if (hasBlended_) transparentPipeline_ = createTransparentPipeline();
     stats_.geometryBytes = vertices_.size() + indices_.size();
     stats_.textureImages = uint32_t(textureImages_.size());
     stats_.textureBytes = textureBytes;
@@ -499,6 +424,7 @@ std::shared_ptr<GBufferRenderer::FrameWork> GBufferRenderer::prepare(const GBuff
                                                                      const GBufferSettings& settings) {
     ++frame_;
     auto work = std::make_shared<FrameWork>();
+    work->frameNumber = frame_;
     work->slot = uint32_t(frame_ % framesInFlight_);
     stats_.frame = frame_;
     work->drawSky = settings.drawSky;
@@ -664,7 +590,11 @@ void GBufferRenderer::recordShadowMap(const FrameWork& work, rg::PassContext& pc
                 if (!work.castsShadow[i]) continue;
                 const auto [vertices, vertexShift] = vertexSource(work, i, slot);
                 for (const DrawRange& range : meshDraws_.at(work.meshes[i])) {
-                    if (range.indexCount == 0 || range.masked != masked) continue;
+                    // Blended surfaces cast no shadow (nor do they in the
+                    // BVH the shadow rays of the RT hits trace).
+                    if (range.indexCount == 0 || range.coverage != (masked ? Coverage::Masked : Coverage::Opaque)) {
+                        continue;
+                    }
                     const size_t image = range.image[kBaseColorSlot];
                     const gpu::Image* baseColor = image == kNoImage ? &white_ : &textureImages_[image];
                     const gpu::Sampler* sampler =
@@ -700,6 +630,45 @@ void GBufferRenderer::recordShadowMap(const FrameWork& work, rg::PassContext& pc
         }
     }
     vkCmdEndRendering(cmd);
+}
+
+GBufferRenderer::MaterialTextures GBufferRenderer::fallbackTextures() const {
+    return {std::pair{&flatNormal_, &textureSamplers_[0]}, std::pair{&white_, &textureSamplers_[0]},
+            std::pair{&white_, &textureSamplers_[0]}, std::pair{&white_, &textureSamplers_[0]}};
+}
+
+bool GBufferRenderer::rangeTextures(const DrawRange& range, MaterialTextures& textures) const {
+    bool textured = false;
+    for (size_t t = 0; t < kMaterialSlots; ++t) {
+        if (range.image[t] == kNoImage) continue;
+        textures[t] = {&textureImages_[range.image[t]], &textureSamplers_[range.sampler[t]]};
+        textured = true;
+    }
+    return textured;
+}
+
+void GBufferRenderer::pushSurfaceBindings(const gpu::Pipeline& pipeline, rg::PassContext& pc, const FrameSlot& slot,
+                                          const gpu::Buffer& vertices, const MaterialTextures& textures,
+                                          rg::Texture shadowMap, rg::Texture environment) const {
+    gpu::PushDescriptors push(pipeline);
+    push.storageBuffer(0, slot.frame)
+        .storageBuffer(1, slot.instances)
+        .storageBuffer(2, vertices)
+        .storageBuffer(3, slot.joints)
+        .storageBuffer(4, slot.previousJoints)
+        .sampledImage(kShadowMapBinding, pc.view(shadowMap), nearest_.handle(), pc.layout(shadowMap));
+    for (uint32_t t = 0; t < kMaterialSlots; ++t) {
+        push.sampledImage(kFirstMaterialTextureBinding + t, textures[t].first->view(), textures[t].second->handle());
+    }
+    // The procedural sky reads no texture: the shadow map, which the
+    // passes read anyway, fills the environment's binding.
+    if (environment.valid()) {
+        push.sampledImage(kEnvironmentBinding, pc.view(environment), environmentSampler_.handle(),
+                          pc.layout(environment));
+    } else {
+        push.sampledImage(kEnvironmentBinding, pc.view(shadowMap), nearest_.handle(), pc.layout(shadowMap));
+    }
+    push.push(ctx_, pc.cmd());
 }
 
 void GBufferRenderer::record(const FrameWork& work, rg::PassContext& pc, const GBufferOutputs& targets,
@@ -742,37 +711,13 @@ void GBufferRenderer::record(const FrameWork& work, rg::PassContext& pc, const G
     vkCmdSetViewport(cmd, 0, 1, &viewport);
     vkCmdSetScissor(cmd, 0, 1, &scissor);
 
+    const MaterialTextures fallbacks = fallbackTextures();
     // Pushed again only when a draw's vertex buffer (a morphing instance's
     // own) or one of its material textures differs from the last draw's.
-    using MaterialTextures = std::array<std::pair<const gpu::Image*, const gpu::Sampler*>, kMaterialSlots>;
     const auto pushBindings = [&](const gpu::Pipeline& pipeline, const gpu::Buffer& vertices,
                                   const MaterialTextures& textures) {
-        gpu::PushDescriptors push(pipeline);
-        push.storageBuffer(0, slot.frame)
-            .storageBuffer(1, slot.instances)
-            .storageBuffer(2, vertices)
-            .storageBuffer(3, slot.joints)
-            .storageBuffer(4, slot.previousJoints)
-            .sampledImage(kShadowMapBinding, pc.view(targets.shadowMap), nearest_.handle(),
-                          pc.layout(targets.shadowMap));
-        for (uint32_t t = 0; t < kMaterialSlots; ++t) {
-            push.sampledImage(kFirstMaterialTextureBinding + t, textures[t].first->view(), textures[t].second->handle());
-        }
-        // The procedural sky reads no texture: the shadow map, which the
-        // pass reads anyway, fills the environment's binding.
-        if (environment.valid()) {
-            push.sampledImage(kEnvironmentBinding, pc.view(environment), environmentSampler_.handle(),
-                              pc.layout(environment));
-        } else {
-            push.sampledImage(kEnvironmentBinding, pc.view(targets.shadowMap), nearest_.handle(),
-                              pc.layout(targets.shadowMap));
-        }
-        push.push(ctx_, cmd);
+        pushSurfaceBindings(pipeline, pc, slot, vertices, textures, targets.shadowMap, environment);
     };
-    const MaterialTextures fallbacks = {std::pair{&flatNormal_, &textureSamplers_[0]},
-                                        std::pair{&white_, &textureSamplers_[0]},
-                                        std::pair{&white_, &textureSamplers_[0]},
-                                        std::pair{&white_, &textureSamplers_[0]}};
 
     stats_.draws = 0;
     stats_.triangles = 0;
@@ -799,7 +744,10 @@ void GBufferRenderer::record(const FrameWork& work, rg::PassContext& pc, const G
             const VkFrontFace instanceFront =
                 work.mirrored[i] ? VK_FRONT_FACE_CLOCKWISE : VK_FRONT_FACE_COUNTER_CLOCKWISE;
             for (const DrawRange& range : meshDraws_.at(work.meshes[i])) {
-                if (range.indexCount == 0 || range.masked != masked) continue;
+                // Blended surfaces are drawn by the transparent pass.
+                if (range.indexCount == 0 || range.coverage != (masked ? Coverage::Masked : Coverage::Opaque)) {
+                    continue;
+                }
                 if (instanceFront != frontFace) {
                     frontFace = instanceFront;
                     vkCmdSetFrontFace(cmd, frontFace);
@@ -809,14 +757,8 @@ void GBufferRenderer::record(const FrameWork& work, rg::PassContext& pc, const G
                     cullMode = rangeCull;
                     vkCmdSetCullMode(cmd, cullMode);
                 }
-                // A slot the draw does not sample keeps whatever is bound.
                 MaterialTextures textures = boundTextures;
-                bool textured = false;
-                for (size_t t = 0; t < kMaterialSlots; ++t) {
-                    if (range.image[t] == kNoImage) continue;
-                    textures[t] = {&textureImages_[range.image[t]], &textureSamplers_[range.sampler[t]]};
-                    textured = true;
-                }
+                const bool textured = rangeTextures(range, textures);
                 stats_.normalMappedDraws += range.material.normalMap != 0 ? 1u : 0u;
                 stats_.texturedDraws += textured ? 1u : 0u;
                 stats_.maskedDraws += masked ? 1u : 0u;
@@ -853,6 +795,7 @@ GBufferOutputs addGBufferPass(rg::Graph& graph, GBufferRenderer& renderer, const
                             std::to_string(height) + "; both sides must be positive");
     }
     std::shared_ptr<GBufferRenderer::FrameWork> work = renderer.prepare(inputs, settings);
+    renderer.current_ = work;
     if (work->frame.lighting.environment.x != 0.0f && !inputs.environment.valid()) {
         throw gpu::GpuError("G-buffer: the lighting looks up an environment image but no environment texture was given "
                             "(passes::importEnvironment)");

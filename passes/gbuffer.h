@@ -1,7 +1,9 @@
 #pragma once
 // Pass 1 of the reflection pipeline: the G-buffer. One raster pass on the
 // graphics queue draws every instance of a scene::Scene (mesh LOD 0) whose
-// bounds meet the view frustum (GBufferSettings::frustumCulling) into reversed-Z depth, world normal, albedo, roughness/metallic,
+// bounds meet the view frustum (GBufferSettings::frustumCulling), less
+// their blended geometries (glTF alphaMode BLEND: the transparent pass
+// draws those, passes/transparent.h), into reversed-Z depth, world normal, albedo, roughness/metallic,
 // motion (camera, rigid and skinned motion) and the lit colour of the
 // opaque scene that SSLR samples; a sky triangle fills what no geometry
 // covers. Output conventions: glint/gbuffer_shared.h.
@@ -19,7 +21,7 @@
 // SSLR and in an RT reflection is shadowed alike). The shadow map is a
 // pass of its own ("shadow_map", graphics queue, before "gbuffer"): an
 // orthographic depth-only raster along the sun's rays of every instance's
-// LOD 0 that meets the map's box, the G-buffer's own vertex buffer and skinning, fitted to the
+// LOD 0 that meets the map's box (blended geometry casts no shadow), the G-buffer's own vertex buffer and skinning, fitted to the
 // camera's view up to a distance or to the whole scene where that is
 // smaller, on a world-fixed texel grid so it does not shimmer as the camera
 // moves. It needs no BVH, so every mode and device gets the same shadows.
@@ -50,6 +52,7 @@
 
 #include "glint/gbuffer_shared.h"
 
+#include <array>
 #include <cstdint>
 #include <memory>
 #include <optional>
@@ -160,7 +163,11 @@ struct GBufferStats {
     uint32_t normalMappedDraws = 0;  // this frame
     uint32_t texturedDraws = 0;   // this frame: draws sampling any material texture
     uint32_t maskedDraws = 0;     // this frame: alpha-tested draws (glTF alphaMode MASK)
+    uint32_t transparentDraws = 0;  // this frame: blended draws (glTF alphaMode BLEND; passes/transparent.h)
 };
+
+struct TransparentInputs;
+struct TransparentOutputs;
 
 // Owns the scene's GPU geometry (every mesh's LOD 0, uploaded once into one
 // vertex and one index buffer) and the per-frame host-visible buffers
@@ -177,12 +184,18 @@ public:
     GBufferRenderer& operator=(const GBufferRenderer&) = delete;
 
     const GBufferStats& stats() const { return stats_; }
+    // Some drawn geometry has a blended material (glTF alphaMode BLEND):
+    // the frame needs the transparent pass (passes/transparent.h).
+    bool hasBlendedGeometry() const { return hasBlended_; }
 
 private:
     friend GBufferOutputs addGBufferPass(rg::Graph&, GBufferRenderer&, const GBufferInputs&, const GBufferSettings&);
+    friend TransparentOutputs addTransparentPass(rg::Graph&, GBufferRenderer&, const TransparentInputs&);
     struct DrawRange;
     struct FrameSlot;
     struct FrameWork;
+    static constexpr size_t kMaterialTextureSlots = 4;  // normal, base colour, metal-rough, emissive
+    using MaterialTextures = std::array<std::pair<const gpu::Image*, const gpu::Sampler*>, kMaterialTextureSlots>;
 
     std::shared_ptr<FrameWork> prepare(const GBufferInputs& inputs, const GBufferSettings& settings);
     // Writes the frame's host buffers; the shadow map pass, the frame's
@@ -190,6 +203,20 @@ private:
     void upload(const FrameWork& work);
     void recordShadowMap(const FrameWork& work, rg::PassContext& pc, rg::Texture shadowMap);
     void record(const FrameWork& work, rg::PassContext& pc, const GBufferOutputs& targets, rg::Texture environment);
+    // passes/transparent.cpp: the blended surfaces of `work`, back to front,
+    // into `layer` over the G-buffer's depth.
+    void recordTransparent(const FrameWork& work, rg::PassContext& pc, rg::Texture layer, const GBufferOutputs& gbuf,
+                           rg::Texture environment);
+    // Per slot the 1x1 fallback (a flat normal, white) and the first sampler.
+    MaterialTextures fallbackTextures() const;
+    // Puts the range's own textures into the slots it samples (the others
+    // keep what `textures` holds); whether it samples any.
+    bool rangeTextures(const DrawRange& range, MaterialTextures& textures) const;
+    gpu::Pipeline createTransparentPipeline() const;  // passes/transparent.cpp
+    // The bindings of the pipelines that light (gbuffer_surface.glsl).
+    void pushSurfaceBindings(const gpu::Pipeline& pipeline, rg::PassContext& pc, const FrameSlot& slot,
+                             const gpu::Buffer& vertices, const MaterialTextures& textures, rg::Texture shadowMap,
+                             rg::Texture environment) const;
     void ensureCapacity(gpu::Buffer& buffer, VkDeviceSize bytes, const char* name);
     // Appends the morphed vertices of `inst` (its mesh's LOD 0 with its
     // morph weights applied on the CPU) to `out`; their first index, or -1
@@ -213,6 +240,10 @@ private:
     gpu::Pipeline skyPipeline_;
     gpu::Pipeline shadowPipeline_;
     gpu::Pipeline shadowMaskedPipeline_;   // the same test in the shadow map (shadow_masked.frag)
+    // glTF alphaMode BLEND, forward-lit and blended (transparent.frag);
+    // created with the first blended geometry.
+    gpu::Pipeline transparentPipeline_;
+    bool hasBlended_ = false;
     gpu::Sampler nearest_;  // completes the shadow map's descriptor; reads are texelFetch
     gpu::Sampler environmentSampler_;
     // Material textures: one image per scene texture and colour space some
@@ -230,6 +261,8 @@ private:
     // Per mesh with morph targets: its vertices as uploaded (else empty).
     std::vector<std::vector<shader::GBufferVertex>> morphBaseVertices_;
     std::vector<std::unique_ptr<FrameSlot>> slots_;
+    // The frame addGBufferPass declared last (the transparent pass draws it).
+    std::shared_ptr<FrameWork> current_;
     GBufferStats stats_;
 };
 

@@ -20,7 +20,7 @@ constexpr std::array<std::string_view, 3> kBackendNames = {"auto", "query", "pip
 
 // Debug views: name, what they show. Kept in one table so the list printed
 // by --help, the parser and the wiring agree.
-constexpr std::array<std::string_view, 23> kDebugViews = {
+constexpr std::array<std::string_view, 24> kDebugViews = {
     "final",              // the composited, tonemapped image
     "lit",                // G-buffer: lit colour of the opaque scene
     "ray_classes",        // ray generation: sky black, env grey, SSLR blue, hybrid purple, RT red
@@ -32,6 +32,7 @@ constexpr std::array<std::string_view, 23> kDebugViews = {
     "rt_radiance",        // RT: radiance along the traced rays
     "rt_hit_distance",    // RT: world distance, 0..100
     "particles",          // particles trace: particles seen in the reflections (premultiplied)
+    "transparent",        // transparent pass: blended surfaces (premultiplied; scenes with alphaMode BLEND)
     "shadow_map",         // G-buffer: the sun's shadow map (reversed depth)
     "lit_pyramid",        // SSLR: the cone trace's colour pyramid (level 0)
     "reflection_source",  // integrate: which trace each pixel used
@@ -297,13 +298,20 @@ ReflectionFrame ReflectionRenderer::addFrame(rg::Graph& graph, const scene::Came
     // 8. Composite and tonemap, or the debug view in its place. Without
     // SSLR particles the particles are drawn into the lit colour only now:
     // SSLR (and its cone pyramid) must not see them, or the trace and SSLR
-    // would both reflect them.
+    // would both reflect them. The blended surfaces' layer, when the scene
+    // has any, goes over everything.
+    const auto transparentLayer = [&] {
+        if (!gbuffer_.hasBlendedGeometry()) return rg::Texture{};
+        f.transparent = addTransparentPass(graph, gbuffer_, {f.gbuffer, f.environment}).layer;
+        return f.transparent;
+    };
     if (view.empty() || view == "final") {
         GBufferOutputs composited = f.gbuffer;
         if (!settings.sslrParticles) {
             composited.lit = addParticleForwardPass(graph, particles_, {f.gbuffer, scene_.particles, camera}).lit;
         }
-        f.output = addCompositePass(graph, composite_, {composited, f.temporal.resolved, camera}, settings.composite);
+        f.output = addCompositePass(graph, composite_, {composited, f.temporal.resolved, camera, transparentLayer()},
+                                    settings.composite);
         graph.markOutput(f.output.color);
         return f;
     }
@@ -364,6 +372,7 @@ ReflectionFrame ReflectionRenderer::addFrame(rg::Graph& graph, const scene::Came
     else if (view == "rt_radiance") show(f.rt ? f.rt->radiance : none, DebugViewKind::Color);
     else if (view == "rt_hit_distance") show(f.rt ? f.rt->hitDistance : none, DebugViewKind::Scalar, 0.0f, 100.0f);
     else if (view == "particles") show(f.particles ? f.particles->radiance : none, DebugViewKind::Color);
+    else if (view == "transparent") show(transparentLayer(), DebugViewKind::Color);
     else if (view == "shadow_map") show(f.gbuffer.shadowMap, DebugViewKind::Scalar);
     else if (view == "lit_pyramid") show(f.sslr ? f.sslr->litPyramid : none, DebugViewKind::Color);
     else if (view == "reflection_source") show(f.integrate.sourceDebug, DebugViewKind::Raw);

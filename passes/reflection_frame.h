@@ -6,7 +6,8 @@
 //
 //   BVH update (async compute) -> G-buffer -> feedback -> ray generation
 //   -> SSLR -> ray-traced hits -> particles trace -> integrate -> temporal
-//   -> particles forward -> composite
+//   -> particles forward -> transparent (scenes with blended materials)
+//   -> composite
 // (with ReflectionFrameSettings::sslrParticles the particles forward pass
 // comes right after the G-buffer, so that SSLR sees the particles)
 //
@@ -36,6 +37,7 @@
 #include "passes/rt_trace.h"
 #include "passes/sslr.h"
 #include "passes/temporal.h"
+#include "passes/transparent.h"
 #include "scene/bvh_planner.h"
 #include "scene/camera.h"
 #include "scene/scene.h"
@@ -115,6 +117,9 @@ struct ReflectionFrame {
     std::optional<ParticleTraceOutputs> particles;  // reflected particles (a BVH with particles)
     IntegrateOutputs integrate;
     TemporalOutputs temporal;
+    // The blended surfaces' layer (passes/transparent.h); invalid when the
+    // scene has none or a debug view other than "transparent" is shown.
+    rg::Texture transparent;
     CompositeOutputs output;  // RGBA8, sRGB-encoded: the image or the debug view
     // The prefiltered environment image (passes/environment.h); invalid for
     // the procedural sky.

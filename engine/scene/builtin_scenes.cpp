@@ -78,7 +78,7 @@ float hillHeight(float x, float z) {
 }
 
 struct PlazaMaterials {
-    uint32_t paving, asphalt, plaster, plasterBlue, tiles, glass, chrome, copper, redPlastic, wood, trunk, neon,
+    uint32_t paving, asphalt, plaster, plasterBlue, tiles, glass, shelterGlass, chrome, copper, redPlastic, wood, trunk, neon,
         carPaint, tyre, flag, cloth, hills, tower, mirrorTower, water, brass, lampGlow, skinTone;
 };
 
@@ -95,6 +95,13 @@ PlazaMaterials plazaMaterials(SceneBuilder& b) {
     m.tiles = b.material(makeMaterial("glazed tiles", {0.08f, 0.32f, 0.36f}, 0.0f, 0.12f));
     m.glass = b.material(makeMaterial("window glass", {0.02f, 0.025f, 0.03f}, 0.0f, 0.03f));
     m.chrome = b.material(makeMaterial("chrome", {0.95f, 0.93f, 0.88f}, 1.0f, 0.05f));
+    // Blended (glTF alphaMode BLEND, passes/transparent.h): a third of the
+    // light is stopped and tinted; seen from both sides.
+    Material shelterGlass = makeMaterial("shelter glass", {0.55f, 0.72f, 0.68f}, 0.0f, 0.05f);
+    shelterGlass.baseColorFactor.a = 0.35f;
+    shelterGlass.alphaMode = AlphaMode::Blend;
+    shelterGlass.doubleSided = true;
+    m.shelterGlass = b.material(shelterGlass);
     m.copper = b.material(makeMaterial("brushed copper", {0.95f, 0.64f, 0.54f}, 1.0f, 0.3f));
     m.redPlastic = b.material(makeMaterial("red plastic", {0.7f, 0.05f, 0.04f}, 0.0f, 0.35f));
     m.wood = b.material(makeMaterial("bench wood", {0.35f, 0.2f, 0.1f}, 0.0f, 0.7f));
@@ -230,6 +237,31 @@ Scene buildPlaza() {
     }
     const uint32_t fence = b.mesh("fence", {{makeFencePanel(7.0f, 1.4f, foliage.fence)}});
     b.place("fence", fence, {-15.0f, 0, -2.0f});
+
+    // A bus shelter with blended glass walls beside the entrance: seen
+    // directly, never in a reflection (passes/transparent.h).
+    {
+        const glm::vec3 size{3.2f, 2.3f, 1.4f};
+        const auto pane = [&](glm::vec2 extent, const glm::mat4& place) {
+            // The grid faces +Y; turned to face +Z, then placed.
+            return transformed(makeGrid(extent, {1, 1}, mat.shelterGlass),
+                               place * glm::mat4_cast(axisAngle({1, 0, 0}, glm::half_pi<float>())));
+        };
+        const glm::quat side = axisAngle({0, 1, 0}, glm::half_pi<float>());
+        std::vector<Geometry> shelter = {
+            transformed(makeBox({size.x + 0.2f, 0.08f, size.z + 0.2f}, mat.chrome), translation({0, size.y, 0})),
+            pane({size.x, size.y - 0.1f}, translation({0, size.y * 0.5f, -size.z * 0.5f})),
+            pane({size.z, size.y - 0.1f}, translation({-size.x * 0.5f, size.y * 0.5f, 0}) * glm::mat4_cast(side)),
+            pane({size.z, size.y - 0.1f}, translation({size.x * 0.5f, size.y * 0.5f, 0}) * glm::mat4_cast(side)),
+        };
+        for (const float x : {-0.5f, 0.5f}) {
+            for (const float z : {-0.5f, 0.5f}) {
+                shelter.push_back(transformed(makeCylinder(0.04f, size.y, 8, mat.chrome),
+                                              translation({x * size.x, 0, z * size.z})));
+            }
+        }
+        b.place("bus shelter", b.mesh("bus shelter", {shelter}), {1.5f, 0, 2.5f});
+    }
 
     // --- Far away: towers beyond the 100 m BVH radius (some enter it along
     // the camera path, some never do) and long-range hills.

@@ -197,8 +197,14 @@ BvhPlan BvhPlanner::plan(const Scene& scene, const glm::vec3& cameraPosition, ui
             return material < scene.materials.size() && scene.materials[material].doubleSided;
         };
         for (std::vector<uint32_t>& part : partitionGeometries(lod, settings_.maxGeometriesPerBlas)) {
-            // A geometry without triangles would be an empty BLAS geometry.
-            std::erase_if(part, [&](uint32_t g) { return lod.geometries[g].triangleCount() == 0; });
+            // A geometry without triangles would be an empty BLAS geometry;
+            // blended ones (glTF alphaMode BLEND) are drawn over the frame
+            // by the transparent pass and neither reflected nor shadowing
+            // (passes/transparent.h).
+            std::erase_if(part, [&](uint32_t g) {
+                const Geometry& geometry = lod.geometries[g];
+                return geometry.triangleCount() == 0 || blended(scene, geometry);
+            });
             std::vector<uint32_t> twoSided;
             std::copy_if(part.begin(), part.end(), std::back_inserter(twoSided), doubleSided);
             std::erase_if(part, doubleSided);

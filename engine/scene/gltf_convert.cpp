@@ -623,7 +623,6 @@ private:
                 m.alphaMode = AlphaMode::Mask;
             } else if (src.alphaMode == "BLEND") {
                 m.alphaMode = AlphaMode::Blend;
-                warn(where, "alphaMode BLEND is not rendered as blended yet: drawn and traced opaque");
             } else {
                 fail(where, "alphaMode '" + src.alphaMode + "'");
             }

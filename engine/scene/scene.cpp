@@ -226,6 +226,11 @@ uint64_t instancedTriangleCount(const Scene& scene) {
     return n;
 }
 
+bool blended(const Scene& scene, const Geometry& geometry) {
+    return geometry.material < scene.materials.size() &&
+           scene.materials[geometry.material].alphaMode == AlphaMode::Blend;
+}
+
 Aabb instanceBounds(const Scene& scene, const Instance& instance) {
     const Mesh& mesh = scene.meshes[instance.mesh];
     if (instance.motion != Motion::Skinned || instance.skin == kNone) {

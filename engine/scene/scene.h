@@ -374,6 +374,10 @@ uint64_t meshTriangleCount(const Scene& scene);
 // Triangles drawn: LOD 0 of every instance.
 uint64_t instancedTriangleCount(const Scene& scene);
 
+// The geometry's material blends (glTF alphaMode BLEND): the transparent
+// pass draws it; the G-buffer, the shadow map and the BVH leave it out.
+bool blended(const Scene& scene, const Geometry& geometry);
+
 // World bounds of an instance this frame. For a skinned instance the bounds
 // cover every joint's transform of the bind-pose bounds, which contains the
 // skinned vertices (each is a convex combination of joint transforms).

@@ -1,6 +1,7 @@
 #version 460
 // Composite (passes/composite.h): the lit colour plus the resolved
-// reflections weighted by the split-sum environment BRDF of GGX, exposed,
+// reflections weighted by the split-sum environment BRDF of GGX, under the
+// blended surfaces' premultiplied layer when there is one, exposed,
 // tonemapped and sRGB-encoded into an RGBA8 image.
 #extension GL_GOOGLE_include_directive : require
 #extension GL_EXT_scalar_block_layout : require
@@ -19,26 +20,15 @@ layout(set = 0, binding = 2) uniform sampler2D normalTexture;
 layout(set = 0, binding = 3) uniform sampler2D roughnessMetalTexture;
 layout(set = 0, binding = 4) uniform sampler2D depthTexture;
 layout(set = 0, binding = 5) uniform sampler2D reflectionTexture;
-layout(set = 0, binding = 6, rgba8) uniform writeonly image2D outputImage;
+// Premultiplied blended surfaces (passes/transparent.h), a = coverage.
+layout(set = 0, binding = 6) uniform sampler2D transparencyTexture;
+layout(set = 0, binding = 7, rgba8) uniform writeonly image2D outputImage;
 
 layout(push_constant, scalar) uniform Constants { CompositeConstants pc; };
 
 // On the bits (an all-ones exponent), not isnan/isinf, which a compiler
 // assuming no NaN may fold away.
 bool isFinite(vec3 v) { return all(notEqual(floatBitsToUint(v) & 0x7F800000u, uvec3(0x7F800000u))); }
-
-// Karis, "Physically Based Shading on Mobile" (Unreal Engine blog, 2014):
-// an analytic fit of the split-sum environment BRDF of GGX (the scale and
-// bias that multiply F0 after integrating the BRDF over the lobe), by
-// perceptual roughness and N.V.
-vec3 envBrdfApprox(vec3 f0, float roughness, float NoV) {
-    const vec4 c0 = vec4(-1.0, -0.0275, -0.572, 0.022);
-    const vec4 c1 = vec4(1.0, 0.0425, 1.04, -0.04);
-    const vec4 r = roughness * c0 + c1;
-    const float a004 = min(r.x * r.x, exp2(-9.28 * NoV)) * r.x + r.y;
-    const vec2 ab = vec2(-1.04, 1.04) * a004 + r.zw;
-    return f0 * ab.x + ab.y;
-}
 
 void main() {
     const ivec2 p = ivec2(gl_GlobalInvocationID.xy);
@@ -67,6 +57,12 @@ void main() {
             s.reflectance = rm.b;
             const float NoV = clamp(dot(s.normal, toViewer), 0.0, 1.0);
             color += max(reflection.rgb, vec3(0.0)) * envBrdfApprox(surfaceF0(s), s.roughness, NoV);
+        }
+    }
+    if (pc.hasTransparency != 0u) {
+        const vec4 layer = texelFetch(transparencyTexture, p, 0);
+        if (isFinite(layer.rgb) && isFinite(vec3(layer.a))) {
+            color = max(layer.rgb, vec3(0.0)) + (1.0 - clamp(layer.a, 0.0, 1.0)) * color;
         }
     }
     imageStore(outputImage, p, encodeSrgb(tonemap(color * pc.exposure, pc.tonemap)));

@@ -1,11 +1,13 @@
 // G-buffer surface: writes the attributes and lights the surface with the
 // unified lighting (glint/brdf.glsl), the sun shadowed by the shadow map
 // (shadow.glsl) as the ray-traced hits are by their shadow rays. Compiled
-// twice: gbuffer.frag (opaque and blended materials) and
-// gbuffer_masked.frag (alpha-tested ones, GLINT_ALPHA_TEST 1), so that
-// only the draws that discard lose early depth testing.
-#ifndef GLINT_ALPHA_TEST
-#error "define GLINT_ALPHA_TEST (0 or 1) before including gbuffer_surface.glsl"
+// three times: gbuffer.frag (opaque materials) and gbuffer_masked.frag
+// (alpha-tested ones, GLINT_ALPHA_TEST 1), so that only the draws that
+// discard lose early depth testing, and transparent.frag (blended ones,
+// GLINT_BLEND 1: no attributes, one premultiplied colour the transparent
+// pass blends over what lies behind; passes/transparent.h).
+#if !defined(GLINT_ALPHA_TEST) || !defined(GLINT_BLEND)
+#error "define GLINT_ALPHA_TEST and GLINT_BLEND (0 or 1) before including gbuffer_surface.glsl"
 #endif
 
 #include "gbuffer_common.glsl"
@@ -30,11 +32,16 @@ layout(set = 0, binding = 8) uniform sampler2D baseColorMap;  // sRGB image: tex
 layout(set = 0, binding = 9) uniform sampler2D metalRoughMap; // linear; G = roughness, B = metallic
 layout(set = 0, binding = 10) uniform sampler2D emissiveMap;  // sRGB image: texels decode to linear
 
+#if GLINT_BLEND
+// Premultiplied: rgb = radiance x coverage, a = coverage.
+layout(location = 0) out vec4 outColor;
+#else
 layout(location = 0) out vec4 outNormal;
 layout(location = 1) out vec4 outAlbedo;
 layout(location = 2) out vec4 outRoughnessMetal;
 layout(location = 3) out vec2 outMotion;
 layout(location = 4) out vec4 outLit;
+#endif
 
 // A texture reference's coordinates: its set (the draw's flag: glTF
 // texCoord plus one), then its KHR_texture_transform.
@@ -73,13 +80,17 @@ vec3 normalMapped(vec3 n, bool backFace) {
 }
 
 void main() {
-#if GLINT_ALPHA_TEST
-    // glTF alphaMode MASK: the coverage (vertex alpha times the base colour
-    // texel's) against the cutoff; what falls below leaves no surface.
+#if GLINT_ALPHA_TEST || GLINT_BLEND
+    // The coverage: vertex alpha (factor times COLOR_0) times the base
+    // colour texel's.
     float alpha = inAlbedo.a;
     if (draw.baseColorMap != 0u) {
         alpha *= texture(baseColorMap, textureUv(draw.baseColorMap, draw.baseColorUvTransform)).a;
     }
+#endif
+#if GLINT_ALPHA_TEST
+    // glTF alphaMode MASK: the coverage against the cutoff; what falls
+    // below leaves no surface.
     if (alpha < draw.alphaCutoff) {
         discard;
     }
@@ -116,12 +127,14 @@ void main() {
     // away from it: the surface itself shadows it.
     const bool selfShadowed = draw.normalMap != 0u && dot(geometricNormal, frame.lighting.sunDirection.xyz) <= 0.0;
     const float sunVisibility = selfShadowed ? 0.0 : sunShadowVisibility(inWorldPosition, geometricNormal);
+#if !GLINT_BLEND
     outNormal = vec4(n, 1.0);
     outAlbedo = vec4(s.albedo, 1.0);
     outRoughnessMetal = vec4(s.roughness, s.metallic, s.reflectance, 1.0);
     // A vertex behind last frame's camera has w <= 0: no motion is better
     // than a wild one.
     outMotion = inPreviousClip.w > 0.0 ? pixelOf(inPreviousClip) - pixelOf(inClip) : vec2(0.0);
+#endif
     // Emission: glTF factor x strength (in the vertex) x the sRGB texel, in
     // lit units through the emissive scale; neither lit nor shadowed.
     vec3 emission = inEmissive;
@@ -129,5 +142,18 @@ void main() {
         emission *= texture(emissiveMap, textureUv(draw.emissiveMap, draw.emissiveUvTransform)).rgb;
     }
     emission *= frame.lighting.sunDirection.w;
+#if GLINT_BLEND
+    // glTF alphaMode BLEND, as the Khronos sample viewer blends it: the
+    // whole radiance (sun, diffuse sky, emission and the specular sky light
+    // an opaque surface gets from the reflection passes, here from the
+    // environment alone) times the coverage, over what lies behind.
+    const float NoV = clamp(dot(n, toViewer), 0.0, 1.0);
+    const vec3 specularSky = environmentRadiance(frame.lighting, reflect(-toViewer, n), s.roughness) *
+                             envBrdfApprox(surfaceF0(s), s.roughness, NoV);
+    const vec3 radiance = shadeSurface(frame.lighting, s, toViewer, sunVisibility) + specularSky + emission;
+    const float coverage = clamp(alpha, 0.0, 1.0);
+    outColor = vec4(radiance * coverage, coverage);
+#else
     outLit = vec4(shadeSurface(frame.lighting, s, toViewer, sunVisibility) + emission, 1.0);
+#endif
 }

@@ -156,7 +156,7 @@ TEST_CASE("2,400 frames with mode switches, resizes and history resets hold memo
         const gpu::MemoryStats memory = ctx.memory().stats();
         samples[segment] = {heapBytesInUse(), residentBytes(), memory.blockBytes, memory.usedBytes, executor.stats().commandBuffers,
                             ctx.deviceMemoryInUse().value_or(0)};
-        spdlog::info("soak segment {}: heap {:.2f} MB, rss {:.1f} MB, device {:.1f} MB in blocks ({:.1f} used), driver {:.1f} MB, "
+        spdlog::info("soak segment {}: heap {:.2f} MB, rss {:.1f} MB, device {:.1f} MB in blocks ({:.4f} used), driver {:.1f} MB, "
                      "{} command buffers",
                      segment, double(samples[segment].heap) * 1e-6, double(samples[segment].rss) * 1e-6, double(memory.blockBytes) * 1e-6,
                      double(memory.usedBytes) * 1e-6, double(samples[segment].driverBytes) * 1e-6,
@@ -190,12 +190,15 @@ TEST_CASE("2,400 frames with mode switches, resizes and history resets hold memo
     CHECK(heapGrowth <= 0.01 * warmRss);
     if (!kSanitized) CHECK(rssGrowth <= 0.02);
     if (!cpuDevice) CHECK(floorOver(lastCycle, &Sample::driverBytes) <= floorOver(warmCycle, &Sample::driverBytes) * 1.01);
+    // What our allocator hands out depends on the segment's mode, size and
+    // stretch of the camera path (the BVH's residents, the transient
+    // heaps): each segment against the same combination one cycle before.
     const Sample& warm = samples[kWarmUpSegments - 1];
     for (uint32_t segment = kWarmUpSegments; segment < kSegments; ++segment) {
         const Sample& s = samples[segment];
         CAPTURE(segment);
         CHECK(s.deviceBlockBytes <= warm.deviceBlockBytes);
-        CHECK(s.deviceUsedBytes <= warm.deviceUsedBytes);
+        CHECK(s.deviceUsedBytes <= samples[segment - kCycleSegments].deviceUsedBytes);
         CHECK(s.commandBuffers == warm.commandBuffers);
     }
 }

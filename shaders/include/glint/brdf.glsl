@@ -52,6 +52,21 @@ vec3 diffuseColor(Surface s) {
     return s.albedo * (1.0 - s.metallic);
 }
 
+// The specular sky light the reflection passes add (composite) and the
+// transparent surfaces add themselves (gbuffer_surface.glsl) is weighted
+// by this. Karis, "Physically Based Shading on Mobile" (Unreal Engine blog, 2014):
+// an analytic fit of the split-sum environment BRDF of GGX (the scale and
+// bias that multiply F0 after integrating the BRDF over the lobe), by
+// perceptual roughness and N.V.
+vec3 envBrdfApprox(vec3 f0, float roughness, float NoV) {
+    const vec4 c0 = vec4(-1.0, -0.0275, -0.572, 0.022);
+    const vec4 c1 = vec4(1.0, 0.0425, 1.04, -0.04);
+    const vec4 r = roughness * c0 + c1;
+    const float a004 = min(r.x * r.x, exp2(-9.28 * NoV)) * r.x + r.y;
+    const vec2 ab = vec2(-1.04, 1.04) * a004 + r.zw;
+    return f0 * ab.x + ab.y;
+}
+
 #ifdef GLINT_ENVIRONMENT_BINDING
 // The environment's lookups (the sky, its irradiance, the prefiltered
 // image): shaders that light surfaces bind it.

@@ -30,8 +30,8 @@ struct CompositeConstants {
     uvec2 size;
     float exposure;
     uint tonemap;
-    uint hasReflections;  // 0: the lit colour alone
-    uint pad0;
+    uint hasReflections;   // 0: the lit colour alone
+    uint hasTransparency;  // 0: no transparent layer
     uint pad1;
     uint pad2;
 };

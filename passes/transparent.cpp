@@ -1,0 +1,183 @@
+#include "passes/transparent.h"
+
+#include "gpu/commands.h"
+#include "gpu/descriptors.h"
+#include "gpu/error.h"
+#include "graph/executor.h"
+#include "passes/gbuffer_internal.h"
+
+#include <algorithm>
+#include <string>
+#include <vector>
+
+namespace glint::passes {
+
+using namespace gbuffer_detail;
+
+gpu::Pipeline GBufferRenderer::createTransparentPipeline() const {
+    gpu::GraphicsPipelineDesc desc;
+    desc.vertexShader = "gbuffer/gbuffer.vert";
+    desc.fragmentShader = "gbuffer/transparent.frag";
+    desc.bindings = surfaceBindings();
+    desc.pushConstantBytes = sizeof(shader::GBufferDraw);
+    desc.dynamicCulling = true;  // per draw, as the G-buffer culls
+    desc.colorFormats = {kTransparentFormat};
+    desc.depthFormat = kGBufferDepthFormat;
+    desc.depthWrite = false;
+    // Premultiplied "over" for colour and coverage alike: the shader writes
+    // (radiance x a, a).
+    VkPipelineColorBlendAttachmentState over{};
+    over.blendEnable = VK_TRUE;
+    over.srcColorBlendFactor = VK_BLEND_FACTOR_ONE;
+    over.dstColorBlendFactor = VK_BLEND_FACTOR_ONE_MINUS_SRC_ALPHA;
+    over.colorBlendOp = VK_BLEND_OP_ADD;
+    over.srcAlphaBlendFactor = VK_BLEND_FACTOR_ONE;
+    over.dstAlphaBlendFactor = VK_BLEND_FACTOR_ONE_MINUS_SRC_ALPHA;
+    over.alphaBlendOp = VK_BLEND_OP_ADD;
+    over.colorWriteMask =
+        VK_COLOR_COMPONENT_R_BIT | VK_COLOR_COMPONENT_G_BIT | VK_COLOR_COMPONENT_B_BIT | VK_COLOR_COMPONENT_A_BIT;
+    desc.colorBlends = {over};
+    desc.name = "gbuffer.transparent";
+    return gpu::createGraphicsPipeline(ctx_, desc);
+}
+
+void GBufferRenderer::recordTransparent(const FrameWork& work, rg::PassContext& pc, rg::Texture layer,
+                                        const GBufferOutputs& gbuf, rg::Texture environment) {
+    const VkCommandBuffer cmd = pc.cmd();
+    const FrameSlot& slot = *slots_[work.slot];
+
+    VkRenderingAttachmentInfo color{VK_STRUCTURE_TYPE_RENDERING_ATTACHMENT_INFO};
+    color.imageView = pc.view(layer);
+    color.imageLayout = pc.layout(layer);
+    color.loadOp = VK_ATTACHMENT_LOAD_OP_CLEAR;
+    color.storeOp = VK_ATTACHMENT_STORE_OP_STORE;
+    color.clearValue.color = {{0.0f, 0.0f, 0.0f, 0.0f}};
+    VkRenderingAttachmentInfo depth{VK_STRUCTURE_TYPE_RENDERING_ATTACHMENT_INFO};
+    depth.imageView = pc.view(gbuf.depth);
+    depth.imageLayout = pc.layout(gbuf.depth);
+    depth.loadOp = VK_ATTACHMENT_LOAD_OP_LOAD;
+    depth.storeOp = VK_ATTACHMENT_STORE_OP_NONE;
+    VkRenderingInfo rendering{VK_STRUCTURE_TYPE_RENDERING_INFO};
+    rendering.renderArea = {{0, 0}, {gbuf.width, gbuf.height}};
+    rendering.layerCount = 1;
+    rendering.colorAttachmentCount = 1;
+    rendering.pColorAttachments = &color;
+    rendering.pDepthAttachment = &depth;
+    vkCmdBeginRendering(cmd, &rendering);
+
+    // Every blended geometry of every instance the G-buffer drew, farthest
+    // first: the distance from the camera to the geometry's bounds centre.
+    struct Draw {
+        float distanceSq = 0.0f;
+        uint32_t instance = 0;
+        const DrawRange* range = nullptr;
+    };
+    std::vector<Draw> draws;
+    const glm::vec3 camera(work.frame.cameraPosition);
+    for (size_t i = 0; i < work.instances.size(); ++i) {
+        if (!work.visible[i]) continue;
+        for (const DrawRange& range : meshDraws_.at(work.meshes[i])) {
+            if (range.coverage != Coverage::Blended || range.indexCount == 0) continue;
+            const glm::vec3 centre(work.instances[i].transform * glm::vec4(range.bounds.center(), 1.0f));
+            const glm::vec3 d = centre - camera;
+            draws.push_back({glm::dot(d, d), uint32_t(i), &range});
+        }
+    }
+    // Stable: equal distances keep scene order, so the image is the same
+    // every frame and on every device.
+    std::stable_sort(draws.begin(), draws.end(),
+                     [](const Draw& a, const Draw& b) { return a.distanceSq > b.distanceSq; });
+
+    stats_.transparentDraws = 0;
+    if (!draws.empty()) {
+        const VkViewport viewport{0.0f, 0.0f, float(gbuf.width), float(gbuf.height), 0.0f, 1.0f};
+        const VkRect2D scissor{{0, 0}, {gbuf.width, gbuf.height}};
+        vkCmdSetViewport(cmd, 0, 1, &viewport);
+        vkCmdSetScissor(cmd, 0, 1, &scissor);
+        vkCmdBindIndexBuffer(cmd, indices_.handle(), 0, VK_INDEX_TYPE_UINT32);
+        const gpu::Pipeline& pipeline = transparentPipeline_;
+        pipeline.bind(cmd);
+        VkCullModeFlags cullMode = VK_CULL_MODE_NONE;
+        VkFrontFace frontFace = VK_FRONT_FACE_COUNTER_CLOCKWISE;
+        vkCmdSetCullMode(cmd, cullMode);
+        vkCmdSetFrontFace(cmd, frontFace);
+        const gpu::Buffer* boundVertices = &vertices_;
+        MaterialTextures boundTextures = fallbackTextures();
+        pushSurfaceBindings(pipeline, pc, slot, *boundVertices, boundTextures, gbuf.shadowMap, environment);
+        for (const Draw& d : draws) {
+            const DrawRange& range = *d.range;
+            const auto [vertices, vertexShift] = vertexSource(work, d.instance, slot);
+            const VkFrontFace instanceFront =
+                work.mirrored[d.instance] ? VK_FRONT_FACE_CLOCKWISE : VK_FRONT_FACE_COUNTER_CLOCKWISE;
+            if (instanceFront != frontFace) {
+                frontFace = instanceFront;
+                vkCmdSetFrontFace(cmd, frontFace);
+            }
+            const VkCullModeFlags rangeCull = range.doubleSided ? VK_CULL_MODE_NONE : VK_CULL_MODE_BACK_BIT;
+            if (rangeCull != cullMode) {
+                cullMode = rangeCull;
+                vkCmdSetCullMode(cmd, cullMode);
+            }
+            MaterialTextures textures = boundTextures;
+            rangeTextures(range, textures);
+            if (vertices != boundVertices || textures != boundTextures) {
+                boundVertices = vertices;
+                boundTextures = textures;
+                pushSurfaceBindings(pipeline, pc, slot, *boundVertices, boundTextures, gbuf.shadowMap, environment);
+            }
+            shader::GBufferDraw draw = range.material;
+            draw.instance = d.instance;
+            draw.doubleSided = range.doubleSided ? 1u : 0u;
+            pipeline.pushConstants(cmd, draw);
+            vkCmdDrawIndexed(cmd, range.indexCount, 1, range.firstIndex, range.vertexOffset + vertexShift, 0);
+            ++stats_.transparentDraws;
+        }
+    }
+    vkCmdEndRendering(cmd);
+}
+
+TransparentOutputs addTransparentPass(rg::Graph& graph, GBufferRenderer& renderer, const TransparentInputs& inputs) {
+    const std::shared_ptr<GBufferRenderer::FrameWork> work = renderer.current_;
+    const GBufferOutputs& gbuf = inputs.gbuffer;
+    if (!work) {
+        throw gpu::GpuError("transparent pass: the G-buffer renderer has declared no frame (call addGBufferPass first)");
+    }
+    if (glm::vec2(float(gbuf.width), float(gbuf.height)) != work->frame.size) {
+        throw gpu::GpuError("transparent pass: the G-buffer given is " + std::to_string(gbuf.width) + "x" +
+                            std::to_string(gbuf.height) + ", the renderer's last frame " +
+                            std::to_string(uint32_t(work->frame.size.x)) + "x" +
+                            std::to_string(uint32_t(work->frame.size.y)));
+    }
+    if (work->frame.lighting.environment.x != 0.0f && !inputs.environment.valid()) {
+        throw gpu::GpuError("transparent pass: the lighting looks up an environment image but no environment texture "
+                            "was given (the one addGBufferPass read)");
+    }
+    struct Data {
+        TransparentOutputs out;
+        GBufferOutputs gbuffer;
+        rg::Texture environment;
+    };
+    const Data& data = graph.addPass<Data>(
+        "transparent", rg::Queue::Graphics,
+        [&](rg::Builder& b, Data& d) {
+            b.setPipeline(rg::Pipeline::Raster);
+            d.out.width = gbuf.width;
+            d.out.height = gbuf.height;
+            d.out.layer = b.write(b.createTexture("transparent.layer", {.width = gbuf.width,
+                                                                         .height = gbuf.height,
+                                                                         .format = kTransparentFormat}),
+                                  rg::Access::ColorAttachment);
+            d.gbuffer = gbuf;
+            d.gbuffer.depth = b.read(gbuf.depth, rg::Access::DepthRead);
+            d.gbuffer.shadowMap = b.read(gbuf.shadowMap, rg::Access::SampledRead);
+            if (inputs.environment.valid()) {
+                d.environment = b.read(inputs.environment, rg::Access::SampledRead);
+            }
+        },
+        [&renderer, work](const Data& d, rg::PassContext& pc) {
+            renderer.recordTransparent(*work, pc, d.out.layer, d.gbuffer, d.environment);
+        });
+    return data.out;
+}
+
+} // namespace glint::passes
