@@ -46,6 +46,7 @@
 #include "gpu/pipeline.h"
 #include "gpu/resources.h"
 #include "graph/graph.h"
+#include "passes/image_clear.h"
 #include "passes/lighting.h"
 #include "scene/camera.h"
 #include "scene/scene.h"
@@ -184,9 +185,6 @@ public:
     GBufferRenderer& operator=(const GBufferRenderer&) = delete;
 
     const GBufferStats& stats() const { return stats_; }
-    // Some drawn geometry has a blended material (glTF alphaMode BLEND):
-    // the frame needs the transparent pass (passes/transparent.h).
-    bool hasBlendedGeometry() const { return hasBlended_; }
 
 private:
     friend GBufferOutputs addGBufferPass(rg::Graph&, GBufferRenderer&, const GBufferInputs&, const GBufferSettings&);
@@ -194,6 +192,7 @@ private:
     struct DrawRange;
     struct FrameSlot;
     struct FrameWork;
+    struct TransparentDraw;
     static constexpr size_t kMaterialTextureSlots = 4;  // normal, base colour, metal-rough, emissive
     using MaterialTextures = std::array<std::pair<const gpu::Image*, const gpu::Sampler*>, kMaterialTextureSlots>;
 
@@ -203,10 +202,12 @@ private:
     void upload(const FrameWork& work);
     void recordShadowMap(const FrameWork& work, rg::PassContext& pc, rg::Texture shadowMap);
     void record(const FrameWork& work, rg::PassContext& pc, const GBufferOutputs& targets, rg::Texture environment);
-    // passes/transparent.cpp: the blended surfaces of `work`, back to front,
-    // into `layer` over the G-buffer's depth.
-    void recordTransparent(const FrameWork& work, rg::PassContext& pc, rg::Texture layer, const GBufferOutputs& gbuf,
-                           rg::Texture environment);
+    // passes/transparent.cpp: the blended geometries of the instances `work`
+    // draws, farthest first; then their draws into `layer` (cleared) over
+    // the G-buffer's depth.
+    std::vector<TransparentDraw> transparentDraws(const FrameWork& work) const;
+    void recordTransparent(const FrameWork& work, const std::vector<TransparentDraw>& draws, rg::PassContext& pc,
+                           rg::Texture layer, const GBufferOutputs& gbuf, rg::Texture environment);
     // Per slot the 1x1 fallback (a flat normal, white) and the first sampler.
     MaterialTextures fallbackTextures() const;
     // Puts the range's own textures into the slots it samples (the others
@@ -243,6 +244,9 @@ private:
     // glTF alphaMode BLEND, forward-lit and blended (transparent.frag);
     // created with the first blended geometry.
     gpu::Pipeline transparentPipeline_;
+    // Clears the transparent layer (passes/image_clear.h says why not a
+    // load-op clear); made by the first addTransparentPass that draws.
+    std::unique_ptr<ImageClearer> transparentClearer_;
     bool hasBlended_ = false;
     gpu::Sampler nearest_;  // completes the shadow map's descriptor; reads are texelFetch
     gpu::Sampler environmentSampler_;

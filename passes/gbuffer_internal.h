@@ -85,6 +85,15 @@ struct GBufferRenderer::DrawRange {
     static_assert(gbuffer_detail::kMaterialSlots == kMaterialTextureSlots);
 };
 
+// A blended geometry of one instance, with its distance from the camera
+// (to its bounds centre, squared): the transparent pass draws them farthest
+// first.
+struct GBufferRenderer::TransparentDraw {
+    float distanceSq = 0.0f;
+    uint32_t instance = 0;
+    const DrawRange* range = nullptr;
+};
+
 // Host-visible buffers of one frame in flight, written when the frame
 // records (the executor has waited for the slot's previous frame by then).
 struct GBufferRenderer::FrameSlot {

@@ -300,9 +300,8 @@ ReflectionFrame ReflectionRenderer::addFrame(rg::Graph& graph, const scene::Came
     // SSLR (and its cone pyramid) must not see them, or the trace and SSLR
     // would both reflect them. The blended surfaces' layer, when the scene
     // has any, goes over everything.
-    const auto transparentLayer = [&] {
-        if (!gbuffer_.hasBlendedGeometry()) return rg::Texture{};
-        f.transparent = addTransparentPass(graph, gbuffer_, {f.gbuffer, f.environment}).layer;
+    const auto transparentLayer = [&](bool declareEmpty) {
+        f.transparent = addTransparentPass(graph, gbuffer_, {f.gbuffer, f.environment, declareEmpty}).layer;
         return f.transparent;
     };
     if (view.empty() || view == "final") {
@@ -310,7 +309,7 @@ ReflectionFrame ReflectionRenderer::addFrame(rg::Graph& graph, const scene::Came
         if (!settings.sslrParticles) {
             composited.lit = addParticleForwardPass(graph, particles_, {f.gbuffer, scene_.particles, camera}).lit;
         }
-        f.output = addCompositePass(graph, composite_, {composited, f.temporal.resolved, camera, transparentLayer()},
+        f.output = addCompositePass(graph, composite_, {composited, f.temporal.resolved, camera, transparentLayer(false)},
                                     settings.composite);
         graph.markOutput(f.output.color);
         return f;
@@ -372,7 +371,7 @@ ReflectionFrame ReflectionRenderer::addFrame(rg::Graph& graph, const scene::Came
     else if (view == "rt_radiance") show(f.rt ? f.rt->radiance : none, DebugViewKind::Color);
     else if (view == "rt_hit_distance") show(f.rt ? f.rt->hitDistance : none, DebugViewKind::Scalar, 0.0f, 100.0f);
     else if (view == "particles") show(f.particles ? f.particles->radiance : none, DebugViewKind::Color);
-    else if (view == "transparent") show(transparentLayer(), DebugViewKind::Color);
+    else if (view == "transparent") show(transparentLayer(true), DebugViewKind::Color);
     else if (view == "shadow_map") show(f.gbuffer.shadowMap, DebugViewKind::Scalar);
     else if (view == "lit_pyramid") show(f.sslr ? f.sslr->litPyramid : none, DebugViewKind::Color);
     else if (view == "reflection_source") show(f.integrate.sourceDebug, DebugViewKind::Raw);

@@ -6,7 +6,7 @@
 //
 //   BVH update (async compute) -> G-buffer -> feedback -> ray generation
 //   -> SSLR -> ray-traced hits -> particles trace -> integrate -> temporal
-//   -> particles forward -> transparent (scenes with blended materials)
+//   -> particles forward -> transparent (when blended surfaces are in view)
 //   -> composite
 // (with ReflectionFrameSettings::sslrParticles the particles forward pass
 // comes right after the G-buffer, so that SSLR sees the particles)
@@ -117,8 +117,8 @@ struct ReflectionFrame {
     std::optional<ParticleTraceOutputs> particles;  // reflected particles (a BVH with particles)
     IntegrateOutputs integrate;
     TemporalOutputs temporal;
-    // The blended surfaces' layer (passes/transparent.h); invalid when the
-    // scene has none or a debug view other than "transparent" is shown.
+    // The blended surfaces' layer (passes/transparent.h); invalid when none
+    // is in view or a debug view other than "transparent" is shown.
     rg::Texture transparent;
     CompositeOutputs output;  // RGBA8, sRGB-encoded: the image or the debug view
     // The prefiltered environment image (passes/environment.h); invalid for

@@ -41,38 +41,9 @@ gpu::Pipeline GBufferRenderer::createTransparentPipeline() const {
     return gpu::createGraphicsPipeline(ctx_, desc);
 }
 
-void GBufferRenderer::recordTransparent(const FrameWork& work, rg::PassContext& pc, rg::Texture layer,
-                                        const GBufferOutputs& gbuf, rg::Texture environment) {
-    const VkCommandBuffer cmd = pc.cmd();
-    const FrameSlot& slot = *slots_[work.slot];
-
-    VkRenderingAttachmentInfo color{VK_STRUCTURE_TYPE_RENDERING_ATTACHMENT_INFO};
-    color.imageView = pc.view(layer);
-    color.imageLayout = pc.layout(layer);
-    color.loadOp = VK_ATTACHMENT_LOAD_OP_CLEAR;
-    color.storeOp = VK_ATTACHMENT_STORE_OP_STORE;
-    color.clearValue.color = {{0.0f, 0.0f, 0.0f, 0.0f}};
-    VkRenderingAttachmentInfo depth{VK_STRUCTURE_TYPE_RENDERING_ATTACHMENT_INFO};
-    depth.imageView = pc.view(gbuf.depth);
-    depth.imageLayout = pc.layout(gbuf.depth);
-    depth.loadOp = VK_ATTACHMENT_LOAD_OP_LOAD;
-    depth.storeOp = VK_ATTACHMENT_STORE_OP_NONE;
-    VkRenderingInfo rendering{VK_STRUCTURE_TYPE_RENDERING_INFO};
-    rendering.renderArea = {{0, 0}, {gbuf.width, gbuf.height}};
-    rendering.layerCount = 1;
-    rendering.colorAttachmentCount = 1;
-    rendering.pColorAttachments = &color;
-    rendering.pDepthAttachment = &depth;
-    vkCmdBeginRendering(cmd, &rendering);
-
-    // Every blended geometry of every instance the G-buffer drew, farthest
-    // first: the distance from the camera to the geometry's bounds centre.
-    struct Draw {
-        float distanceSq = 0.0f;
-        uint32_t instance = 0;
-        const DrawRange* range = nullptr;
-    };
-    std::vector<Draw> draws;
+std::vector<GBufferRenderer::TransparentDraw> GBufferRenderer::transparentDraws(const FrameWork& work) const {
+    std::vector<TransparentDraw> draws;
+    if (!hasBlended_) return draws;
     const glm::vec3 camera(work.frame.cameraPosition);
     for (size_t i = 0; i < work.instances.size(); ++i) {
         if (!work.visible[i]) continue;
@@ -86,9 +57,35 @@ void GBufferRenderer::recordTransparent(const FrameWork& work, rg::PassContext& 
     // Stable: equal distances keep scene order, so the image is the same
     // every frame and on every device.
     std::stable_sort(draws.begin(), draws.end(),
-                     [](const Draw& a, const Draw& b) { return a.distanceSq > b.distanceSq; });
+                     [](const TransparentDraw& a, const TransparentDraw& b) { return a.distanceSq > b.distanceSq; });
+    return draws;
+}
 
-    stats_.transparentDraws = 0;
+void GBufferRenderer::recordTransparent(const FrameWork& work, const std::vector<TransparentDraw>& draws,
+                                        rg::PassContext& pc, rg::Texture layer, const GBufferOutputs& gbuf,
+                                        rg::Texture environment) {
+    const VkCommandBuffer cmd = pc.cmd();
+    const FrameSlot& slot = *slots_[work.slot];
+
+    // The layer was cleared by the pass before (a compute clear).
+    VkRenderingAttachmentInfo color{VK_STRUCTURE_TYPE_RENDERING_ATTACHMENT_INFO};
+    color.imageView = pc.view(layer);
+    color.imageLayout = pc.layout(layer);
+    color.loadOp = VK_ATTACHMENT_LOAD_OP_LOAD;
+    color.storeOp = VK_ATTACHMENT_STORE_OP_STORE;
+    VkRenderingAttachmentInfo depth{VK_STRUCTURE_TYPE_RENDERING_ATTACHMENT_INFO};
+    depth.imageView = pc.view(gbuf.depth);
+    depth.imageLayout = pc.layout(gbuf.depth);
+    depth.loadOp = VK_ATTACHMENT_LOAD_OP_LOAD;
+    depth.storeOp = VK_ATTACHMENT_STORE_OP_NONE;  // tested, never written
+    VkRenderingInfo rendering{VK_STRUCTURE_TYPE_RENDERING_INFO};
+    rendering.renderArea = {{0, 0}, {gbuf.width, gbuf.height}};
+    rendering.layerCount = 1;
+    rendering.colorAttachmentCount = 1;
+    rendering.pColorAttachments = &color;
+    rendering.pDepthAttachment = &depth;
+    vkCmdBeginRendering(cmd, &rendering);
+
     if (!draws.empty()) {
         const VkViewport viewport{0.0f, 0.0f, float(gbuf.width), float(gbuf.height), 0.0f, 1.0f};
         const VkRect2D scissor{{0, 0}, {gbuf.width, gbuf.height}};
@@ -104,7 +101,7 @@ void GBufferRenderer::recordTransparent(const FrameWork& work, rg::PassContext& 
         const gpu::Buffer* boundVertices = &vertices_;
         MaterialTextures boundTextures = fallbackTextures();
         pushSurfaceBindings(pipeline, pc, slot, *boundVertices, boundTextures, gbuf.shadowMap, environment);
-        for (const Draw& d : draws) {
+        for (const TransparentDraw& d : draws) {
             const DrawRange& range = *d.range;
             const auto [vertices, vertexShift] = vertexSource(work, d.instance, slot);
             const VkFrontFace instanceFront =
@@ -130,7 +127,6 @@ void GBufferRenderer::recordTransparent(const FrameWork& work, rg::PassContext& 
             draw.doubleSided = range.doubleSided ? 1u : 0u;
             pipeline.pushConstants(cmd, draw);
             vkCmdDrawIndexed(cmd, range.indexCount, 1, range.firstIndex, range.vertexOffset + vertexShift, 0);
-            ++stats_.transparentDraws;
         }
     }
     vkCmdEndRendering(cmd);
@@ -152,6 +148,27 @@ TransparentOutputs addTransparentPass(rg::Graph& graph, GBufferRenderer& rendere
         throw gpu::GpuError("transparent pass: the lighting looks up an environment image but no environment texture "
                             "was given (the one addGBufferPass read)");
     }
+    // The draws are known now: a frame with no blended surface in view
+    // declares nothing (composite then reads no layer).
+    auto draws = std::make_shared<const std::vector<GBufferRenderer::TransparentDraw>>(renderer.transparentDraws(*work));
+    renderer.stats_.transparentDraws = uint32_t(draws->size());
+    if (draws->empty() && !inputs.declareEmpty) return {};
+    if (!renderer.transparentClearer_) renderer.transparentClearer_ = std::make_unique<ImageClearer>(renderer.ctx_);
+
+    // A compute clear: a load-op clear of the 1080p layer took 0.30 ms on
+    // an H200, whose graphics engine is small (passes/image_clear.h).
+    struct ClearData {
+        rg::Texture layer;
+    };
+    const ClearData& clear = graph.addPass<ClearData>(
+        "transparent.clear", rg::Queue::Graphics,
+        [&](rg::Builder& b, ClearData& d) {
+            d.layer = b.write(b.createTexture("transparent.layer",
+                                              {.width = gbuf.width, .height = gbuf.height, .format = kTransparentFormat}),
+                              rg::Access::StorageWrite);
+        },
+        [&renderer](const ClearData& d, rg::PassContext& pc) { renderer.transparentClearer_->clear(pc, d.layer); });
+
     struct Data {
         TransparentOutputs out;
         GBufferOutputs gbuffer;
@@ -163,10 +180,7 @@ TransparentOutputs addTransparentPass(rg::Graph& graph, GBufferRenderer& rendere
             b.setPipeline(rg::Pipeline::Raster);
             d.out.width = gbuf.width;
             d.out.height = gbuf.height;
-            d.out.layer = b.write(b.createTexture("transparent.layer", {.width = gbuf.width,
-                                                                         .height = gbuf.height,
-                                                                         .format = kTransparentFormat}),
-                                  rg::Access::ColorAttachment);
+            d.out.layer = b.write(clear.layer, rg::Access::ColorAttachment);
             d.gbuffer = gbuf;
             d.gbuffer.depth = b.read(gbuf.depth, rg::Access::DepthRead);
             d.gbuffer.shadowMap = b.read(gbuf.shadowMap, rg::Access::SampledRead);
@@ -174,8 +188,8 @@ TransparentOutputs addTransparentPass(rg::Graph& graph, GBufferRenderer& rendere
                 d.environment = b.read(inputs.environment, rg::Access::SampledRead);
             }
         },
-        [&renderer, work](const Data& d, rg::PassContext& pc) {
-            renderer.recordTransparent(*work, pc, d.out.layer, d.gbuffer, d.environment);
+        [&renderer, work, draws](const Data& d, rg::PassContext& pc) {
+            renderer.recordTransparent(*work, *draws, pc, d.out.layer, d.gbuffer, d.environment);
         });
     return data.out;
 }

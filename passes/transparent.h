@@ -31,9 +31,8 @@
 //   each frame:
 //     const auto gbuf = passes::addGBufferPass(graph, gbufferRenderer, {camera}, {});
 //     ... reflections ...
-//     rg::Texture layer;
-//     if (gbufferRenderer.hasBlendedGeometry())
-//         layer = passes::addTransparentPass(graph, gbufferRenderer, {gbuf}).layer;
+//     // Invalid when nothing blended is in view: composite then has no layer.
+//     const rg::Texture layer = passes::addTransparentPass(graph, gbufferRenderer, {gbuf}).layer;
 //     passes::addCompositePass(graph, pipelines, {gbuf, reflections, camera, layer});
 //
 // Known limits: a surface behind a blended one gets its reflection as
@@ -57,19 +56,27 @@ struct TransparentInputs {
     // The prefiltered environment the G-buffer's lighting looks up, as given
     // to addGBufferPass (invalid for the procedural sky).
     rg::Texture environment;
+    // With no blended surface in view the pass is not declared and the
+    // layer is invalid; set, it is declared anyway (a cleared layer: for
+    // a debug view of it).
+    bool declareEmpty = false;
 };
 
 struct TransparentOutputs {
-    rg::Texture layer;  // kTransparentFormat, premultiplied radiance, a = coverage
+    // kTransparentFormat, premultiplied radiance, a = coverage; invalid when
+    // nothing blended is in view (see TransparentInputs::declareEmpty).
+    rg::Texture layer;
     uint32_t width = 0;
     uint32_t height = 0;
 };
 
-// Declares the pass over the frame `renderer`'s last addGBufferPass
-// declared (throws gpu::GpuError when it declared none, or when the
-// G-buffer in `inputs` has another size than that frame's). Scenes without blended geometry
-// (GBufferRenderer::hasBlendedGeometry) need not declare it; when they do,
-// the layer is cleared and nothing is drawn.
+// Declares two passes over the frame `renderer`'s last addGBufferPass
+// declared, when an instance it draws has blended geometry: a compute
+// clear of the layer ("transparent.clear"; a load-op clear costs ten
+// times more on GPUs with a small graphics engine) and the raster pass
+// ("transparent"). Throws gpu::GpuError when the renderer declared no
+// frame, or when the G-buffer in `inputs` has another size than that
+// frame's.
 TransparentOutputs addTransparentPass(rg::Graph& graph, GBufferRenderer& renderer, const TransparentInputs& inputs);
 
 } // namespace glint::passes

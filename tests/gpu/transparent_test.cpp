@@ -8,6 +8,9 @@
 #include "support/gpu_test.h"
 #include "support/frame_render.h"
 
+#include "graph/executor.h"
+#include "graph/graph.h"
+#include "graph/plan.h"
 #include "passes/reflection_frame.h"
 #include "scene/animation.h"
 #include "scene/procedural_meshes.h"
@@ -18,6 +21,7 @@
 
 #include <glm/gtc/matrix_transform.hpp>
 
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -193,4 +197,29 @@ TEST_CASE("a blended pane is absent from the reflections in rt and hybrid mode; 
         // (thousands of red pixels): the blended one would have shown.
         CHECK(redPixels(withOpaque) > 1000u);
     }
+}
+
+TEST_CASE("the transparent passes are declared only when a blended surface is in view, or for their debug view") {
+    test::GpuTest gpu;
+    const auto declare = [&](const scene::Scene& s, const char* debugView) {
+        rg::Executor executor(gpu.ctx());
+        passes::ReflectionRenderer renderer(gpu.ctx(), s);
+        scene::Camera camera;
+        camera.resolution = kSize;
+        camera.lens = s.lens;
+        camera.reset(s.cameraPath.evaluate(0.0f), 0);
+        rg::Graph graph(executor.queueCaps());
+        passes::ReflectionFrameSettings settings;
+        settings.debugView = debugView;
+        const passes::ReflectionFrame f = renderer.addFrame(graph, camera, settings);
+        const rg::Plan plan = graph.compile(executor.compileOptions());
+        const bool declared = plan.findPass("transparent") != nullptr && plan.findPass("transparent.clear") != nullptr;
+        CHECK(declared == f.transparent.valid());
+        return declared;
+    };
+    CHECK(declare(panesScene(), "final"));
+    // The pane stands above the view: nothing to draw, nothing declared.
+    const scene::Scene outOfView = mirrorScene(scene::AlphaMode::Blend);
+    CHECK_FALSE(declare(outOfView, "final"));
+    CHECK(declare(outOfView, "transparent"));
 }
