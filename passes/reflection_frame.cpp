@@ -7,8 +7,11 @@
 
 #include "glint/reflection_frame_shared.h"
 
+#include <spdlog/spdlog.h>
+
 #include <algorithm>
 #include <array>
+#include <memory>
 #include <stdexcept>
 
 namespace glint::passes {
@@ -100,34 +103,52 @@ ReflectionRenderer::ReflectionRenderer(gpu::Context& ctx, const scene::Scene& sc
       environment_(ctx, scene, options.environment),
       gbuffer_(ctx, scene, options.framesInFlight),
       planner_(options.bvh),
-      bvh_(ctx, scene, options.framesInFlight, options.bvhUpdate),
+      bvh_(ctx.caps().canTraceRays()
+               ? std::make_unique<BvhManager>(ctx, scene, options.framesInFlight, options.bvhUpdate)
+               : nullptr),
       feedback_(ctx),
       rays_(ctx),
       sslr_(ctx),
-      rt_(ctx, options.backend),
+      rt_(ctx.caps().canTraceRays() ? std::make_unique<RtTracePipelines>(ctx, options.backend) : nullptr),
       integrate_(ctx),
       temporal_(ctx),
       composite_(ctx),
-      particles_(ctx, options.backend),
+      particles_(ctx, ctx.caps().canTraceRays() ? options.backend : RtBackend::Auto),
       tileView_(gpu::createComputePipeline(ctx, {"reflection_frame/tile_view.comp", storageBindings(1, true),
                                                  uint32_t(sizeof(shader::TileViewConstants)),
                                                  "reflection_frame.tile_view"})),
       classCount_(gpu::createComputePipeline(ctx, {"reflection_frame/class_count.comp", storageBindings(4, false),
                                                    uint32_t(sizeof(shader::ClassCountConstants)),
-                                                   "reflection_frame.class_count"})) {}
+                                                   "reflection_frame.class_count"})) {
+    if (!rt_) {
+        spdlog::warn("device '{}' has no ray tracing{}: hybrid and rt reflections render as ssr, and no BVH is built",
+                     ctx.caps().deviceName,
+                     ctx.caps().accelerationStructure ? " (acceleration structures but neither ray query nor ray "
+                                                        "tracing pipelines)"
+                                                      : " (no VK_KHR_acceleration_structure, or disabled)");
+    }
+}
+
+RtBackend ReflectionRenderer::backend() const { return rt_ ? rt_->backend() : RtBackend::Auto; }
+
+const BvhGpuStats& ReflectionRenderer::bvhGpuStats() const {
+    static const BvhGpuStats none{};
+    return bvh_ ? bvh_->stats() : none;
+}
 
 ReflectionRenderer::~ReflectionRenderer() = default;
 
 void ReflectionRenderer::bind(rg::FrameResources& resources, const ReflectionFrame& frame) const {
     if (frame.bvh) {
-        bvh_.bind(resources, *frame.bvh);
+        bvh_->bind(resources, *frame.bvh);
     }
     environment_.bind(resources, frame.environment);
 }
 
 ReflectionFrame ReflectionRenderer::addFrame(rg::Graph& graph, const scene::Camera& camera,
                                              const ReflectionFrameSettings& settings) {
-    const ReflectionMode mode = settings.mode;
+    // Without ray tracing every mode is ssr (the constructor said so once).
+    const ReflectionMode mode = rt_ ? settings.mode : ReflectionMode::Ssr;
     const std::string_view view = settings.debugView;
     const uint64_t frameIndex = camera.frameIndex;
     const bool traces = mode != ReflectionMode::Ssr;
@@ -149,7 +170,7 @@ ReflectionFrame ReflectionRenderer::addFrame(rg::Graph& graph, const scene::Came
         plan.particleTlas = plan.particleTlas && settings.reflectParticles;
         lastPlanStats_ = plan.stats;
         f.bvhComplete = plan.complete();
-        f.bvh = addBvhUpdatePass(graph, bvh_, plan, camera);
+        f.bvh = addBvhUpdatePass(graph, *bvh_, plan, camera);
     }
     // 1. G-buffer; with SSLR particles, the particles drawn into its lit
     // colour before anything samples it.
@@ -197,7 +218,7 @@ ReflectionFrame ReflectionRenderer::addFrame(rg::Graph& graph, const scene::Came
         rtInputs.frameIndex = frameIndex;
         RtTraceSettings rtSettings = settings.rt;
         rtSettings.clearUntraced = rtSettings.clearUntraced || viewsRt;
-        f.rt = addRtTracePass(graph, rt_, rtInputs, rtSettings);
+        f.rt = addRtTracePass(graph, *rt_, rtInputs, rtSettings);
     }
     // 5'. Particles seen in the reflections, cut at each ray's reflected
     // surface (the particle TLAS exists only when the scene has particles).
@@ -213,7 +234,7 @@ ReflectionFrame ReflectionRenderer::addFrame(rg::Graph& graph, const scene::Came
         particleInputs.bvh = *f.bvh;
         particleInputs.camera = camera;
         ParticleTraceSettings particleSettings;
-        particleSettings.backend = rt_.backend();
+        particleSettings.backend = rt_->backend();
         particleSettings.confidenceThreshold = settings.sslr.confidenceThreshold;
         particleSettings.maxDistance = settings.rt.maxDistance;
         particleSettings.sslrSeesParticles = settings.sslrParticles && f.sslr.has_value();

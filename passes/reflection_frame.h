@@ -104,6 +104,8 @@ struct ReflectionFrameSettings {
 
 // Everything a frame declared, for debug views, readbacks and stats.
 struct ReflectionFrame {
+    // The mode declared: the settings' own, or ssr on a device without ray
+    // tracing (ReflectionRenderer::tracesRays).
     ReflectionMode mode = ReflectionMode::Hybrid;
     GBufferOutputs gbuffer;
     std::optional<BvhUpdateOutputs> bvh;
@@ -156,11 +158,16 @@ public:
     // Binds the frame's imports (the BVH's objects, the environment).
     void bind(rg::FrameResources& resources, const ReflectionFrame& frame) const;
 
-    RtBackend backend() const { return rt_.backend(); }
+    // The ray backend; Auto on a device without ray tracing.
+    RtBackend backend() const;
+    // False on a device without ray tracing (gpu::Capabilities::canTraceRays):
+    // then every frame is declared in ssr mode, whatever the settings ask
+    // (ReflectionFrame::mode says which), and no BVH memory is allocated.
+    bool tracesRays() const { return rt_ != nullptr; }
     const GBufferStats& gbufferStats() const { return gbuffer_.stats(); }
     // Of the last frame that declared BVH work (none in ssr mode).
     const scene::BvhStats& bvhPlanStats() const { return lastPlanStats_; }
-    const BvhGpuStats& bvhGpuStats() const { return bvh_.stats(); }
+    const BvhGpuStats& bvhGpuStats() const;
     const EnvironmentStats& environmentStats() const { return environment_.stats(); }
 
 private:
@@ -171,11 +178,11 @@ private:
     EnvironmentMap environment_;
     GBufferRenderer gbuffer_;
     scene::BvhPlanner planner_;
-    BvhManager bvh_;
+    std::unique_ptr<BvhManager> bvh_;  // null without ray tracing
     FeedbackPipelines feedback_;
     RayGenerationPipelines rays_;
     SslrPipelines sslr_;
-    RtTracePipelines rt_;
+    std::unique_ptr<RtTracePipelines> rt_;  // null without ray tracing
     IntegratePipelines integrate_;
     TemporalPipelines temporal_;
     CompositePipelines composite_;

@@ -9,6 +9,7 @@
 #include <cstdlib>
 #include <cstring>
 #include <set>
+#include <string_view>
 
 namespace glint::gpu {
 
@@ -110,6 +111,12 @@ std::string unsuitableReason(VkPhysicalDevice device, const ContextOptions& opti
 }
 
 } // namespace
+
+bool rayTracingDisabled(const ContextOptions& options) {
+    if (options.disableRayTracing) return true;
+    const char* env = std::getenv("GLINT_NO_RAY_TRACING");
+    return env != nullptr && std::string_view(env) == "1";
+}
 
 std::string versionString(uint32_t v) {
     return std::to_string(VK_API_VERSION_MAJOR(v)) + "." + std::to_string(VK_API_VERSION_MINOR(v)) + "." +
@@ -337,7 +344,8 @@ void Context::createDevice(const ContextOptions& options) {
     VkPhysicalDeviceVulkan11Features f11{VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_VULKAN_1_1_FEATURES};
     VkPhysicalDeviceFeatures2 features{VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_FEATURES_2};
 
-    const bool hasAs = hasExtension(extensions, VK_KHR_ACCELERATION_STRUCTURE_EXTENSION_NAME) &&
+    const bool hasAs = !rayTracingDisabled(options) &&
+                       hasExtension(extensions, VK_KHR_ACCELERATION_STRUCTURE_EXTENSION_NAME) &&
                        hasExtension(extensions, VK_KHR_DEFERRED_HOST_OPERATIONS_EXTENSION_NAME);
     const bool hasRq = hasAs && hasExtension(extensions, VK_KHR_RAY_QUERY_EXTENSION_NAME) && !options.disableRayQuery;
     const bool hasRt = hasAs && hasExtension(extensions, VK_KHR_RAY_TRACING_PIPELINE_EXTENSION_NAME);
@@ -374,8 +382,9 @@ void Context::createDevice(const ContextOptions& options) {
     caps_.rayTracingPipeline = hasRt && rtFeatures.rayTracingPipeline && caps_.accelerationStructure;
     caps_.memoryBudget = hasExtension(extensions, VK_EXT_MEMORY_BUDGET_EXTENSION_NAME);
     if (options.requireRayTracing && !(caps_.rayQuery || caps_.rayTracingPipeline)) {
-        throw GpuError("device '" + caps_.deviceName +
-                       "' has no usable ray backend (needs accelerationStructure plus rayQuery or rayTracingPipeline)");
+        throw GpuError("device '" + caps_.deviceName + "' has no usable ray backend (needs accelerationStructure plus "
+                       "rayQuery or rayTracingPipeline)" +
+                       (rayTracingDisabled(options) ? " (ray tracing disabled by option or GLINT_NO_RAY_TRACING)" : ""));
     }
 
     // Enable exactly what we use: the queried structs double as the enable

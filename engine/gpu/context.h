@@ -22,6 +22,12 @@ struct ContextOptions {
     // Fail unless the device has acceleration structures and at least one
     // ray backend (ray query or ray tracing pipeline).
     bool requireRayTracing = true;
+    // Treat the device as if it lacked VK_KHR_acceleration_structure, ray
+    // query and ray tracing pipelines: none is enabled and Capabilities
+    // reports none (with requireRayTracing, creation then fails). The
+    // environment variable GLINT_NO_RAY_TRACING=1 sets it too, so any
+    // program can be run as on a device without ray tracing.
+    bool disableRayTracing = false;
     // Substring of the device name to pick; empty means: take it from the
     // GLINT_DEVICE environment variable, or choose (discrete GPU first, then
     // lavapipe, then anything else).
@@ -34,6 +40,10 @@ struct ContextOptions {
     // ray tracing pipeline path can be exercised on any device.
     bool disableRayQuery = false;
 };
+
+// ContextOptions::disableRayTracing, or GLINT_NO_RAY_TRACING=1 in the
+// environment.
+bool rayTracingDisabled(const ContextOptions& options);
 
 struct QueueFamily {
     uint32_t index = 0;
@@ -77,6 +87,8 @@ struct Capabilities {
     std::optional<uint32_t> computeFamily;  // compute without graphics: real async compute
 
     bool hasAsyncCompute() const { return computeFamily.has_value(); }
+    // Acceleration structures and at least one ray backend.
+    bool canTraceRays() const { return rayQuery || rayTracingPipeline; }
 };
 
 struct Queue {

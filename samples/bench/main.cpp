@@ -129,7 +129,11 @@ int main(int argc, char** argv) {
         const std::filesystem::path jsonPath = args.get("json", (outDir / (stem + suffix + ".json")).string());
         const std::filesystem::path plotPath = args.get("plot", (outDir / (stem + suffix + ".png")).string());
 
-        gpu::Context ctx(args.contextOptions());
+        // Error is measured against a ray-traced reference, and the modes
+        // compared trace rays: a device without ray tracing is refused.
+        gpu::ContextOptions contextOptions = args.contextOptions();
+        contextOptions.requireRayTracing = true;
+        gpu::Context ctx(contextOptions);
         const bool cpuDevice = ctx.caps().deviceType == VK_PHYSICAL_DEVICE_TYPE_CPU;
         const auto [width, height] =
             app::parseSize(args.get("size", cpuDevice ? "256x256" : "1920x1080"));

@@ -525,8 +525,11 @@ int main(int argc, char** argv) {
                        "                       [--busy-mib MIB] [--busy-passes N] [--busy-iterations N]",
                        {"scenes", "frames", "warmup", "rays", "busy-mib", "busy-passes", "busy-iterations"},
                        {"overlap"});
+        // Builds and traces BVHs: a device without ray tracing is refused.
+        gpu::ContextOptions contextOptions = args.contextOptions();
+        contextOptions.requireRayTracing = true;
         if (args.has("overlap")) {
-            gpu::Context ctx(args.contextOptions());
+            gpu::Context ctx(contextOptions);
             return runOverlap(ctx, args);
         }
         const uint32_t frames = args.getUint("frames", 31);
@@ -541,7 +544,7 @@ int main(int argc, char** argv) {
             scenes = defaultScenes();
         }
 
-        gpu::Context ctx(args.contextOptions());
+        gpu::Context ctx(contextOptions);
         std::printf("glint-bvh-bench on %s (%s), %u frames per scene, builds on %s\n", ctx.caps().deviceName.c_str(),
                     ctx.caps().driverName.c_str(), frames,
                     ctx.caps().hasAsyncCompute() ? "the async compute queue" : "the graphics queue (no async compute)");

@@ -59,6 +59,8 @@ Args::Args(int argc, char** argv, const std::string& usage, const std::vector<st
         if (a == "--help" || a == "-h") {
             std::cout << usage << "\n"
                       << "common: --validate  --device NAME  --log LEVEL (trace|debug|info|warn|error)  --no-ray-query\n"
+                      << "        --no-ray-tracing  (as on a device without ray tracing: hybrid and rt render as ssr;\n"
+                      << "                           GLINT_NO_RAY_TRACING=1 does the same)\n"
                       << "        --reflection-lods RATIO[:ERROR]|off  (glTF meshes' reflection LODs; default 0.25:0.01)\n";
             std::exit(0);
         } else if (a == "--validate") {
@@ -69,6 +71,8 @@ Args::Args(int argc, char** argv, const std::string& usage, const std::vector<st
             common_.logLevel = value();
         } else if (a == "--no-ray-query") {
             common_.pipelineOnly = true;
+        } else if (a == "--no-ray-tracing") {
+            common_.noRayTracing = true;
         } else if (a == "--reflection-lods") {
             common_.reflectionLods = parseReflectionLods(value());
         } else if (a.rfind("--", 0) == 0 && known(knownFlags, a.substr(2))) {
@@ -119,6 +123,9 @@ gpu::ContextOptions Args::contextOptions() const {
     o.validation = common_.validate;
     o.deviceFilter = common_.device;
     o.disableRayQuery = common_.pipelineOnly;
+    o.disableRayTracing = common_.noRayTracing;
+    // Every sample runs without ray tracing: the renderer falls back to ssr.
+    o.requireRayTracing = false;
     return o;
 }
 

@@ -20,6 +20,9 @@ struct CommonOptions {
     std::string device;          // --device NAME (overrides GLINT_DEVICE)
     std::string logLevel = "info";
     bool pipelineOnly = false;   // --no-ray-query: use the ray tracing pipeline even where ray query exists
+    // --no-ray-tracing: run as on a device without ray tracing (hybrid and
+    // rt render as ssr); GLINT_NO_RAY_TRACING=1 does the same.
+    bool noRayTracing = false;
     // --reflection-lods RATIO[:ERROR]: the reflection LODs generated for
     // glTF meshes (scene::ReflectionLodSettings: triangle share, relative
     // error); "off": the BVH builds them from full detail.

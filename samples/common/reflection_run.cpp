@@ -291,9 +291,14 @@ ReflectionRunResult runReflections(gpu::Context& ctx, scene::Scene& scene, const
     executor.setPassTimer(options.passTimer.value_or(cpuDevice ? rg::PassTimer::HostSerial
                                                                : rg::PassTimer::GpuTimestamps));
     passes::ReflectionRenderer renderer(ctx, scene, options.renderer);
+    if (reference && !renderer.tracesRays()) {
+        throw std::runtime_error("reference mode traces rays, and device '" + ctx.caps().deviceName +
+                                 "' has no ray tracing (or it was disabled)");
+    }
 
     ReflectionRunResult result;
     result.backend = renderer.backend();
+    result.mode = renderer.tracesRays() ? options.frame.mode : passes::ReflectionMode::Ssr;
     result.passTimer = executor.passTimer();
     const uint32_t w = options.width, h = options.height;
     gpu::Buffer image(ctx, {VkDeviceSize(w) * h * 4, VK_BUFFER_USAGE_TRANSFER_DST_BIT, gpu::MemoryUsage::Readback,
@@ -486,7 +491,7 @@ ReflectionRunResult runReflections(gpu::Context& ctx, scene::Scene& scene, const
     result.pixelClasses.assign(words.begin(), words.begin() + shader::kPixelClassCount);
     result.sslrRays = words[shader::kCountSslrRays];
     result.rtRays = words[shader::kCountRtRays];
-    result.tlasInstances = options.frame.mode == passes::ReflectionMode::Ssr ? 0 : renderer.bvhGpuStats().tlasInstances;
+    result.tlasInstances = result.mode == passes::ReflectionMode::Ssr ? 0 : renderer.bvhGpuStats().tlasInstances;
     result.gbuffer = renderer.gbufferStats();
     return result;
 }
@@ -496,7 +501,8 @@ std::string statsJson(const gpu::Context& ctx, const ReflectionRunOptions& optio
     json j;
     j["device"] = ctx.caps().deviceName;
     j["driver"] = ctx.caps().driverName + " " + ctx.caps().driverInfo;
-    j["mode"] = options.reference.enabled ? std::string("reference") : std::string(passes::modeName(options.frame.mode));
+    j["mode"] = options.reference.enabled ? std::string("reference") : std::string(passes::modeName(r.mode));
+    if (r.mode != options.frame.mode) j["requested_mode"] = std::string(passes::modeName(options.frame.mode));
     if (options.reference.enabled) {
         j["reference"] = {{"frames", r.framesRun},
                           {"converged", r.converged},
@@ -504,7 +510,7 @@ std::string statsJson(const gpu::Context& ctx, const ReflectionRunOptions& optio
                           {"tolerance", options.reference.tolerance},
                           {"seed", options.reference.seed}};
     }
-    j["backend"] = options.frame.mode == passes::ReflectionMode::Ssr ? "none" : std::string(passes::backendName(r.backend));
+    j["backend"] = r.mode == passes::ReflectionMode::Ssr ? "none" : std::string(passes::backendName(r.backend));
     j["size"] = {options.width, options.height};
     j["frames"] = options.reference.enabled ? r.framesRun : options.frames;
     j["frames_timed"] = r.framesTimed;

@@ -99,6 +99,9 @@ struct ReflectionRunResult {
     uint32_t tlasInstances = 0;
     passes::GBufferStats gbuffer;  // the last frame's
     passes::RtBackend backend = passes::RtBackend::Auto;
+    // The mode the frames were declared in: the options' own, or ssr on a
+    // device without ray tracing (passes::ReflectionRenderer::tracesRays).
+    passes::ReflectionMode mode = passes::ReflectionMode::Hybrid;
     // Reference runs: frames accumulated, whether the tolerance was met
     // (else maxFrames stopped it), and the last relative change measured.
     uint32_t framesRun = 0;

@@ -1,7 +1,8 @@
 # Runs glint-render with ARGS and checks the stats JSON it writes (STATS):
 # the keys of the stats are there (both reflection times numbers), every pass has a finite time, and the
 # mode's work happened (RT rays in rt mode, none in ssr mode, SSLR rays
-# outside rt mode).
+# outside rt mode). With REQUESTED (a device without ray tracing, where
+# MODE is ssr): the stats name the mode asked for when it differs.
 cmake_policy(SET CMP0054 NEW)  # quoted arguments are strings, never variables
 execute_process(COMMAND ${RENDER} ${ARGS} RESULT_VARIABLE rc)
 if(NOT rc EQUAL 0)
@@ -24,6 +25,12 @@ endforeach()
 string(JSON mode GET "${json}" mode)
 if(NOT mode STREQUAL MODE)
   message(FATAL_ERROR "${STATS}: mode ${mode}, expected ${MODE}")
+endif()
+if(DEFINED REQUESTED AND NOT REQUESTED STREQUAL MODE)
+  string(JSON requested ERROR_VARIABLE err GET "${json}" requested_mode)
+  if(err OR NOT requested STREQUAL REQUESTED)
+    message(FATAL_ERROR "${STATS}: requested_mode '${requested}', expected ${REQUESTED} ${err}")
+  endif()
 endif()
 string(JSON passes LENGTH "${json}" passes)
 if(passes LESS 5)
