@@ -203,7 +203,7 @@ BvhManager::BvhManager(gpu::Context& ctx, const scene::Scene& scene, uint32_t fr
 BvhManager::~BvhManager() {
     // Retired objects and resident BLASes may still be referenced by frames
     // in flight.
-    ctx_.waitIdle();
+    ctx_.waitIdleForTeardown("BVH manager");
 }
 
 const gpu::AccelerationStructure* BvhManager::blas(scene::BlasId id) const {

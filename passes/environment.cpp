@@ -72,7 +72,7 @@ EnvironmentMap::EnvironmentMap(gpu::Context& ctx, const scene::Scene& scene, con
 
 EnvironmentMap::~EnvironmentMap() {
     // Frames in flight may still sample the image.
-    ctx_.waitIdle();
+    ctx_.waitIdleForTeardown("environment map");
 }
 
 EnvironmentMap::Fingerprint EnvironmentMap::fingerprint() const {

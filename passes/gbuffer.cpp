@@ -412,7 +412,7 @@ GBufferRenderer::GBufferRenderer(gpu::Context& ctx, const scene::Scene& scene, u
 
 GBufferRenderer::~GBufferRenderer() {
     // Frames in flight may still read the geometry and the slots' buffers.
-    ctx_.waitIdle();
+    ctx_.waitIdleForTeardown("G-buffer renderer");
 }
 
 void GBufferRenderer::ensureCapacity(gpu::Buffer& buffer, VkDeviceSize bytes, const char* name) {

@@ -44,7 +44,7 @@ gpu::Buffer uploadBlueNoise(gpu::Context& ctx) {
     gpu::Buffer staging(ctx, {bytes, VK_BUFFER_USAGE_TRANSFER_SRC_BIT, gpu::MemoryUsage::Upload,
                               "ray_generation.blue_noise.staging"});
     std::memcpy(staging.mapped(), words.data(), bytes);
-    gpu::submitAndWait(ctx, ctx.graphicsQueue(), "blue noise upload", [&](VkCommandBuffer cmd) {
+    gpu::submitAndWait(ctx, ctx.graphicsQueue(), "upload 'ray_generation.blue_noise'", [&](VkCommandBuffer cmd) {
         const VkBufferCopy region{0, 0, bytes};
         vkCmdCopyBuffer(cmd, staging.handle(), buffer.handle(), 1, &region);
         gpu::bufferBarrier(cmd, buffer, VK_PIPELINE_STAGE_2_COPY_BIT, VK_ACCESS_2_TRANSFER_WRITE_BIT,

@@ -136,7 +136,11 @@ const BvhGpuStats& ReflectionRenderer::bvhGpuStats() const {
     return bvh_ ? bvh_->stats() : none;
 }
 
-ReflectionRenderer::~ReflectionRenderer() = default;
+ReflectionRenderer::~ReflectionRenderer() {
+    // Before any member goes: frames in flight use every member's pipelines
+    // (after a device error the caller may not have waited).
+    ctx_.waitIdleForTeardown("reflection renderer");
+}
 
 void ReflectionRenderer::bind(rg::FrameResources& resources, const ReflectionFrame& frame) const {
     if (frame.bvh) {

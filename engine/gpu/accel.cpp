@@ -103,7 +103,7 @@ AccelerationStructure buildNow(Context& ctx, AccelBuild& build, const std::strin
     AccelerationStructure as(ctx, build.type(), build.structureSize(), name);
     Buffer scratch(ctx, {build.scratchSize(), VK_BUFFER_USAGE_STORAGE_BUFFER_BIT, MemoryUsage::DeviceLocal,
                          name + ".scratch"});
-    submitAndWait(ctx, ctx.graphicsQueue(), "build " + name, [&](VkCommandBuffer cmd) {
+    submitAndWait(ctx, ctx.graphicsQueue(), "build '" + name + "'", [&](VkCommandBuffer cmd) {
         // Inputs were written by earlier submissions (uploads end with a
         // full barrier); order this build's reads after them anyway.
         memoryBarrier(cmd, VK_PIPELINE_STAGE_2_ALL_COMMANDS_BIT, VK_ACCESS_2_MEMORY_WRITE_BIT,

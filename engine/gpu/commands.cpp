@@ -43,7 +43,7 @@ void CommandPool::reset() {
 // ---------------------------------------------------------------- TimelineSemaphore
 
 TimelineSemaphore::TimelineSemaphore(Context& ctx, std::string_view name, uint64_t initial)
-    : device_(ctx.device()), name_(name) {
+    : device_(ctx.device()), faults_(&ctx.faults()), name_(name) {
     VkSemaphoreTypeCreateInfo type{VK_STRUCTURE_TYPE_SEMAPHORE_TYPE_CREATE_INFO};
     type.semaphoreType = VK_SEMAPHORE_TYPE_TIMELINE;
     type.initialValue = initial;
@@ -67,7 +67,8 @@ void TimelineSemaphore::wait(uint64_t value, uint64_t timeoutNs) const {
     info.semaphoreCount = 1;
     info.pSemaphores = &s;
     info.pValues = &value;
-    const VkResult r = vkWaitSemaphores(device_, &info, timeoutNs);
+    VkResult r = vkWaitSemaphores(device_, &info, timeoutNs);
+    if (r == VK_SUCCESS && faults_) r = faults_->next(FaultSite::Wait);
     if (r == VK_TIMEOUT) {
         throw GpuError("timeline semaphore '" + name_ + "' did not reach " + std::to_string(value) +
                        " in time (GPU hang or a wait that nothing signals)");
@@ -98,8 +99,11 @@ void submitAndWait(Context& ctx, const Queue& queue, std::string_view what,
     VkSubmitInfo2 submit{VK_STRUCTURE_TYPE_SUBMIT_INFO_2};
     submit.commandBufferInfoCount = 1;
     submit.pCommandBufferInfos = &cmdInfo;
-    check(vkQueueSubmit2(queue.queue, 1, &submit, fence), std::string("vkQueueSubmit2 (") + std::string(what) + ")");
-    const VkResult r = vkWaitForFences(ctx.device(), 1, &fence, VK_TRUE, 10'000'000'000ull);
+    VkResult submitted = ctx.faults().next(FaultSite::Submit);
+    if (submitted == VK_SUCCESS) submitted = vkQueueSubmit2(queue.queue, 1, &submit, fence);
+    check(submitted, std::string("vkQueueSubmit2 (") + std::string(what) + ")");
+    VkResult r = vkWaitForFences(ctx.device(), 1, &fence, VK_TRUE, 10'000'000'000ull);
+    if (r == VK_SUCCESS) r = ctx.faults().next(FaultSite::Wait);
     if (r == VK_TIMEOUT) {
         // The pool cannot be destroyed while the GPU may still use it; a
         // device wait would hang too. Report and let the device be torn down.
@@ -195,7 +199,7 @@ void uploadBuffer(Context& ctx, const Buffer& dst, const void* data, VkDeviceSiz
     }
     Buffer staging(ctx, {size, VK_BUFFER_USAGE_TRANSFER_SRC_BIT, MemoryUsage::Upload, dst.desc().name + ".staging"});
     std::memcpy(staging.mapped(), data, size);
-    submitAndWait(ctx, ctx.graphicsQueue(), "upload " + dst.desc().name, [&](VkCommandBuffer cmd) {
+    submitAndWait(ctx, ctx.graphicsQueue(), "upload '" + dst.desc().name + "'", [&](VkCommandBuffer cmd) {
         const VkBufferCopy region{0, offset, size};
         vkCmdCopyBuffer(cmd, staging.handle(), dst.handle(), 1, &region);
         // Make the copy visible to whatever reads the buffer next.
@@ -220,7 +224,7 @@ Image createSampledImageWithMips(Context& ctx, const ImageDesc& desc, const void
     const VkDeviceSize bytes = VkDeviceSize(d.width) * d.height * d.layers * bytesPerTexel(d.format);
     Buffer staging(ctx, {bytes, VK_BUFFER_USAGE_TRANSFER_SRC_BIT, MemoryUsage::Upload, d.name + ".staging"});
     std::memcpy(staging.mapped(), texels, bytes);
-    submitAndWait(ctx, ctx.graphicsQueue(), "upload " + d.name, [&](VkCommandBuffer cmd) {
+    submitAndWait(ctx, ctx.graphicsQueue(), "upload '" + d.name + "'", [&](VkCommandBuffer cmd) {
         const auto mipBarrier = [&](uint32_t mip, VkImageLayout from, VkImageLayout to, VkPipelineStageFlags2 srcStage,
                                     VkAccessFlags2 srcAccess, VkPipelineStageFlags2 dstStage,
                                     VkAccessFlags2 dstAccess) {
@@ -270,7 +274,7 @@ std::vector<std::byte> readbackBuffer(Context& ctx, const Buffer& src, const Que
         return out;
     }
     Buffer staging(ctx, {src.size(), VK_BUFFER_USAGE_TRANSFER_DST_BIT, MemoryUsage::Readback, src.desc().name + ".readback"});
-    submitAndWait(ctx, queue ? *queue : ctx.graphicsQueue(), "readback " + src.desc().name, [&](VkCommandBuffer cmd) {
+    submitAndWait(ctx, queue ? *queue : ctx.graphicsQueue(), "readback '" + src.desc().name + "'", [&](VkCommandBuffer cmd) {
         // Whatever wrote the buffer before this submission is made available
         // by the submission order plus this barrier.
         memoryBarrier(cmd, VK_PIPELINE_STAGE_2_ALL_COMMANDS_BIT, VK_ACCESS_2_MEMORY_WRITE_BIT, VK_PIPELINE_STAGE_2_COPY_BIT,
@@ -294,7 +298,7 @@ std::vector<std::byte> readbackImage(Context& ctx, const Image& src, VkImageLayo
     const VkExtent3D e{std::max(full.width >> mip, 1u), std::max(full.height >> mip, 1u), std::max(full.depth >> mip, 1u)};
     const VkDeviceSize size = VkDeviceSize(e.width) * e.height * e.depth * bytesPerTexel(src.format());
     Buffer staging(ctx, {size, VK_BUFFER_USAGE_TRANSFER_DST_BIT, MemoryUsage::Readback, src.desc().name + ".readback"});
-    submitAndWait(ctx, ctx.graphicsQueue(), "readback " + src.desc().name, [&](VkCommandBuffer cmd) {
+    submitAndWait(ctx, ctx.graphicsQueue(), "readback '" + src.desc().name + "'", [&](VkCommandBuffer cmd) {
         imageBarrier(cmd, src, layout, VK_IMAGE_LAYOUT_TRANSFER_SRC_OPTIMAL, lastStage, lastAccess,
                      VK_PIPELINE_STAGE_2_COPY_BIT, VK_ACCESS_2_TRANSFER_READ_BIT);
         VkBufferImageCopy region{};

@@ -45,11 +45,13 @@ public:
     TimelineSemaphore(Context& ctx, std::string_view name, uint64_t initial = 0);
     VkSemaphore handle() const { return semaphore_.get(); }
     uint64_t value() const;
-    // Waits on the host; throws GpuError naming the semaphore on timeout.
+    // Waits on the host; throws GpuError naming the semaphore on timeout
+    // or failure.
     void wait(uint64_t value, uint64_t timeoutNs = 10'000'000'000ull) const;
 
 private:
     VkDevice device_ = VK_NULL_HANDLE;
+    FaultInjector* faults_ = nullptr;
     std::string name_;
     Unique<VkSemaphore> semaphore_;
 };

@@ -156,7 +156,8 @@ Context::Context(const ContextOptions& options) : log_(std::make_shared<Validati
         createInstance(options);
         selectPhysicalDevice(options);
         createDevice(options);
-        memory_ = std::make_unique<MemoryAllocator>(physicalDevice_, device_);
+        faults_ = std::make_unique<FaultInjector>(options.fault);
+        memory_ = std::make_unique<MemoryAllocator>(physicalDevice_, device_, faults_.get());
     } catch (...) {
         release();
         throw;
@@ -598,6 +599,19 @@ void Context::setName(VkObjectType type, uint64_t handle, std::string_view name)
     }
 }
 
-void Context::waitIdle() const { check(vkDeviceWaitIdle(device_), "vkDeviceWaitIdle"); }
+void Context::waitIdle() const {
+    VkResult result = vkDeviceWaitIdle(device_);
+    if (result == VK_SUCCESS) result = faults_->next(FaultSite::Wait);
+    check(result, "vkDeviceWaitIdle");
+}
+
+void Context::waitIdleForTeardown(std::string_view who) const noexcept {
+    try {
+        waitIdle();
+    } catch (const std::exception& e) {
+        // The error that ended the work was reported where it happened.
+        spdlog::warn("{}: releasing its objects without the GPU idle: {}", who, e.what());
+    }
+}
 
 } // namespace glint::gpu

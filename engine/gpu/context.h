@@ -3,6 +3,7 @@
 // physical device selection, logical device, queues, extension entry points,
 // and the memory allocator. Everything else in engine/gpu takes a Context&.
 
+#include "gpu/fault.h"
 #include "gpu/memory.h"
 #include "gpu/validation.h"
 
@@ -39,6 +40,9 @@ struct ContextOptions {
     // Disables the ray query backend even where the device has it, so the
     // ray tracing pipeline path can be exercised on any device.
     bool disableRayQuery = false;
+    // Tests only: make the Nth allocation, submission or wait fail
+    // (gpu/fault.h).
+    std::optional<FaultInjection> fault;
 };
 
 // ContextOptions::disableRayTracing, or GLINT_NO_RAY_TRACING=1 in the
@@ -126,6 +130,10 @@ public:
     const Capabilities& caps() const { return caps_; }
     const DeviceFunctions& fn() const { return fn_; }
     MemoryAllocator& memory() { return *memory_; }
+    // Asked before every device memory allocation and queue submission and
+    // after every host wait (gpu/fault.h); reports nothing unless
+    // ContextOptions::fault.
+    FaultInjector& faults() const { return *faults_; }
     // Bytes of device memory this process uses, summed over the heaps, as
     // the driver reports it (VK_EXT_memory_budget); none without the
     // extension. Counts what the driver holds beyond our allocator's blocks.
@@ -151,7 +159,11 @@ public:
         setName(type, reinterpret_cast<uint64_t>(handle), name);
     }
 
+    // vkDeviceWaitIdle; throws GpuError on failure (a lost device).
     void waitIdle() const;
+    // For destructors: waits like waitIdle, but a failure is logged, not
+    // thrown (a lost device must not end the program while it tears down).
+    void waitIdleForTeardown(std::string_view who) const noexcept;
 
 private:
     void createInstance(const ContextOptions& options);
@@ -171,6 +183,7 @@ private:
     DeviceFunctions fn_;
     Queue graphics_;
     std::optional<Queue> compute_;
+    std::unique_ptr<FaultInjector> faults_;
     std::unique_ptr<MemoryAllocator> memory_;
 };
 

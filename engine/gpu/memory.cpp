@@ -87,8 +87,9 @@ void Allocation::reset() {
 
 // ---------------------------------------------------------------- MemoryAllocator
 
-MemoryAllocator::MemoryAllocator(VkPhysicalDevice physicalDevice, VkDevice device, VkDeviceSize blockSize)
-    : device_(device), blockSize_(blockSize) {
+MemoryAllocator::MemoryAllocator(VkPhysicalDevice physicalDevice, VkDevice device, FaultInjector* faults,
+                                 VkDeviceSize blockSize)
+    : device_(device), faults_(faults), blockSize_(blockSize) {
     vkGetPhysicalDeviceMemoryProperties(physicalDevice, &properties_);
 }
 
@@ -144,7 +145,8 @@ uint32_t MemoryAllocator::createBlock(uint32_t memoryTypeIndex, VkDeviceSize siz
     block.memoryTypeIndex = memoryTypeIndex;
     block.linear = linear;
     block.dedicated = dedicated;
-    VkResult result = vkAllocateMemory(device_, &info, nullptr, &block.memory);
+    VkResult result = faults_ ? faults_->next(FaultSite::Allocation) : VK_SUCCESS;
+    if (result == VK_SUCCESS) result = vkAllocateMemory(device_, &info, nullptr, &block.memory);
     if (result != VK_SUCCESS) {
         throw GpuError("memory: allocating " + std::to_string(size) + " bytes for '" + std::string(name) +
                        "' failed: " + std::string(resultName(result)));

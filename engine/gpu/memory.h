@@ -4,6 +4,8 @@
 // more than one resource; the render graph uses that to alias transients
 // whose lifetimes do not overlap.
 
+#include "gpu/fault.h"
+
 #include <vulkan/vulkan.h>
 
 #include <cstdint>
@@ -92,7 +94,9 @@ class MemoryAllocator {
 public:
     // Blocks are `blockSize` bytes; a request over half of that gets a block
     // of its own so one large image does not strand a block's tail.
-    MemoryAllocator(VkPhysicalDevice physicalDevice, VkDevice device, VkDeviceSize blockSize = 64ull << 20);
+    // `faults` (may be null) is asked before each vkAllocateMemory.
+    MemoryAllocator(VkPhysicalDevice physicalDevice, VkDevice device, FaultInjector* faults = nullptr,
+                    VkDeviceSize blockSize = 64ull << 20);
     ~MemoryAllocator();
     MemoryAllocator(const MemoryAllocator&) = delete;
     MemoryAllocator& operator=(const MemoryAllocator&) = delete;
@@ -120,6 +124,7 @@ private:
     void release(uint32_t block, uint64_t offset, uint64_t size);
 
     VkDevice device_;
+    FaultInjector* faults_ = nullptr;
     VkPhysicalDeviceMemoryProperties properties_{};
     VkDeviceSize blockSize_;
     mutable std::mutex mutex_;

@@ -178,7 +178,7 @@ Executor::~Executor() {
     try {
         waitIdle();
     } catch (const std::exception& e) {
-        spdlog::error("render graph: waiting for the GPU at shutdown failed: {}", e.what());
+        spdlog::warn("render graph: releasing its objects without the GPU idle: {}", e.what());
     }
 }
 
@@ -402,7 +402,7 @@ void Executor::prepareHistory(const Plan& plan) {
                     gpu_, bufferDescOf(current.buffer, r.bufferUsage | VK_BUFFER_USAGE_TRANSFER_DST_BIT, halfName, shared));
             }
         }
-        gpu::submitAndWait(gpu_, gpu_.graphicsQueue(), "rg.history.init " + name, [&](VkCommandBuffer cmd) {
+        gpu::submitAndWait(gpu_, gpu_.graphicsQueue(), "render graph: clearing history '" + name + "'", [&](VkCommandBuffer cmd) {
             for (uint32_t k = 0; k < 2; ++k) {
                 const VkImageLayout entry = k == h->current ? r.entryLayout : prevPlan.entryLayout;
                 if (r.kind == ResourceKind::Texture) {
@@ -638,6 +638,27 @@ Executor::ExternalSync Executor::placeSemaphores(const Plan& plan, const FrameRe
     return out;
 }
 
+namespace {
+
+// "passes 'a' to 'b' (n)", or "pass 'a'": what a failed submission held.
+std::string batchPassNames(const Plan& plan, const Batch& batch) {
+    const auto passes = plan.passesOf(batch);
+    if (passes.empty()) return "no passes";
+    const std::string first(plan.passName(passes.front()));
+    if (passes.size() == 1) return "pass '" + first + "'";
+    return "passes '" + first + "' to '" + std::string(plan.passName(passes.back())) + "' (" +
+           std::to_string(passes.size()) + ")";
+}
+
+// vkQueueWaitIdle; throws naming `what` the host waited for.
+void queueWaitIdle(gpu::Context& gpu, VkQueue queue, const std::string& what) {
+    VkResult result = vkQueueWaitIdle(queue);
+    if (result == VK_SUCCESS) result = gpu.faults().next(gpu::FaultSite::Wait);
+    gpu::check(result, "vkQueueWaitIdle (render graph, " + what + ")");
+}
+
+} // namespace
+
 void Executor::wait(const SubmittedFrame& frame) const {
     for (uint32_t q = 0; q < kQueueCount; ++q) {
         if (frame.timelineValue[q] != 0) timelines_[q].wait(frame.timelineValue[q]);
@@ -665,8 +686,14 @@ SubmittedFrame Executor::run(const Plan& plan, const FrameResources& imports) {
     // ---- the slot of this frame: wait for the frame that used it last
     FrameSlot& slot = *slots_[frame_ % framesInFlight_];
     if (slot.used) {
-        for (uint32_t q = 0; q < kQueueCount; ++q) {
-            timelines_[q].wait(slot.endValue[q]);
+        try {
+            for (uint32_t q = 0; q < kQueueCount; ++q) {
+                timelines_[q].wait(slot.endValue[q]);
+            }
+        } catch (const gpu::GpuError& e) {
+            throw gpu::GpuError("render graph: waiting for frame " + std::to_string(slot.frame) +
+                                " to finish before frame " + std::to_string(frame_) + " reuses its command buffers: " +
+                                e.what());
         }
     }
     slot.pools[0].reset();
@@ -791,9 +818,11 @@ SubmittedFrame Executor::run(const Plan& plan, const FrameResources& imports) {
                 spanStart = std::chrono::steady_clock::now();
                 spanSubmitted = true;
             }
-            gpu::check(vkQueueSubmit2(queue, 1, &info, VK_NULL_HANDLE),
-                       "vkQueueSubmit2 (render graph, " + std::string(toString(batch.queue)) + " batch " +
-                           std::to_string(batch.ordinal) + ")");
+            VkResult result = gpu_.faults().next(gpu::FaultSite::Submit);
+            if (result == VK_SUCCESS) result = vkQueueSubmit2(queue, 1, &info, VK_NULL_HANDLE);
+            gpu::check(result, "vkQueueSubmit2 (render graph frame " + std::to_string(frame_) + ", " +
+                                   std::string(toString(batch.queue)) + " batch " + std::to_string(batch.ordinal) +
+                                   ": " + batchPassNames(plan, batch) + ")");
             first = false;
         };
 
@@ -811,8 +840,7 @@ SubmittedFrame Executor::run(const Plan& plan, const FrameResources& imports) {
             } else if (hostTimed && &p == spanFirst) {
                 // The span starts on an idle queue: what precedes it goes first.
                 submit(false);
-                gpu::check(vkQueueWaitIdle(queue), "vkQueueWaitIdle (render graph, before timed span '" +
-                                                       span_->name + "')");
+                queueWaitIdle(gpu_, queue, "before timed span '" + span_->name + "'");
                 begin();
                 inSpan = true;
             }
@@ -856,7 +884,7 @@ SubmittedFrame Executor::run(const Plan& plan, const FrameResources& imports) {
                     recordBarriers(cmd, plan, plan.barriersAfter(batch));
                 }
                 submit(lastPass);
-                gpu::check(vkQueueWaitIdle(queue), "vkQueueWaitIdle (render graph, timed span '" + span_->name + "')");
+                queueWaitIdle(gpu_, queue, "timed span '" + span_->name + "'");
                 slot.spanMilliseconds =
                     std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - spanStart).count();
                 slot.spanRecorded = true;
@@ -876,7 +904,7 @@ SubmittedFrame Executor::run(const Plan& plan, const FrameResources& imports) {
                 const auto start = std::chrono::steady_clock::now();
                 const double cpuStart = processCpuMilliseconds();
                 submit(lastPass);
-                gpu::check(vkQueueWaitIdle(queue), "vkQueueWaitIdle (render graph, host-timed pass '" + ctx.name_ + "')");
+                queueWaitIdle(gpu_, queue, "host-timed pass '" + ctx.name_ + "'");
                 slot.passes[pair].milliseconds =
                     std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
                 slot.passes[pair].cpuMilliseconds = processCpuMilliseconds() - cpuStart;
@@ -891,6 +919,9 @@ SubmittedFrame Executor::run(const Plan& plan, const FrameResources& imports) {
             submit(true);
         }
         lastSignal_[qi] = std::max(lastSignal_[qi], signalValue);
+        // Kept up to date batch by batch: if a later submission fails, the
+        // slot's next use still waits for what this frame did submit.
+        slot.endValue[qi] = lastSignal_[qi];
     }
     if (!external.unplacedWaits.empty() || !external.unplacedSignals.empty()) {
         // No batch to carry them: a submission of their own keeps the
@@ -900,8 +931,9 @@ SubmittedFrame Executor::run(const Plan& plan, const FrameResources& imports) {
         info.pWaitSemaphoreInfos = external.unplacedWaits.data();
         info.signalSemaphoreInfoCount = static_cast<uint32_t>(external.unplacedSignals.size());
         info.pSignalSemaphoreInfos = external.unplacedSignals.data();
-        gpu::check(vkQueueSubmit2(gpu_.graphicsQueue().queue, 1, &info, VK_NULL_HANDLE),
-                   "vkQueueSubmit2 (render graph, semaphores of an empty plan)");
+        VkResult result = gpu_.faults().next(gpu::FaultSite::Submit);
+        if (result == VK_SUCCESS) result = vkQueueSubmit2(gpu_.graphicsQueue().queue, 1, &info, VK_NULL_HANDLE);
+        gpu::check(result, "vkQueueSubmit2 (render graph, semaphores of an empty plan)");
     }
     SubmittedFrame submitted;
     submitted.frame = frame_;

@@ -186,13 +186,7 @@ public:
         lastTime_ = glfwGetTime();
     }
 
-    ~Viewer() {
-        try {
-            ctx_.waitIdle();
-        } catch (const std::exception& e) {
-            spdlog::error("viewer: waiting for the GPU at exit failed: {}", e.what());
-        }
-    }
+    ~Viewer() { ctx_.waitIdleForTeardown("viewer"); }
 
     // Until the window closes, or after `frames` frames presented or skipped (0: no limit).
     void run(uint32_t frames) {
