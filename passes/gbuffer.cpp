@@ -424,7 +424,6 @@ std::shared_ptr<GBufferRenderer::FrameWork> GBufferRenderer::prepare(const GBuff
                                                                      const GBufferSettings& settings) {
     ++frame_;
     auto work = std::make_shared<FrameWork>();
-    work->frameNumber = frame_;
     work->slot = uint32_t(frame_ % framesInFlight_);
     stats_.frame = frame_;
     work->drawSky = settings.drawSky;

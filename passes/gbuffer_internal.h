@@ -106,7 +106,6 @@ struct GBufferRenderer::FrameSlot {
 
 // What one frame draws, copied from the scene and camera at declaration.
 struct GBufferRenderer::FrameWork {
-    uint64_t frameNumber = 0;  // GBufferRenderer::frame_ when prepared
     uint32_t slot = 0;
     bool drawSky = true;
     shader::GBufferFrame frame{};

@@ -1149,8 +1149,9 @@ private:
                 }
             }
             noteFirstUses(out.size(), resource, texture, q, info, i, j);
-            out.emplace_back(resource, Subresource{mip, 1, layer, layerCount}, aspect, srcStages, srcAccess, s.stages,
-                             s.access, oldLayout, texture ? s.layout : VK_IMAGE_LAYOUT_UNDEFINED, false);
+            out.emplace_back(Barrier{resource, Subresource{mip, 1, layer, layerCount}, aspect, srcStages, srcAccess,
+                                     s.stages, s.access, oldLayout, texture ? s.layout : VK_IMAGE_LAYOUT_UNDEFINED,
+                                     false});
             i = j;
         }
         if (st_.log) {
@@ -1180,14 +1181,15 @@ private:
         if (n.firstUse) [[unlikely]]
             firstUses_.push_back(
                 {static_cast<uint32_t>(st_.plan.barriers.size()), n.cell, resource, q, ref.texture, ref.info});
-        // Constructed from its fields: value-initialising it first would store
-        // every field twice. The aspect is read only when a barrier needs it;
-        // the aliasing flag is set by resolveFirstUses() where bytes are shared.
-        const Barrier& b = st_.plan.barriers.emplace_back(
+        // Constructed from its fields (braces: clang 14 has no parenthesised
+        // aggregate initialisation). The aspect is read only when a barrier
+        // needs it; the aliasing flag is set by resolveFirstUses() where
+        // bytes are shared.
+        const Barrier& b = st_.plan.barriers.emplace_back(Barrier{
             resource, ref.texture ? Subresource{range.baseMip, 1, range.baseLayer, 1} : Subresource{0, 1, 0, 1},
             ref.texture ? st_.plan.resources[resource].aspect : 0, n.srcStages, n.srcAccess, s.stages, s.access,
             ref.texture ? n.oldLayout : VK_IMAGE_LAYOUT_UNDEFINED, ref.texture ? s.layout : VK_IMAGE_LAYOUT_UNDEFINED,
-            false);
+            false});
         if (st_.log && !n.firstUse) {
             const ir::Resource& r = d_.resources[resource];
             spdlog::debug("rg barriers: {}", describeBarrier(r.name, b, r.kind));

@@ -3,6 +3,7 @@
 #include <spdlog/spdlog.h>
 
 #include "graph/compile_state.h"
+#include "graph/error.h"
 #include "graph/graph.h"
 
 namespace glint::rg {
@@ -73,6 +74,18 @@ Plan compile(const Graph& graph, const QueueCaps& caps, const CompileOptions& op
     plan.declaration = graph.decl_;
     graph.mayBeShared_.store(true, std::memory_order_relaxed);
     plan.stats.declaredPasses = static_cast<uint32_t>(graph.decl_->passes.size());
+
+    // An import the graph must leave in a final state has to start from a
+    // known one, used or not: moving it from an unknown state races
+    // whatever last touched it (the previous frame's own move, for one).
+    for (const ir::Resource& r : graph.decl_->resources) {
+        if (r.origin == ir::Origin::Imported && r.hasFinal && !r.hasInitial &&
+            (r.final.isRaw || r.final.access != Access::None)) [[unlikely]] {
+            throw GraphError(ErrorKind::ImportWithoutState, "(graph)", std::string(r.name),
+                             "was imported with a final state but no initial state; the graph cannot move it from "
+                             "an unknown state");
+        }
+    }
 
     detail::CompileState state{*graph.decl_, caps, options, plan};
     state.log = spdlog::should_log(spdlog::level::debug);

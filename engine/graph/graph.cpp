@@ -111,10 +111,9 @@ inline uint32_t appendUse(ir::Declaration& d, uint32_t pass, uint32_t index, uin
                           bool write, const Subresource& range) {
     ir::Resource& r = d.resources[index];
     r.lastUser = pass;
-    // Built in place, each field stored once: assembling it on the stack and
-    // copying it stalls on store forwarding, and this runs for every use of
-    // every pass.
-    d.uses.emplace_back(index, version, r.lastWriter, bit, write, range);
+    // Braces, not parentheses: clang 14 (the fuzz build) has no
+    // parenthesised aggregate initialisation.
+    d.uses.emplace_back(ir::Use{index, version, r.lastWriter, bit, write, range});
     ir::Pass& owner = d.passes[pass];
     ++owner.useCount;
     owner.kinds |= bit;

@@ -322,3 +322,22 @@ TEST_CASE("descriptions that cannot be created are refused") {
     CHECK_THROWS_AS(g.createTexture("mips", TextureDesc{4, 4, 1, 1, 4, VK_FORMAT_R8_UNORM}), GraphError);
     CHECK_THROWS_AS(g.createBuffer("zero", {0}), GraphError);
 }
+
+TEST_CASE("an import with a final state but no initial state is refused at compile, used or not") {
+    // Found by the graph fuzzer: unused, it was moved to its final state
+    // from an unknown one every frame, racing the previous frame's move.
+    Graph g(twoQueues());
+    g.importTexture("orphan", {tex(64, VK_FORMAT_R8G8B8A8_UNORM, 4), std::nullopt,
+                               BoundaryState::of(Access::StorageWrite)});
+    try {
+        compile(g, g.caps());
+        FAIL("no GraphError was thrown");
+    } catch (const GraphError& e) {
+        CHECK((e.kind() == ErrorKind::ImportWithoutState));
+        CHECK(std::string(e.what()).find("orphan") != std::string::npos);
+    }
+    // A final state of None asks for nothing: compiles.
+    Graph quiet(twoQueues());
+    quiet.importTexture("orphan", {tex(), std::nullopt, BoundaryState::of(Access::None)});
+    CHECK(compile(quiet, quiet.caps()).passes.empty());
+}
