@@ -724,38 +724,26 @@ void GBufferRenderer::record(const FrameWork& work, rg::PassContext& pc, const G
     stats_.texturedDraws = 0;
     stats_.maskedDraws = 0;
     vkCmdBindIndexBuffer(cmd, indices_.handle(), 0, VK_INDEX_TYPE_UINT32);
-    VkCullModeFlags cullMode = VK_CULL_MODE_NONE;
-    VkFrontFace frontFace = VK_FRONT_FACE_COUNTER_CLOCKWISE;
+    Facing facing;
     // Opaque draws first, then the alpha-tested ones with their own
     // pipeline: the discard costs early depth testing only where it exists,
     // and the opaque depth already rejects what the cutouts hide behind.
     for (const bool masked : {false, true}) {
         const gpu::Pipeline& pipeline = masked ? surfaceMaskedPipeline_ : surfacePipeline_;
         pipeline.bind(cmd);
-        vkCmdSetCullMode(cmd, cullMode);
-        vkCmdSetFrontFace(cmd, frontFace);
+        facing.bind(cmd);
         const gpu::Buffer* boundVertices = &vertices_;
         MaterialTextures boundTextures = fallbacks;
         pushBindings(pipeline, *boundVertices, boundTextures);
         for (size_t i = 0; i < work.instances.size(); ++i) {
             if (!work.visible[i]) continue;
             const auto [vertices, vertexShift] = vertexSource(work, i, slot);
-            const VkFrontFace instanceFront =
-                work.mirrored[i] ? VK_FRONT_FACE_CLOCKWISE : VK_FRONT_FACE_COUNTER_CLOCKWISE;
             for (const DrawRange& range : meshDraws_.at(work.meshes[i])) {
                 // Blended surfaces are drawn by the transparent pass.
                 if (range.indexCount == 0 || range.coverage != (masked ? Coverage::Masked : Coverage::Opaque)) {
                     continue;
                 }
-                if (instanceFront != frontFace) {
-                    frontFace = instanceFront;
-                    vkCmdSetFrontFace(cmd, frontFace);
-                }
-                const VkCullModeFlags rangeCull = range.doubleSided ? VK_CULL_MODE_NONE : VK_CULL_MODE_BACK_BIT;
-                if (rangeCull != cullMode) {
-                    cullMode = rangeCull;
-                    vkCmdSetCullMode(cmd, cullMode);
-                }
+                facing.set(cmd, work.mirrored[i] != 0, range.doubleSided);
                 MaterialTextures textures = boundTextures;
                 const bool textured = rangeTextures(range, textures);
                 stats_.normalMappedDraws += range.material.normalMap != 0 ? 1u : 0u;

@@ -62,6 +62,34 @@ enum class Coverage : uint8_t {
     Blended,  // BLEND: only the transparent pass (passes/transparent.h)
 };
 
+// The dynamic facing state of a command buffer, set per draw only where it
+// changes. glTF: front faces wind counter-clockwise on screen (the
+// projection flips Y with the framebuffer), clockwise under a mirroring
+// transform; single-sided materials cull back faces, double-sided ones
+// cull nothing.
+struct Facing {
+    VkCullModeFlags cull = VK_CULL_MODE_NONE;
+    VkFrontFace front = VK_FRONT_FACE_COUNTER_CLOCKWISE;
+
+    // After a pipeline bind: the state as it stands.
+    void bind(VkCommandBuffer cmd) const {
+        vkCmdSetCullMode(cmd, cull);
+        vkCmdSetFrontFace(cmd, front);
+    }
+    void set(VkCommandBuffer cmd, bool mirrored, bool doubleSided) {
+        const VkFrontFace f = mirrored ? VK_FRONT_FACE_CLOCKWISE : VK_FRONT_FACE_COUNTER_CLOCKWISE;
+        if (f != front) {
+            front = f;
+            vkCmdSetFrontFace(cmd, front);
+        }
+        const VkCullModeFlags c = doubleSided ? VK_CULL_MODE_NONE : VK_CULL_MODE_BACK_BIT;
+        if (c != cull) {
+            cull = c;
+            vkCmdSetCullMode(cmd, cull);
+        }
+    }
+};
+
 } // namespace glint::passes::gbuffer_detail
 
 namespace glint::passes {

@@ -94,27 +94,15 @@ void GBufferRenderer::recordTransparent(const FrameWork& work, const std::vector
         vkCmdBindIndexBuffer(cmd, indices_.handle(), 0, VK_INDEX_TYPE_UINT32);
         const gpu::Pipeline& pipeline = transparentPipeline_;
         pipeline.bind(cmd);
-        VkCullModeFlags cullMode = VK_CULL_MODE_NONE;
-        VkFrontFace frontFace = VK_FRONT_FACE_COUNTER_CLOCKWISE;
-        vkCmdSetCullMode(cmd, cullMode);
-        vkCmdSetFrontFace(cmd, frontFace);
+        Facing facing;
+        facing.bind(cmd);
         const gpu::Buffer* boundVertices = &vertices_;
         MaterialTextures boundTextures = fallbackTextures();
         pushSurfaceBindings(pipeline, pc, slot, *boundVertices, boundTextures, gbuf.shadowMap, environment);
         for (const TransparentDraw& d : draws) {
             const DrawRange& range = *d.range;
             const auto [vertices, vertexShift] = vertexSource(work, d.instance, slot);
-            const VkFrontFace instanceFront =
-                work.mirrored[d.instance] ? VK_FRONT_FACE_CLOCKWISE : VK_FRONT_FACE_COUNTER_CLOCKWISE;
-            if (instanceFront != frontFace) {
-                frontFace = instanceFront;
-                vkCmdSetFrontFace(cmd, frontFace);
-            }
-            const VkCullModeFlags rangeCull = range.doubleSided ? VK_CULL_MODE_NONE : VK_CULL_MODE_BACK_BIT;
-            if (rangeCull != cullMode) {
-                cullMode = rangeCull;
-                vkCmdSetCullMode(cmd, cullMode);
-            }
+            facing.set(cmd, work.mirrored[d.instance] != 0, range.doubleSided);
             MaterialTextures textures = boundTextures;
             rangeTextures(range, textures);
             if (vertices != boundVertices || textures != boundTextures) {

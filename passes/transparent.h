@@ -1,6 +1,8 @@
 #pragma once
-// Blended surfaces (glTF alphaMode BLEND): one raster pass on the graphics
-// queue, "transparent", after the reflections are resolved.
+// Blended surfaces (glTF alphaMode BLEND): two passes on the graphics
+// queue after the reflections are resolved, a compute clear of their layer
+// ("transparent.clear") and the raster pass that draws them
+// ("transparent"), declared only in frames with a blended surface in view.
 //
 // The G-buffer, the shadow map and the BVH leave blended geometry out, so
 // no pass that reads them sees it: SSLR cannot hit it, ray-traced
@@ -38,7 +40,9 @@
 // Known limits: a surface behind a blended one gets its reflection as
 // usual, but a blended surface's own reflection shows the environment
 // only, never the scene; intersecting blended surfaces, and a concave
-// blended mesh, sort per geometry, not per pixel.
+// blended mesh, sort per geometry, not per pixel; particles (drawn into
+// the lit colour, passes/particles.h) end up under blended surfaces even
+// where they are in front of them.
 
 #include "graph/graph.h"
 #include "passes/gbuffer.h"
