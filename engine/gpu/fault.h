@@ -3,7 +3,8 @@
 // failure does to the program: the Nth device memory allocation, queue
 // submission or host wait (fence or timeline semaphore) reports the chosen
 // VkResult, as a driver would. ContextOptions::fault sets it up; every call
-// site of the three kinds asks the Context's injector first.
+// site of the three kinds asks the Context's injector (before allocating
+// or submitting, after waiting).
 //
 // A submission that fails was not made (nothing of it runs); a wait that
 // fails waited first, so the work it waited for is finished (a test's
