@@ -1,5 +1,6 @@
 #include "passes/particles.h"
 
+#include "gpu/commands.h"
 #include "gpu/descriptors.h"
 #include "gpu/error.h"
 #include "graph/executor.h"
@@ -353,28 +354,8 @@ ParticleForwardOutputs addParticleForwardPass(rg::Graph& graph, ParticlePipeline
         },
         [&pipelines, push](const ForwardData& d, rg::PassContext& pc) {
             const VkCommandBuffer cmd = pc.cmd();
-            VkRenderingAttachmentInfo color{VK_STRUCTURE_TYPE_RENDERING_ATTACHMENT_INFO};
-            color.imageView = pc.view(d.lit);
-            color.imageLayout = pc.layout(d.lit);
-            color.loadOp = VK_ATTACHMENT_LOAD_OP_LOAD;
-            color.storeOp = VK_ATTACHMENT_STORE_OP_STORE;
-            VkRenderingAttachmentInfo depth{VK_STRUCTURE_TYPE_RENDERING_ATTACHMENT_INFO};
-            depth.imageView = pc.view(d.depth);
-            depth.imageLayout = pc.layout(d.depth);
-            depth.loadOp = VK_ATTACHMENT_LOAD_OP_LOAD;
-            depth.storeOp = VK_ATTACHMENT_STORE_OP_NONE;  // tested, never written
-            VkRenderingInfo rendering{VK_STRUCTURE_TYPE_RENDERING_INFO};
-            rendering.renderArea = {{0, 0}, {d.width, d.height}};
-            rendering.layerCount = 1;
-            rendering.colorAttachmentCount = 1;
-            rendering.pColorAttachments = &color;
-            rendering.pDepthAttachment = &depth;
-            vkCmdBeginRendering(cmd, &rendering);
-            // Positive height: the projection already flips Y for Vulkan.
-            const VkViewport viewport{0.0f, 0.0f, float(d.width), float(d.height), 0.0f, 1.0f};
-            const VkRect2D scissor{{0, 0}, {d.width, d.height}};
-            vkCmdSetViewport(cmd, 0, 1, &viewport);
-            vkCmdSetScissor(cmd, 0, 1, &scissor);
+            gpu::beginRenderingOverDepth(cmd, pc.view(d.lit), pc.layout(d.lit), pc.view(d.depth), pc.layout(d.depth),
+                                         {d.width, d.height});
             const gpu::Pipeline& pipeline = pipelines.forward_;
             pipeline.bind(cmd);
             gpu::PushDescriptors(pipeline).storageBuffer(0, pc.buffer(d.particles)).push(pc.gpu(), cmd);

@@ -67,30 +67,10 @@ void GBufferRenderer::recordTransparent(const FrameWork& work, const std::vector
     const VkCommandBuffer cmd = pc.cmd();
     const FrameSlot& slot = *slots_[work.slot];
 
-    // The layer was cleared by the pass before (a compute clear).
-    VkRenderingAttachmentInfo color{VK_STRUCTURE_TYPE_RENDERING_ATTACHMENT_INFO};
-    color.imageView = pc.view(layer);
-    color.imageLayout = pc.layout(layer);
-    color.loadOp = VK_ATTACHMENT_LOAD_OP_LOAD;
-    color.storeOp = VK_ATTACHMENT_STORE_OP_STORE;
-    VkRenderingAttachmentInfo depth{VK_STRUCTURE_TYPE_RENDERING_ATTACHMENT_INFO};
-    depth.imageView = pc.view(gbuf.depth);
-    depth.imageLayout = pc.layout(gbuf.depth);
-    depth.loadOp = VK_ATTACHMENT_LOAD_OP_LOAD;
-    depth.storeOp = VK_ATTACHMENT_STORE_OP_NONE;  // tested, never written
-    VkRenderingInfo rendering{VK_STRUCTURE_TYPE_RENDERING_INFO};
-    rendering.renderArea = {{0, 0}, {gbuf.width, gbuf.height}};
-    rendering.layerCount = 1;
-    rendering.colorAttachmentCount = 1;
-    rendering.pColorAttachments = &color;
-    rendering.pDepthAttachment = &depth;
-    vkCmdBeginRendering(cmd, &rendering);
-
+    // Over the layer the pass before cleared (a compute clear).
+    gpu::beginRenderingOverDepth(cmd, pc.view(layer), pc.layout(layer), pc.view(gbuf.depth), pc.layout(gbuf.depth),
+                                 {gbuf.width, gbuf.height});
     if (!draws.empty()) {
-        const VkViewport viewport{0.0f, 0.0f, float(gbuf.width), float(gbuf.height), 0.0f, 1.0f};
-        const VkRect2D scissor{{0, 0}, {gbuf.width, gbuf.height}};
-        vkCmdSetViewport(cmd, 0, 1, &viewport);
-        vkCmdSetScissor(cmd, 0, 1, &scissor);
         vkCmdBindIndexBuffer(cmd, indices_.handle(), 0, VK_INDEX_TYPE_UINT32);
         const gpu::Pipeline& pipeline = transparentPipeline_;
         pipeline.bind(cmd);

@@ -75,6 +75,15 @@ void imageBarrier(VkCommandBuffer cmd, const Image& image, const VkImageSubresou
 void memoryBarrier(VkCommandBuffer cmd, VkPipelineStageFlags2 srcStage, VkAccessFlags2 srcAccess,
                    VkPipelineStageFlags2 dstStage, VkAccessFlags2 dstAccess);
 
+// Dynamic rendering that draws over what a colour attachment holds (loaded
+// and stored) behind a depth attachment that is tested, never written
+// (loaded, not stored), both in the layouts given; the viewport and scissor
+// cover `extent` (positive height: Glint's projections flip Y themselves).
+// The forward passes over the G-buffer (particles, blended surfaces) draw
+// this way. End with vkCmdEndRendering.
+void beginRenderingOverDepth(VkCommandBuffer cmd, VkImageView color, VkImageLayout colorLayout, VkImageView depth,
+                             VkImageLayout depthLayout, VkExtent2D extent);
+
 // Debug-utils label around a region of a command buffer.
 class ScopedLabel {
 public:
