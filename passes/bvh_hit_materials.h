@@ -3,9 +3,10 @@
 // (glint/alpha_test.h): per primitive offset row a shader::RtGeometryMaterial
 // (the material's mean emission and its alpha test), and for alpha-tested
 // geometry (glTF alphaMode MASK) the per-triangle texture coordinates and
-// alpha and the alpha mask array. Built once from the scene when the
-// passes::BvhManager is created: emission and alpha do not change from frame
-// to frame, only which rows the TLAS uses.
+// alpha and the alpha mask array. Built from the scene when the
+// passes::BvhManager is created, and again when the scene's assets change
+// (scene::Scene::assetRevision): emission and alpha do not change from
+// frame to frame otherwise, only which rows the TLAS uses.
 
 #include "gpu/context.h"
 #include "gpu/resources.h"

@@ -11,6 +11,8 @@
 #include "glint/packing.h"
 #include "glint/particles_shared.h"
 
+#include <spdlog/spdlog.h>
+
 #include <algorithm>
 #include <bit>
 #include <cstring>
@@ -175,7 +177,8 @@ BvhManager::BvhManager(gpu::Context& ctx, const scene::Scene& scene, uint32_t fr
       scene_(scene),
       framesInFlight_(std::max(framesInFlight, 1u)),
       options_(options),
-      hitMaterials_(ctx, scene, options.hitMaterials) {
+      hitMaterials_(std::make_unique<HitMaterials>(ctx, scene, options.hitMaterials)),
+      assets_(scene::assetStamp(scene)) {
     const VkShaderStageFlags cs = VK_SHADER_STAGE_COMPUTE_BIT;
     packPipeline_ = gpu::createComputePipeline(
         ctx, {"bvh/pack_primitives.comp",
@@ -216,8 +219,8 @@ void BvhManager::bind(rg::FrameResources& resources, const BvhUpdateOutputs& out
     resources.bind(outputs.primitivePool, pool_);
     resources.bind(outputs.primitiveOffsets, offsets_);
     resources.bind(outputs.materials, materials_);
-    resources.bind(outputs.alphaTriangles, hitMaterials_.alphaTriangles());
-    resources.bind(outputs.alphaMasks, hitMaterials_.alphaMasks());
+    resources.bind(outputs.alphaTriangles, hitMaterials_->alphaTriangles());
+    resources.bind(outputs.alphaMasks, hitMaterials_->alphaMasks());
     if (outputs.particleTlas.valid()) {
         resources.bind(outputs.particleTlas, *particleTlas_);
         resources.bind(outputs.particles, particleData_);
@@ -284,7 +287,7 @@ BvhManager::ResidentBlas& BvhManager::createBlas(const scene::BlasDesc& desc, Fr
     VkDeviceSize first = 0;
     for (const scene::BlasGeometry& g : desc.geometries) {
         blas->sources.push_back(&sourceGeometry(desc.mesh, desc.lod, g.meshGeometry, work));
-        blas->materialRows.push_back(hitMaterials_.row(desc.mesh, desc.lod, g.meshGeometry));
+        blas->materialRows.push_back(hitMaterials_->row(desc.mesh, desc.lod, g.meshGeometry));
         gpu::TriangleGeometry t;
         t.vertices = blas->positions.address() + first * sizeof(glm::vec3);
         t.vertexCount = 3 * g.triangleCount;
@@ -521,6 +524,23 @@ std::shared_ptr<BvhManager::FrameWork> BvhManager::prepare(const scene::BvhPlan&
         retire(std::move(it->second));
         blases_.erase(it);
         ++stats_.blasReleased;
+    }
+
+    // Edited assets (Scene::assetRevision): the planner dropped every BLAS
+    // above; the geometry uploaded for them and the hit materials were made
+    // from the old meshes and materials.
+    if (const scene::AssetStamp assets = scene::assetStamp(scene_); assets != assets_) {
+        for (auto& [id, blas] : blases_) retire(std::move(blas));
+        blases_.clear();
+        for (auto& [key, source] : geometries_) retire(std::move(source));
+        geometries_.clear();
+        stats_.blasBytes = stats_.positionBytes = stats_.geometryBytes = 0;
+        stats_.uploadedGeometries = 0;
+        retire(std::move(hitMaterials_));
+        hitMaterials_ = std::make_unique<HitMaterials>(ctx_, scene_, options_.hitMaterials);
+        assets_ = assets;
+        spdlog::info("BVH: the scene's assets changed (revision {}): geometry and hit materials uploaded again",
+                     assets.revision);
     }
 
     // Static BLASes built in an earlier frame need their positions no more
@@ -882,7 +902,7 @@ BvhUpdateOutputs BvhManager::declare(rg::Graph& graph, BvhManager& manager, cons
             outputs.particleBoundsMax = glm::max(outputs.particleBoundsMax, p.position + reach);
         }
     }
-    const HitMaterials& hit = manager.hitMaterials_;
+    const HitMaterials& hit = *manager.hitMaterials_;
     outputs.alphaTriangles =
         graph.importBuffer("bvh.alpha_triangles", {{hit.alphaTriangles().size()}, bufferState, bufferState});
     const gpu::ImageDesc& masks = hit.alphaMasks().desc();

@@ -2,7 +2,8 @@
 // The GPU side of the BVH manager (issue 4): executes a scene::BvhPlan.
 //
 // BvhManager owns what lives across frames: the reflection-LOD geometry of
-// every mesh a BLAS was built from (uploaded once, material sampled at the
+// every mesh a BLAS was built from (uploaded once per asset revision,
+// scene::Scene::assetRevision; material sampled at the
 // vertices on the CPU, copied from staging inside the update pass of the
 // frame that first builds it: no submission of its own, no host wait; a
 // morphing instance's own BLAS instead gets its morphed vertices, morph
@@ -158,9 +159,10 @@ struct BvhUpdateOptions {
 
 class BvhManager {
 public:
-    // `scene` must outlive the manager; its meshes must not change (the
-    // planner's BLAS ids stand for them), its instances and joint palette
-    // may. `framesInFlight` must be at least the executor's: host-written
+    // `scene` must outlive the manager. Its instances and joint palette may
+    // change between frames; edited meshes, materials and textures
+    // (scene::Scene::assetRevision) are uploaded again, and the planner
+    // drops every BLAS built from them. `framesInFlight` must be at least the executor's: host-written
     // buffers are kept once per frame in flight.
     BvhManager(gpu::Context& ctx, const scene::Scene& scene, uint32_t framesInFlight = 2,
                const BvhUpdateOptions& options = {});
@@ -177,7 +179,7 @@ public:
     const gpu::Buffer& primitivePool() const { return pool_; }
     const gpu::Buffer& primitiveOffsets() const { return offsets_; }
     const gpu::Buffer& materials() const { return materials_; }
-    const HitMaterials& hitMaterials() const { return hitMaterials_; }
+    const HitMaterials& hitMaterials() const { return *hitMaterials_; }
     const gpu::AccelerationStructure& tlas() const { return *tlas_; }
     // Nullptr when the BLAS is not resident.
     const gpu::AccelerationStructure* blas(scene::BlasId id) const;
@@ -223,8 +225,10 @@ private:
     gpu::Buffer offsets_;                         // device-local, read by the traces
     std::vector<gpu::Buffer> offsetStaging_;      // host-visible, one per frame in flight
     // Per offset row, its geometry's material row (BvhUpdateOutputs::materials),
-    // sized with the offsets; the rows come from hitMaterials_, built once.
-    HitMaterials hitMaterials_;
+    // sized with the offsets; the rows come from hitMaterials_, built when
+    // the manager is made and again when the scene's assets change.
+    std::unique_ptr<HitMaterials> hitMaterials_;
+    scene::AssetStamp assets_;  // of the scene hitMaterials_ and geometries_ were made from
     gpu::Buffer materials_;
     std::vector<gpu::Buffer> materialStaging_;
     std::vector<gpu::Buffer> instanceBuffers_;    // host-visible TLAS instances, one per frame in flight

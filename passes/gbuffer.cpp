@@ -264,6 +264,18 @@ GBufferRenderer::GBufferRenderer(gpu::Context& ctx, const scene::Scene& scene, u
     white_ = gpu::createSampledImageWithMips(
         ctx, {.width = 1, .height = 1, .format = VK_FORMAT_R8G8B8A8_UNORM, .name = "gbuffer.white"}, white.data());
 
+    loadAssets();
+    for (uint32_t i = 0; i < framesInFlight_; ++i) {
+        slots_.push_back(std::make_unique<FrameSlot>());
+    }
+}
+
+void GBufferRenderer::loadAssets() {
+    assets_ = scene::assetStamp(scene_);
+    textureImages_.clear();
+    meshDraws_.clear();
+    morphBaseVertices_.clear();
+    hasBlended_ = false;
     // Material textures, uploaded with their mips the first time a drawn
     // geometry's material needs them, each once per colour space however
     // many materials share it. glTF: base colour and emissive are sRGB (the sampler
@@ -274,11 +286,11 @@ GBufferRenderer::GBufferRenderer(gpu::Context& ctx, const scene::Scene& scene, u
     std::set<size_t> normalImages;
     const auto textureImage = [&](const scene::TextureRef& ref, VkFormat format, const char* slotName) {
         if (!ref.valid()) return kNoImage;
-        const scene::Texture& texture = scene.textures.at(size_t(ref.texture));
+        const scene::Texture& texture = scene_.textures.at(size_t(ref.texture));
         if (texture.format != scene::TextureFormat::Rgba8) return kNoImage;
         const auto [it, added] = imageOf.try_emplace({ref.texture, format}, textureImages_.size());
         if (!added) return it->second;
-        textureImages_.push_back(gpu::createSampledImageWithMips(ctx,
+        textureImages_.push_back(gpu::createSampledImageWithMips(ctx_,
                                                                  {.width = texture.width,
                                                                   .height = texture.height,
                                                                   .format = format,
@@ -296,11 +308,11 @@ GBufferRenderer::GBufferRenderer(gpu::Context& ctx, const scene::Scene& scene, u
     // for the whole frame, draws differ only in their ranges.
     std::vector<shader::GBufferVertex> vertices;
     std::vector<uint32_t> indices;
-    meshDraws_.resize(scene.meshes.size());
-    meshFirstVertex_.assign(scene.meshes.size(), 0);
-    morphBaseVertices_.resize(scene.meshes.size());
-    for (size_t m = 0; m < scene.meshes.size(); ++m) {
-        const scene::Mesh& mesh = scene.meshes[m];
+    meshDraws_.resize(scene_.meshes.size());
+    meshFirstVertex_.assign(scene_.meshes.size(), 0);
+    morphBaseVertices_.resize(scene_.meshes.size());
+    for (size_t m = 0; m < scene_.meshes.size(); ++m) {
+        const scene::Mesh& mesh = scene_.meshes[m];
         meshFirstVertex_[m] = int32_t(vertices.size());
         if (mesh.lods.empty()) continue;
         for (const scene::Geometry& g : mesh.lods[0].geometries) {
@@ -308,7 +320,7 @@ GBufferRenderer::GBufferRenderer(gpu::Context& ctx, const scene::Scene& scene, u
             range.firstIndex = uint32_t(indices.size());
             range.indexCount = uint32_t(g.indices.size());
             range.vertexOffset = int32_t(vertices.size());
-            const scene::Material& material = scene.materials.at(g.material);
+            const scene::Material& material = scene_.materials.at(g.material);
             range.doubleSided = material.doubleSided;
             range.coverage = material.alphaMode == scene::AlphaMode::Mask    ? Coverage::Masked
                              : material.alphaMode == scene::AlphaMode::Blend ? Coverage::Blended
@@ -343,7 +355,7 @@ GBufferRenderer::GBufferRenderer(gpu::Context& ctx, const scene::Scene& scene, u
             useSlot(kEmissiveSlot, material.emissiveTexture, VK_FORMAT_R8G8B8A8_SRGB, "emissive",
                     emissiveFactor != glm::vec3(0.0f), draw.emissiveMap, draw.emissiveUvTransform);
             for (uint32_t v = 0; v < g.vertexCount(); ++v) {
-                const shader::SurfaceVertex s = scene::surfaceAtVertex(scene, g, v);
+                const shader::SurfaceVertex s = scene::surfaceAtVertex(scene_, g, v);
                 shader::GBufferVertex out{};
                 out.position = g.positions[v];
                 out.normal = s.normal;
@@ -365,7 +377,7 @@ GBufferRenderer::GBufferRenderer(gpu::Context& ctx, const scene::Scene& scene, u
                 // Per pixel the texel multiplies the factor; else (no
                 // texture, or not 8-bit) the vertex holds it all.
                 out.emissive = range.material.emissiveMap != 0 ? emissiveFactor
-                                                               : scene::emissionAtVertex(scene, g, v);
+                                                               : scene::emissionAtVertex(scene_, g, v);
                 if (g.skinned()) {
                     const glm::u16vec4 j = g.joints[v];
                     out.joints = {uint32_t(j.x) | uint32_t(j.y) << 16, uint32_t(j.z) | uint32_t(j.w) << 16};
@@ -390,13 +402,13 @@ GBufferRenderer::GBufferRenderer(gpu::Context& ctx, const scene::Scene& scene, u
     // Vulkan buffers cannot be empty; an empty scene still binds something.
     if (vertices.empty()) vertices.push_back({});
     if (indices.empty()) indices.push_back(0);
-    vertices_ = gpu::createBufferWithData(ctx, {vertices.size() * sizeof(vertices[0]), VK_BUFFER_USAGE_STORAGE_BUFFER_BIT,
+    vertices_ = gpu::createBufferWithData(ctx_, {vertices.size() * sizeof(vertices[0]), VK_BUFFER_USAGE_STORAGE_BUFFER_BIT,
                                                 gpu::MemoryUsage::DeviceLocal, "gbuffer.vertices"},
                                           vertices.data());
-    indices_ = gpu::createBufferWithData(ctx, {indices.size() * sizeof(uint32_t), VK_BUFFER_USAGE_INDEX_BUFFER_BIT,
+    indices_ = gpu::createBufferWithData(ctx_, {indices.size() * sizeof(uint32_t), VK_BUFFER_USAGE_INDEX_BUFFER_BIT,
                                                gpu::MemoryUsage::DeviceLocal, "gbuffer.indices"},
                                          indices.data());
-    if (hasBlended_) transparentPipeline_ = createTransparentPipeline();
+    if (hasBlended_ && transparentPipeline_.handle() == VK_NULL_HANDLE) transparentPipeline_ = createTransparentPipeline();
     stats_.geometryBytes = vertices_.size() + indices_.size();
     stats_.textureImages = uint32_t(textureImages_.size());
     stats_.textureBytes = textureBytes;
@@ -405,9 +417,17 @@ GBufferRenderer::GBufferRenderer(gpu::Context& ctx, const scene::Scene& scene, u
                  "normal maps",
                  stats_.textureImages, double(textureBytes) / (1024.0 * 1024.0), stats_.normalMaps);
 
-    for (uint32_t i = 0; i < framesInFlight_; ++i) {
-        slots_.push_back(std::make_unique<FrameSlot>());
-    }
+}
+
+void GBufferRenderer::reloadAssetsIfEdited() {
+    // Frames up to frame_ - 1 may still read what is retired here; prepare()
+    // for frame N runs before the executor waits for frame N - framesInFlight.
+    std::erase_if(retired_, [&](const RetiredAssets& r) { return r.lastUse + framesInFlight_ < frame_; });
+    if (scene::assetStamp(scene_) == assets_) return;
+    retired_.push_back({frame_, std::move(textureImages_), std::move(vertices_), std::move(indices_)});
+    loadAssets();
+    spdlog::info("G-buffer: the scene's assets changed (revision {}): geometry and textures uploaded again",
+                 assets_.revision);
 }
 
 GBufferRenderer::~GBufferRenderer() {
@@ -423,6 +443,7 @@ void GBufferRenderer::ensureCapacity(gpu::Buffer& buffer, VkDeviceSize bytes, co
 std::shared_ptr<GBufferRenderer::FrameWork> GBufferRenderer::prepare(const GBufferInputs& inputs,
                                                                      const GBufferSettings& settings) {
     ++frame_;
+    reloadAssetsIfEdited();
     auto work = std::make_shared<FrameWork>();
     work->slot = uint32_t(frame_ % framesInFlight_);
     stats_.frame = frame_;

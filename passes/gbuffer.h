@@ -170,14 +170,17 @@ struct GBufferStats {
 struct TransparentInputs;
 struct TransparentOutputs;
 
-// Owns the scene's GPU geometry (every mesh's LOD 0, uploaded once into one
-// vertex and one index buffer) and the per-frame host-visible buffers
+// Owns the scene's GPU geometry (every mesh's LOD 0, uploaded into one
+// vertex and one index buffer, again only when the scene's assets change) and the per-frame host-visible buffers
 // (frame constants, instance transforms of this and last frame, joint
 // palettes), one set per frame in flight.
 class GBufferRenderer {
 public:
-    // `scene` must outlive the renderer; its meshes and materials must not
-    // change, its instances, joint palettes, sun and sky may.
+    // `scene` must outlive the renderer. Its instances, joint palettes, sun
+    // and sky may change between frames; edited meshes, materials and
+    // textures (scene::Scene::assetRevision) are uploaded again before the
+    // next frame (the old ones are released once no frame in flight reads
+    // them).
     // `framesInFlight` must be at least the executor's.
     GBufferRenderer(gpu::Context& ctx, const scene::Scene& scene, uint32_t framesInFlight = 2);
     ~GBufferRenderer();
@@ -197,6 +200,12 @@ private:
     using MaterialTextures = std::array<std::pair<const gpu::Image*, const gpu::Sampler*>, kMaterialTextureSlots>;
 
     std::shared_ptr<FrameWork> prepare(const GBufferInputs& inputs, const GBufferSettings& settings);
+    // Uploads the scene's meshes (LOD 0) and material textures and makes
+    // their draw ranges.
+    void loadAssets();
+    // Loads them again when the scene's assets changed (scene::assetStamp);
+    // releases what earlier reloads retired once no frame reads it.
+    void reloadAssetsIfEdited();
     // Writes the frame's host buffers; the shadow map pass, the frame's
     // first, calls it.
     void upload(const FrameWork& work);
@@ -264,6 +273,15 @@ private:
     std::vector<int32_t> meshFirstVertex_;           // per mesh: its first vertex in vertices_
     // Per mesh with morph targets: its vertices as uploaded (else empty).
     std::vector<std::vector<shader::GBufferVertex>> morphBaseVertices_;
+    scene::AssetStamp assets_;  // of the scene the above were made from
+    // What a reload replaced, kept until no frame in flight reads it.
+    struct RetiredAssets {
+        uint64_t lastUse = 0;  // the last frame that may read them
+        std::vector<gpu::Image> textureImages;
+        gpu::Buffer vertices;
+        gpu::Buffer indices;
+    };
+    std::vector<RetiredAssets> retired_;
     std::vector<std::unique_ptr<FrameSlot>> slots_;
     // The frame addGBufferPass declared last (the transparent pass draws it).
     std::shared_ptr<FrameWork> current_;

@@ -24,6 +24,7 @@ std::string_view reasonName(BlasDropReason reason) {
     switch (reason) {
     case BlasDropReason::ObjectRemoved: return "object removed";
     case BlasDropReason::Evicted: return "evicted";
+    case BlasDropReason::AssetsEdited: return "assets edited";
     }
     return "?";
 }
@@ -158,12 +159,35 @@ void PoolAllocator::advance(uint64_t frame) {
 
 BvhPlanner::BvhPlanner(const BvhSettings& settings) : settings_(settings) {}
 
+uint64_t deformationStamp(const Scene& scene, const Instance& instance) {
+    // FNV-1a over the bytes of each part.
+    uint64_t hash = 14695981039346656037ull;
+    const auto add = [&](const void* data, size_t bytes) {
+        const auto* p = static_cast<const uint8_t*>(data);
+        for (size_t i = 0; i < bytes; ++i) {
+            hash = (hash ^ p[i]) * 1099511628211ull;
+        }
+    };
+    add(&instance.deformVersion, sizeof(instance.deformVersion));
+    add(&instance.mesh, sizeof(instance.mesh));
+    add(&instance.skin, sizeof(instance.skin));
+    add(instance.morphWeights.data(), instance.morphWeights.size() * sizeof(float));
+    if (instance.motion == Motion::Skinned && instance.skin != kNone && size_t(instance.skin) < scene.skins.size()) {
+        const size_t count = scene.skins[size_t(instance.skin)].joints.size();
+        if (size_t(instance.jointOffset) + count <= scene.jointMatrices.size()) {
+            add(scene.jointMatrices.data() + instance.jointOffset, count * sizeof(glm::mat4));
+        }
+    }
+    return hash;
+}
+
 void BvhPlanner::reset() {
     resident_.clear();
     roundRobin_.clear();
     pool_ = PoolAllocator{};
     nextId_ = 1;
     havePlanned_ = false;
+    assets_ = {};
 }
 
 BvhPlan BvhPlanner::plan(const Scene& scene, const glm::vec3& cameraPosition, uint64_t frame) {
@@ -179,6 +203,18 @@ BvhPlan BvhPlanner::plan(const Scene& scene, const glm::vec3& cameraPosition, ui
     BvhPlan plan;
     plan.frame = frame;
     BvhStats& stats = plan.stats;
+
+    // --- Edited assets: every BLAS was built from what changed. -----------
+    if (const AssetStamp assets = assetStamp(scene); assets != assets_) {
+        for (const auto& [key, r] : resident_) {
+            pool_.release(r.desc.poolOffset, r.desc.triangleCount, frame + settings_.framesInFlight);
+            plan.drops.push_back({r.desc.id, BlasDropReason::AssetsEdited});
+            ++stats.dropped;
+        }
+        resident_.clear();
+        roundRobin_.clear();
+        assets_ = assets;
+    }
 
     // --- Objects: each mesh's reflection LOD split into BLAS parts. -------
     std::vector<uint32_t> lodOf(scene.meshes.size());
@@ -341,7 +377,7 @@ BvhPlan BvhPlanner::plan(const Scene& scene, const glm::vec3& cameraPosition, ui
             g.poolOffset = offset;
             offset += g.triangleCount;
         }
-        r.builtVersion = key.perInstance ? inst.deformVersion : 0;
+        r.builtShape = key.perInstance ? deformationStamp(scene, inst) : 0;
         r.lastInRange = frame;
         r.lastBuilt = frame;
         plan.builds.push_back({desc.id, BlasBuildReason::FirstInRange});
@@ -372,7 +408,8 @@ BvhPlan BvhPlanner::plan(const Scene& scene, const glm::vec3& cameraPosition, ui
             return false;
         }
         const Instance& inst = scene.instances[key.owner];
-        if (inst.deformVersion == r.builtVersion) {
+        const uint64_t shape = deformationStamp(scene, inst);
+        if (shape == r.builtShape) {
             ++stats.skippedUnchanged;
             return false;
         }
@@ -398,7 +435,7 @@ BvhPlan BvhPlanner::plan(const Scene& scene, const glm::vec3& cameraPosition, ui
         if (reason == BlasBuildReason::FirstPerson) {
             ++stats.rebuiltFirstPerson;
         }
-        r.builtVersion = inst.deformVersion;
+        r.builtShape = shape;
         r.lastBuilt = frame;
         plan.builds.push_back({r.desc.id, reason});
         stats.builtTriangles += r.desc.triangleCount;

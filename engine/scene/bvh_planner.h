@@ -14,8 +14,12 @@
 //  - static BLASes are built once (and shared by the instances of a mesh);
 //  - dynamic and skinned BLASes are rebuilt in a round-robin loop of at most
 //    16 rebuilds per frame, at most 12 of them skinned, and only when the
-//    object deformed (Instance::deformVersion changed). Rigid motion is a
-//    TLAS instance transform, never a BLAS rebuild;
+//    object deformed (Instance::deformVersion changed) or the instance at
+//    its index is no longer shaped as it was built (instances removed or
+//    reordered: its skin, joint matrices or morph weights differ). Rigid
+//    motion is a TLAS instance transform, never a BLAS rebuild;
+//  - edited assets (Scene::assetRevision, or meshes, materials or textures
+//    added or removed) drop every BLAS, which then builds as new;
 //  - first-person objects that deformed are rebuilt every frame, ahead of
 //    the loop and inside the same budget;
 //  - first builds (objects entering the radius) have a budget of their own,
@@ -82,6 +86,7 @@ enum class BlasBuildReason : uint8_t {
 enum class BlasDropReason : uint8_t {
     ObjectRemoved,  // no instance refers to it any more (removed, mesh or motion changed)
     Evicted,        // outside the radius for BvhSettings::evictAfterFramesOutside frames
+    AssetsEdited,   // the scene's meshes, materials or textures changed (Scene::assetRevision): every BLAS goes
 };
 
 std::string_view reasonName(BlasBuildReason reason);
@@ -225,7 +230,7 @@ private:
     };
     struct Resident {
         BlasDesc desc;
-        uint64_t builtVersion = 0;  // deformVersion the BLAS was last built from
+        uint64_t builtShape = 0;  // deformationStamp of the instance the BLAS was last built from
         uint64_t lastInRange = 0;   // last frame an object of it was within its radius
         uint64_t lastBuilt = 0;
     };
@@ -237,6 +242,12 @@ private:
     BlasId nextId_ = 1;
     bool havePlanned_ = false;
     uint64_t lastFrame_ = 0;
+    AssetStamp assets_;  // of the last plan's scene
 };
+
+// A hash of what shapes a deformable instance's BLAS: its deformVersion,
+// mesh, skin, joint matrices (this frame's, of its skin's range) and morph
+// weights. Equal stamps, equal shapes (up to a 64-bit hash collision).
+uint64_t deformationStamp(const Scene& scene, const Instance& instance);
 
 } // namespace glint::scene

@@ -226,6 +226,10 @@ uint64_t instancedTriangleCount(const Scene& scene) {
     return n;
 }
 
+AssetStamp assetStamp(const Scene& scene) {
+    return {scene.assetRevision, scene.meshes.size(), scene.materials.size(), scene.textures.size()};
+}
+
 bool blended(const Scene& scene, const Geometry& geometry) {
     return geometry.material < scene.materials.size() &&
            scene.materials[geometry.material].alphaMode == AlphaMode::Blend;

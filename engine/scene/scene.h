@@ -361,7 +361,29 @@ struct Scene {
     std::vector<SceneView> views;
 
     double time = 0.0;  // seconds, set by advanceScene
+
+    // Edits between frames. Instances (added, removed, reordered, moved,
+    // given another mesh or motion), particles, the sun, the environment
+    // and the animation state may change freely: the renderers read them
+    // every frame. Meshes, materials and textures are uploaded once and
+    // baked into vertex and BVH data: after changing any of them (a
+    // material's factor, a mesh's geometry, a texture's texels) bump
+    // assetRevision, and the renderers upload them again before their next
+    // frame. Adding or removing meshes, materials or textures is noticed
+    // without it (assetStamp).
+    uint64_t assetRevision = 0;
 };
+
+// What the renderers compare to notice edited assets (Scene::assetRevision):
+// the revision and how many meshes, materials and textures there are.
+struct AssetStamp {
+    uint64_t revision = 0;
+    size_t meshes = 0;
+    size_t materials = 0;
+    size_t textures = 0;
+    bool operator==(const AssetStamp&) const = default;
+};
+AssetStamp assetStamp(const Scene& scene);
 
 // The view `nameOrIndex` names (a view's name, or its index in decimal);
 // throws SceneError naming the scene and listing the views otherwise.

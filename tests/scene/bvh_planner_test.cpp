@@ -575,6 +575,70 @@ TEST_CASE("a dropped BLAS frees its pool range only after the frames in flight")
     CHECK(plan.find(plan.builds[0].blas)->poolOffset == freedOffset);
 }
 
+TEST_CASE("an instance removed from the middle: a deformable BLAS is rebuilt when the instance now at its index is "
+          "shaped otherwise") {
+    // Three deformable boxes posed differently (morph weights); each index
+    // owns a BLAS. Removing the first moves the others down one index onto
+    // BLASes built from another shape, with deformVersion left as it was.
+    TestScene t;
+    for (int i = 0; i < 3; ++i) {
+        t.add({float(i) * 3.0f, 0, 0}, Motion::Dynamic);
+    }
+    t.prepare();
+    for (size_t i = 0; i < 3; ++i) {
+        t.scene.instances[i].morphWeights = {0.5f * float(i)};
+    }
+    BvhPlanner planner;
+    BvhPlan plan = planner.plan(t.scene, {0, 0, 0}, 0);
+    REQUIRE(plan.builds.size() == 3);
+    plan = planner.plan(t.scene, {0, 0, 0}, 1);
+    CHECK(plan.builds.empty());
+
+    t.scene.instances.erase(t.scene.instances.begin());
+    plan = planner.plan(t.scene, {0, 0, 0}, 2);
+    REQUIRE(plan.drops.size() == 1);
+    CHECK(plan.drops[0].reason == BlasDropReason::ObjectRemoved);
+    CHECK(countReason(plan, BlasBuildReason::Deformed) == 2);
+    CHECK(inTlas(plan, 0));
+    CHECK(inTlas(plan, 1));
+
+    // The last one removed: nobody moves, nothing builds.
+    t.scene.instances.pop_back();
+    plan = planner.plan(t.scene, {0, 0, 0}, 3);
+    CHECK(plan.drops.size() == 1);
+    CHECK(plan.builds.empty());
+}
+
+TEST_CASE("edited assets drop every BLAS, which builds again; instance edits alone keep them") {
+    TestScene t;
+    t.add({0, 0, 0});
+    t.add({3, 0, 0});
+    t.add({6, 0, 0}, Motion::Dynamic);
+    t.prepare();
+    BvhPlanner planner;
+    BvhPlan plan = planner.plan(t.scene, {0, 0, 0}, 0);
+    REQUIRE(plan.builds.size() == 2);  // the static mesh's shared BLAS, the dynamic one's own
+    t.add({9, 0, 0});                  // an instance more: no asset changed
+    t.scene.instances[0].transform = glm::translate(glm::mat4(1.0f), {0, 1, 0});
+    plan = planner.plan(t.scene, {0, 0, 0}, 1);
+    CHECK(plan.builds.empty());
+    CHECK(plan.drops.empty());
+
+    const auto rebuiltAll = [&](uint64_t frame) {
+        plan = planner.plan(t.scene, {0, 0, 0}, frame);
+        CHECK(plan.drops.size() == 2);
+        for (const BlasDrop& d : plan.drops) CHECK(d.reason == BlasDropReason::AssetsEdited);
+        CHECK(countReason(plan, BlasBuildReason::FirstInRange) == 2);
+        CHECK(plan.tlas.size() == 4);
+    };
+    ++t.scene.assetRevision;  // a mesh or material edited in place
+    rebuiltAll(2);
+    plan = planner.plan(t.scene, {0, 0, 0}, 3);
+    CHECK(plan.builds.empty());
+    t.scene.materials.emplace_back();  // a material added, no revision: noticed by the count
+    rebuiltAll(4);
+}
+
 TEST_CASE("eviction drops BLASes of objects long outside the radius, and they are rebuilt on return") {
     TestScene t;
     t.add({0, 0, 0});
