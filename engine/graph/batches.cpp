@@ -123,8 +123,12 @@ void BatchBuilder::finish() {
             SemaphoreWait wait;
             wait.queue = placed.signaller;
             wait.frameOffset = placed.point.frame;
-            wait.batch = placed.point.ordinal == TimelinePoint::kLastBatch ? count_[queueIndex(placed.signaller)] - 1
-                                                                           : placed.point.ordinal;
+            if (placed.point.ordinal != TimelinePoint::kLastBatch) {
+                wait.batch = placed.point.ordinal;
+            } else {
+                const uint32_t batches = count_[queueIndex(placed.signaller)];
+                wait.batch = batches > 0 ? batches - 1 : SemaphoreWait::kLastSignalled;
+            }
             wait.stages = placed.stages;
             plan.waits.push_back(wait);
         }

@@ -766,8 +766,14 @@ SubmittedFrame Executor::run(const Plan& plan, const FrameResources& imports) {
                     continue;  // no previous frame to wait for
                 }
                 // The previous frame's batch `w.batch`, never past its end
-                // (its plan may have had fewer batches).
-                value = std::min(previousBase_[wq] + w.batch + 1, previousEnd[wq]);
+                // (its plan may have had fewer batches); or the queue's
+                // last signal, whichever frame gave it.
+                value = w.batch == SemaphoreWait::kLastSignalled
+                            ? previousEnd[wq]
+                            : std::min(previousBase_[wq] + w.batch + 1, previousEnd[wq]);
+                if (value == 0) {
+                    continue;  // that queue has signalled nothing yet
+                }
             }
             VkSemaphoreSubmitInfo info{VK_STRUCTURE_TYPE_SEMAPHORE_SUBMIT_INFO};
             info.semaphore = timelines_[wq].handle();

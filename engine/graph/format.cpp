@@ -172,6 +172,9 @@ std::string barrierText(const Plan& plan, const Barrier& b) {
 }
 
 std::string waitText(const SemaphoreWait& w) {
+    if (w.batch == SemaphoreWait::kLastSignalled) {
+        return std::string(toString(w.queue)) + "'s last signal at " + stageNames(w.stages);
+    }
     return std::string(toString(w.queue)) + " batch " + std::to_string(w.batch) +
            (w.frameOffset < 0 ? " of the previous frame" : "") + " at " + stageNames(w.stages);
 }

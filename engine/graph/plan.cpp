@@ -23,6 +23,8 @@ uint64_t Plan::signalValue(uint64_t frame, const Batch& b) const { return frame 
 
 std::optional<uint64_t> Plan::waitValue(uint64_t frame, const SemaphoreWait& w) const {
     if (w.frameOffset < 0 && frame < static_cast<uint64_t>(-w.frameOffset)) return std::nullopt;
+    // A queue without batches signals nothing under these values.
+    if (w.batch == SemaphoreWait::kLastSignalled) return std::nullopt;
     const uint64_t target = frame + static_cast<uint64_t>(static_cast<int64_t>(w.frameOffset));
     return target * batchCount(w.queue) + w.batch + 1;
 }

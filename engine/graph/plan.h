@@ -6,7 +6,8 @@
 //   for each batch in `batches` (submission order):
 //     wait  : for w in waitsOf(batch): the timeline semaphore of w.queue at
 //             waitValue(frame, w), in stage mask w.stages (skip when nullopt:
-//             the first frame has no previous one)
+//             the first frame has no previous one, or the queue has no
+//             batch to wait for)
 //     record: for p in passesOf(batch): barriersBefore(p) as one
 //             vkCmdPipelineBarrier2, then timestamp p.timestampQuery, the
 //             pass's execute callback, timestamp p.timestampQuery + 1;
@@ -57,6 +58,11 @@ struct Barrier {
 // the previous one (the write-after-read edge from a frame's graphics reads
 // to the next frame's async work, and cross-frame reuse of memory).
 struct SemaphoreWait {
+    // With frameOffset -1: whatever `queue` signalled last before this
+    // frame. An import whose initial state is on a queue that has no batch
+    // in the plan waits so (its last access was before this plan ran).
+    static constexpr uint32_t kLastSignalled = UINT32_MAX;
+
     Queue queue = Queue::Graphics;
     uint32_t batch = 0;
     int32_t frameOffset = 0;

@@ -261,6 +261,13 @@ private:
                 const auto q = static_cast<uint32_t>(w.queue);
                 if (w.queue == batch.queue) bad("batch " + std::to_string(b) + " waits on its own queue");
                 if (w.frameOffset != 0 && w.frameOffset != -1) bad("wait frame offset must be 0 or -1");
+                if (w.batch == SemaphoreWait::kLastSignalled) {
+                    // Only where the plan has no batch on that queue to name.
+                    if (w.frameOffset != -1 || count[q] != 0)
+                        bad("batch " + std::to_string(b) + " waits on the last signal of a queue with batches");
+                    if (!w.stages) bad("batch " + std::to_string(b) + " waits in no stage");
+                    continue;
+                }
                 if (w.batch >= count[q]) {
                     bad("batch " + std::to_string(b) + " waits on a batch that does not exist");
                     continue;
@@ -561,9 +568,12 @@ private:
 
     void wait(uint32_t q, const SemaphoreWait& w, uint32_t f) {
         const int64_t frame = static_cast<int64_t>(f) + w.frameOffset;
-        const int64_t key = timelineKey(frame, w.batch);
+        // The last signal of a queue without batches: what an import's
+        // initial state on it was done by (see the frame start).
+        const bool lastSignalled = w.batch == SemaphoreWait::kLastSignalled;
+        const int64_t key = timelineKey(frame, lastSignalled ? 0 : w.batch);
         const auto from = static_cast<uint32_t>(w.queue);
-        if (frame >= 0 && signalled_[from] < key) {
+        if (!lastSignalled && frame >= 0 && signalled_[from] < key) {
             fail(Kind::Deadlock, f,
                  "a " + std::string(toString(static_cast<Queue>(q))) + " batch waits on " +
                      std::string(toString(w.queue)) + " batch " + std::to_string(w.batch) + " before it is submitted");

@@ -209,3 +209,25 @@ TEST_CASE("an import's final state on the other queue is reached through a wait"
     CHECK((plan.waitsOf(last)[0].queue == Queue::AsyncCompute));
     CHECK(plan.waitsOf(last)[0].batch == batchOf(plan, "count").ordinal);
 }
+
+TEST_CASE("an import left on a queue that has no batch in the plan waits for that queue's last signal") {
+    // No pass at all this frame (so no queue's passes stand in for the
+    // other's), and an import left on async compute that graphics holds at
+    // the frame's end: an end-only graphics batch waits for whatever async
+    // compute signalled last (found by the graph fuzzer: it waited on
+    // batch 4294967295, which the verifier rejected).
+    Graph g(twoQueues());
+    g.importTexture("left_on_compute", {tex(), BoundaryState::of(Access::StorageWrite, Queue::AsyncCompute),
+                                        BoundaryState::of(Access::SampledRead, Queue::Graphics)});
+    Plan plan = compileChecked(g);
+    INFO(plan.toText());
+    CHECK(plan.batchCount(Queue::AsyncCompute) == 0);
+    std::vector<SemaphoreWait> waits;
+    for (const Batch& b : plan.batches)
+        for (const SemaphoreWait& w : plan.waitsOf(b)) waits.push_back(w);
+    REQUIRE(waits.size() == 1);
+    CHECK((waits[0].queue == Queue::AsyncCompute));
+    CHECK(waits[0].frameOffset == -1);
+    CHECK(waits[0].batch == SemaphoreWait::kLastSignalled);
+    CHECK_FALSE(plan.waitValue(1, waits[0]).has_value());  // nothing signals under the plan's own values
+}
