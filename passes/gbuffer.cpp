@@ -416,7 +416,6 @@ void GBufferRenderer::loadAssets() {
     spdlog::info("G-buffer: {} material textures uploaded for per-pixel sampling ({:.2f} MiB with mips), {} of them "
                  "normal maps",
                  stats_.textureImages, double(textureBytes) / (1024.0 * 1024.0), stats_.normalMaps);
-
 }
 
 void GBufferRenderer::reloadAssetsIfEdited() {
