@@ -1,5 +1,5 @@
 #pragma once
-// The GPU side of the BVH manager (issue 4): executes a scene::BvhPlan.
+// The GPU side of the BVH manager: executes a scene::BvhPlan.
 //
 // BvhManager owns what lives across frames: the reflection-LOD geometry of
 // every mesh a BLAS was built from (uploaded once per asset revision,
@@ -22,8 +22,7 @@
 //   -> barrier -> BLAS builds -> barrier -> TLAS build,
 // with build scratch from the graph.
 //
-// Particles (issue 4's particle TLAS, DESIGN.md section 3 pass 0): when the
-// plan says particleTlas and the pass is given the camera, the same pass
+// Particles (a TLAS of their own): when the plan says particleTlas and the pass is given the camera, the same pass
 // uploads the scene's particles (per frame in flight), writes three quads
 // per particle, one facing each of the camera's axes
 // (shaders/bvh/particle_quads.comp, in the pack step; why three:
@@ -31,8 +30,8 @@
 // BLASes and a particle TLAS of their three instances (mask
 // particleAxisMask(axis), kSbtOffsetParticles) beside the TLAS, all every
 // frame with fast build. A scene without particles gets no
-// particle buffer, BLAS, TLAS or dispatch (issue 4: model only what a scene
-// needs); BvhUpdateOutputs::particleTlas is then invalid.
+// particle buffer, BLAS, TLAS or dispatch (nothing is modelled that the
+// scene does not need); BvhUpdateOutputs::particleTlas is then invalid.
 //
 //   passes::BvhManager bvh(ctx, scene);
 //   each frame:

@@ -1,5 +1,5 @@
 #pragma once
-// Pass 8 of the reflection pipeline (issue 5): composite and debug views.
+// Pass 8 of the reflection pipeline: composite and debug views.
 //
 // Composite, one compute pass:
 //   opaque = lit + reflection * envBRDF(F0, roughness, N.V)

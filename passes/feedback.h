@@ -1,7 +1,7 @@
 #pragma once
-// Pass 6 of the reflection pipeline, its first half (issue 5): the tile
+// Pass 6 of the reflection pipeline, its first half: the tile
 // feedback. Far Cry 6 keeps one u32 per 8x8 tile with the SSLR hit and miss
-// counts of two frames (DESIGN.md section 3; layout: glint/feedback_shared.h)
+// counts of two frames (layout: glint/feedback_shared.h)
 // and uses it to send each tile's hybrid pixels to SSLR only, to SSLR with
 // the ray tracer behind it, or straight to the ray tracer. At the start of a
 // frame, after the G-buffer, one compute pass
@@ -47,7 +47,7 @@ struct FeedbackSettings {
     uint32_t minRays = 1;
     // A tile goes SSLR-only when at most this fraction of its rays missed,
     // RT-only when at most this fraction hit. 0: only hits / only misses,
-    // as the Far Cry 6 talk describes it (DESIGN.md section 3); a small
+    // as the Far Cry 6 talk describes it; a small
     // fraction tolerates a stray ray (Glint's knob, tuned by the bench).
     float sslrMissFraction = 0.0f;
     float rtHitFraction = 0.0f;

@@ -1,5 +1,5 @@
 #pragma once
-// Pass 5 of the reflection pipeline (issue 5): integrate. One compute pass
+// Pass 5 of the reflection pipeline: integrate. One compute pass
 // over every pixel picks where its reflection comes from:
 //   sky                        nothing (radiance 0, a = 0)
 //   env class (too rough)      the environment map
@@ -80,7 +80,7 @@ struct IntegrateInputs {
 struct IntegrateSettings {
     // SSLR confidence at which SSLR alone is trusted, and at which a traced
     // ray counts as a hit in the feedback counters: the Far Cry 6 talk's 0.9
-    // (DESIGN.md section 3). It must equal SslrSettings's, which lists the
+    //. It must equal SslrSettings's, which lists the
     // hybrid rays below it for the ray tracer: the RT outputs are read only
     // where the stored SSLR confidence is below it (compared, as SSLR does,
     // at sslrStoredThreshold), since nothing clears the traces' outputs.

@@ -1,5 +1,5 @@
 #pragma once
-// Particles in the reflections (DESIGN.md section 3, pass 5) and in the
+// Particles in the reflections and in the
 // direct view. Two passes on the graphics queue:
 //
 // The particle trace. For every traced reflection ray - the ray leaders

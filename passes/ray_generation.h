@@ -1,5 +1,5 @@
 #pragma once
-// Pass 2 of the reflection pipeline (issue 5): ray generation and tile
+// Pass 2 of the reflection pipeline: ray generation and tile
 // classification. One compute pass reads the G-buffer and, per pixel,
 //   - classifies it: sky (no ray), env (rougher than the cutoff: the
 //     environment map, no ray), RT (near), SSLR (far, beyond the BVH) or
@@ -37,14 +37,15 @@ namespace glint::passes {
 inline constexpr VkDeviceSize kRayListDispatchArgsBytes = 0;
 inline constexpr VkDeviceSize kRayListTraceArgsBytes = 3 * sizeof(uint32_t);
 
-// Which trace resolves a pixel's reflection: issue 5's three modes.
+// Which trace resolves a pixel's reflection: SSLR first and the ray
+// tracer where it has no confidence, SSLR only, or the ray tracer only.
 enum class ReflectionMode : uint32_t { Hybrid, Ssr, Rt };
 
 inline constexpr VkFormat kRayClassDebugFormat = VK_FORMAT_R8G8B8A8_UNORM;
 
 struct RayGenerationInputs {
     GBufferOutputs gbuffer;
-    // Drives all noise (DESIGN.md section 5): the same index, the same rays.
+    // Drives all noise: the same index, the same rays.
     uint64_t frameIndex = 0;
     // This frame's unjittered matrices and position; the G-buffer's camera.
     scene::Camera camera;
@@ -56,7 +57,7 @@ struct RayGenerationInputs {
 struct RayGenerationSettings {
     // Perceptual roughness above which a pixel takes the environment map
     // and traces nothing: FidelityFX Hybrid Reflections' default 0.22
-    // (DESIGN.md section 3).
+    //.
     float roughnessCutoff = 0.22f;
     // Perceptual roughness from which a 2x2 quad shares one ray. Glint's
     // starting value, not a published one: at 0.1 (alpha 0.01) the lobe
@@ -80,7 +81,7 @@ struct RayGenerationSettings {
     // feedback decides the floor. The bench sweeps it (rt_near_distance).
     float rtMaxDistance = 3.0f;
     // Pixels at or beyond this go to SSLR only: the BVH covers a radius of
-    // 100 around the camera (Far Cry 6 talk, DESIGN.md section 3).
+    // 100 around the camera (Far Cry 6 talk).
     float sslrMinDistance = 100.0f;
     ReflectionMode mode = ReflectionMode::Hybrid;
     // SSLR and hybrid pixels at least this rough (perceptual) cone-trace in
@@ -95,8 +96,8 @@ struct RayGenerationSettings {
     float coneRoughness = 0.1f;
     // Share of the hybrid-band pixels of a tile the feedback sends to RT that
     // stay hybrid (tried with SSLR first) this frame, so that the tile's
-    // counters keep seeing SSLR and it can return to SSLR (Far Cry 6 talk,
-    // DESIGN.md section 3). Glint's starting value; the bench sweeps it.
+    // counters keep seeing SSLR and it can return to SSLR (Far Cry 6
+    // talk). Glint's starting value; the bench sweeps it.
     float rtToHybridShare = 1.0f / 16.0f;
     // Where the random numbers of ray generation (the GGX samples, the
     // pixels kept hybrid) and of SSLR (its start offsets, which follow this

@@ -1,5 +1,5 @@
 #pragma once
-// The whole hybrid-reflections frame (issue 5, DESIGN.md section 3) wired
+// The whole hybrid-reflections frame wired
 // from the pass functions: what glint-render, the benchmark, the viewer and
 // the golden-image tests declare every frame, and the reference for an
 // engine that wires the passes into its own frame.
@@ -137,7 +137,7 @@ struct ReflectionFrame {
 std::span<const std::string_view> debugViewNames();
 
 // The passes whose GPU time is the reflections' cost (ray generation
-// through temporal accumulation: issue 5's reflection_ms).
+// through temporal accumulation: the stats' reflection_ms).
 bool isReflectionPass(std::string_view passName);
 
 class ReflectionRenderer {

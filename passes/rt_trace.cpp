@@ -136,7 +136,7 @@ RtTracePipelines::RtTracePipelines(gpu::Context& ctx, RtBackend backend)
     }
     if (backend_ == RtBackend::Auto) {
         // Ray query first: one dispatch, no shader binding table, and the
-        // hit shading stays in the same invocation (DESIGN.md section 3).
+        // hit shading stays in the same invocation.
         backend_ = ctx.caps().rayQuery ? RtBackend::RayQuery : RtBackend::Pipeline;
     }
     backend_ = prepare(backend_);

@@ -1,5 +1,5 @@
 #pragma once
-// Pass 4 of the reflection pipeline (issue 5): ray-traced hits and
+// Pass 4 of the reflection pipeline: ray-traced hits and
 // lighting. Traces the rays of the RT ray list (glint/ray_generation_shared.h,
 // kRayList*: ray generation's RT pixels and the hybrid rays SSLR could not
 // resolve) through the BVH update's TLAS, dispatched indirectly from the
@@ -11,7 +11,7 @@
 //     and with the depth reconstruction's error (the rasteriser's
 //     sub-pixel snapping included);
 //   - its length is maxDistance (the BVH's radius), shrinking as the
-//     surface's roughness grows (Far Cry 6 talk, DESIGN.md section 3);
+//     surface's roughness grows (Far Cry 6 talk);
 //   - a hit reads its triangle from the packed primitive pool through the
 //     primitive offset buffer, interpolates it at the barycentrics and
 //     lights it as the G-buffer lights its surfaces (glint/brdf.glsl's
@@ -86,7 +86,7 @@ struct RtTraceSettings {
     // frame of the other backend.
     RtBackend backend = RtBackend::Auto;
     // Ray length at roughness 0: the BVH's radius around the camera (Far
-    // Cry 6 talk, DESIGN.md section 3); beyond it the TLAS holds nothing.
+    // Cry 6 talk); beyond it the TLAS holds nothing.
     float maxDistance = 100.0f;
     // The length falls linearly with perceptual roughness to
     // shortRangeFraction * maxDistance at shortRangeRoughness: rough

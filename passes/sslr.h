@@ -1,9 +1,9 @@
 #pragma once
-// Pass 3 of the reflection pipeline (issue 5): screen-space reflections.
+// Pass 3 of the reflection pipeline: screen-space reflections.
 // One compute pass, dispatched indirectly over ray generation's SSLR ray
 // list (one invocation per ray: no work for an empty list), traces each ray
 // leader of the SSLR and hybrid pixels across the depth buffer: a linear march of large steps with a per-pixel
-// random start offset, then binary refinement (Far Cry 6 talk, DESIGN.md
+// random start offset, then binary refinement (Far Cry 6 talk
 // section 3). It writes the lit colour at the hit and a confidence in
 // [0, 1], and lists the hybrid rays below the confidence threshold, with
 // indirect args, for the ray-traced pass: it appends them to ray
@@ -49,8 +49,8 @@ struct SslrInputs {
 };
 
 struct SslrSettings {
-    // Large linear steps, then refinement steps: issue 5's 64 + 8, the
-    // Far Cry 6 talk's linear-then-refine trace (DESIGN.md section 3).
+    // Large linear steps, then refinement steps: the Far Cry 6 talk's
+    // linear-then-refine trace, 64 + 8 by default.
     uint32_t linearSteps = 64;
     uint32_t refineSteps = 8;
     // A ray takes fewer linear steps when its on-screen length has fewer
@@ -72,7 +72,7 @@ struct SslrSettings {
     // SSSR's hit validation fades the same way). Glint's starting value.
     float edgeFade = 0.05f;
     // Hybrid rays below this confidence go to the ray tracer: the Far Cry 6
-    // talk's 0.9 (DESIGN.md section 3). Compared as the confidence image
+    // talk's 0.9. Compared as the confidence image
     // stores it (sslrStoredThreshold); integrate and the particle trace
     // compare with the same value.
     float confidenceThreshold = 0.9f;

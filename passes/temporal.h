@@ -1,5 +1,5 @@
 #pragma once
-// Pass 7 of the reflection pipeline (issue 5): reflection motion, temporal
+// Pass 7 of the reflection pipeline: reflection motion, temporal
 // accumulation and a spatial filter for rough reflections. Two compute
 // passes on the graphics queue (after temporal.constants, a transfer that
 // fills their uniform buffer):
@@ -95,7 +95,7 @@ struct TemporalSettings {
     // spatialRoughnessStart (mirrors need none), full from
     // spatialRoughnessEnd. Radius 0 turns it off; at most
     // shader::kTemporalMaxSpatialRadius. Glint's starting values: rays are
-    // traced up to the 0.22 roughness cutoff (DESIGN.md section 3) and are
+    // traced up to the 0.22 roughness cutoff and are
     // noisiest there.
     uint32_t spatialRadius = 2;
     float spatialRoughnessStart = 0.1f;

@@ -66,7 +66,7 @@ bool hasExtension(const std::vector<VkExtensionProperties>& list, const char* na
     return std::any_of(list.begin(), list.end(), [&](const auto& e) { return std::strcmp(e.extensionName, name) == 0; });
 }
 
-// Lower is worse; the issue asks for a discrete GPU first, then lavapipe.
+// Lower is worse: a discrete GPU first, then lavapipe (the tests' device).
 int typeScore(VkPhysicalDeviceType type) {
     switch (type) {
     case VK_PHYSICAL_DEVICE_TYPE_DISCRETE_GPU: return 4;

@@ -2,7 +2,8 @@
 // LDR-FLIP (Andersson, Nilsson, Akenine-Moller, Oskarsson, Astrom, Fairchild,
 // "FLIP: A Difference Evaluator for Alternating Images", HPG 2020), written
 // from the paper. Per pixel error in [0,1]; the pooled statistics follow the
-// official tool's printout (../shared/flip/EXPECTED.md).
+// official tool's printout (NVlabs flip, v1.6; tests/metrics checks ours
+// against its recorded output).
 
 #include "metrics/image.h"
 

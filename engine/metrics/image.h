@@ -1,7 +1,7 @@
 #pragma once
 // Images as the metrics see them: linear RGB, row-major, top row first.
 //
-// PNG input follows the official FLIP tool (../shared/flip/EXPECTED.md):
+// PNG input follows the official FLIP tool (NVlabs, v1.6):
 // stb_image, 3 channels (alpha dropped, not composited; 16-bit reduced to
 // 8-bit; gAMA/iCCP ignored), each value v/255 treated as sRGB and linearised
 // with the piecewise sRGB curve in float.

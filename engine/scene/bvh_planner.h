@@ -5,7 +5,7 @@
 // primitive pool. The GPU side executes the plan; nothing here touches
 // Vulkan, so every decision is testable.
 //
-// Policy (Far Cry 6, GDC 2022 "Performant Reflective Beauty"; DESIGN.md 3):
+// Policy (Far Cry 6, GDC 2022 "Performant Reflective Beauty"):
 //  - one BLAS per object, split per material only when an object has more
 //    than 32 geometries, and into its single- and double-sided geometries
 //    when it has both (a reflection ray passes through the back of a

@@ -1,4 +1,4 @@
-// glint-bench (issue 6): what each reflection setting costs and what it
+// glint-bench: what each reflection setting costs and what it
 // loses. Renders the converged reference once, then every mode with its
 // defaults and sweeps of the main parameters over the same camera path,
 // and reports per-pass GPU time (median over frames; on a CPU device the

@@ -1,5 +1,5 @@
 #pragma once
-// glint-bench's report (issue 6): the rows it measures, the table, CSV and
+// glint-bench's report: the rows it measures, the table, CSV and
 // JSON it writes, the Pareto front of time against error, and the plot.
 // Pure CPU code with no Vulkan, so the tests check the schema and the plot
 // without a device.
@@ -15,7 +15,7 @@
 
 namespace glint::bench {
 
-// The CSV header issue 6 specifies, column for column. The metric columns
+// The CSV header, column for column (docs/results.md reads these files). The metric columns
 // are the final image's; the reflection term's go to the JSON only.
 inline constexpr std::string_view kCsvHeader =
     "scene,mode,param,value,width,height,reflection_ms,total_ms,rt_rays,flip_mean,relmse,psnr,ssim";

@@ -19,7 +19,7 @@
 
 namespace glint::app {
 
-// Issue 6's reference: every reflection ray traced (rt mode, no quad reuse,
+// The converged reference: every reflection ray traced (rt mode, no quad reuse,
 // no roughness cutoff, unbounded BVH radius and ray length), one new
 // sample per pixel per frame from a still camera without jitter,
 // accumulated without reprojection or clamping (the temporal pass with an
@@ -144,7 +144,7 @@ double getParameter(const ReflectionRunOptions& options, std::string_view name);
 // Renders options.frames frames of `scene` (which it animates).
 ReflectionRunResult runReflections(gpu::Context& ctx, scene::Scene& scene, const ReflectionRunOptions& options);
 
-// The stats JSON of issue 5 (device, mode, size, frames, passes,
+// The stats JSON glint-render writes (device, mode, size, frames, passes,
 // reflection_ms, rays, pixel_classes, bvh).
 std::string statsJson(const gpu::Context& ctx, const ReflectionRunOptions& options, const ReflectionRunResult& result);
 

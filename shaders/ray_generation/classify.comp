@@ -49,7 +49,7 @@ const vec4 kClassColours[5] = vec4[5](vec4(0.0, 0.0, 0.0, 1.0), vec4(0.5, 0.5, 0
 
 // The mode and the feedback refine the distance split: ssr and rt send
 // every traced pixel one way; in hybrid mode the middle band follows its
-// tile's feedback (Far Cry 6 talk, DESIGN.md section 3), except that a
+// tile's feedback (Far Cry 6 talk), except that a
 // random share of an RT tile's pixels stays hybrid, so SSLR keeps being
 // tried there and the tile can come back to it when SSLR starts to hit.
 uint applyMode(uint pixelClass, uvec2 pixel) {

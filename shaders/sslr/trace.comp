@@ -5,7 +5,7 @@
 // buffer in screen space: kLinearSteps large steps with a per-pixel random
 // start offset, then a binary search between the last step in front of the
 // surface and the first behind it (the Far Cry 6 talk's linear-then-refine
-// trace; issue 5's 64 + 8 steps). Hits sample the lit colour; the
+// trace; 64 + 8 steps by default). Hits sample the lit colour; the
 // confidence falls to zero for misses, thick or back-facing hits and near
 // the screen border, and hybrid rays below the threshold are listed for RT.
 #extension GL_GOOGLE_include_directive : require
@@ -243,7 +243,7 @@ void main() {
     writeResult(p, radiance, confidence, hitUv, tHit >= 0.0);
 
     // Only hybrid rays go on: SSLR-class pixels lie beyond the BVH's reach
-    // (DESIGN.md section 3), where the ray tracer could find nothing better.
+    //, where the ray tracer could find nothing better.
     // "Not at least the threshold", so a NaN goes on too: readers find the
     // ray traced wherever the stored confidence is not at least the
     // threshold (glint/sslr_shared.h).

@@ -1,5 +1,5 @@
-// glint-bench's report (samples/bench/report.h): the CSV schema issue 6
-// specifies, the Pareto front, and the plot, all without a GPU.
+// glint-bench's report (samples/bench/report.h): the CSV schema it states,
+// the Pareto front, and the plot, all without a GPU.
 
 #include "bench/report.h"
 
@@ -52,7 +52,7 @@ Row makeRow(const std::string& mode, const std::string& param, std::optional<dou
 
 } // namespace
 
-TEST_CASE("the CSV has issue 6's header and one parseable row per configuration") {
+TEST_CASE("the CSV has the stated header and one parseable row per configuration") {
     const std::vector<Row> rows = {makeRow("hybrid", "default", std::nullopt, 1.0, 0.05),
                                    makeRow("ssr", "default", std::nullopt, 0.5, 0.09),
                                    makeRow("hybrid", "sslr_threshold", 0.7f, 0.8, 0.06),

@@ -1,4 +1,4 @@
-// glTF features past the core loader (issue 4): generated tangents,
+// glTF features past the core loader: generated tangents,
 // texture coordinate sets, KHR_texture_transform and morph targets, on
 // small documents generated here, with the errors their broken variants give.
 

@@ -1,4 +1,4 @@
-# Issue 6: the reference is deterministic for a seed. Renders it twice
+# The reference is deterministic for a seed. Renders it twice
 # (RENDER, ARGS without --out) into OUT_A and OUT_B and requires identical
 # PNGs, then once with another seed, which must differ (the seed reaches
 # the noise).

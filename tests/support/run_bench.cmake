@@ -1,6 +1,6 @@
 # Runs glint-bench (BENCH) as a quick smoke test: --quick on the plaza, tiny
 # and short, validation on, writing CSV, JSON and plot under OUT. Checks the
-# exit code, that the three files exist, the CSV header issue 6 specifies,
+# exit code, that the three files exist, the CSV header report.h states,
 # a row per configuration (three mode defaults and the quick sweeps), and
 # the JSON's provenance keys.
 cmake_policy(SET CMP0054 NEW)

@@ -1,5 +1,5 @@
 // The 8x8-tile feedback counters of the hybrid reflections (Far Cry 6 talk,
-// DESIGN.md section 3): constants and packing shared by GLSL and C++
+// constants and packing shared by GLSL and C++
 // (passes/integrate.cpp writes them, passes/feedback.cpp reprojects them
 // and decides each tile's mode, shaders/ray_generation/classify.comp reads
 // the modes).
@@ -58,7 +58,7 @@ GLINT_FUNC uint rotateFeedback(uint reprojected, uint hits, uint misses) {
 //   hits at most rtHitFraction of the rays          -> RT (only misses)
 //   otherwise                                       -> hybrid (mixed)
 // With both fractions 0 a tile needs every ray to agree before it leaves
-// hybrid, the Far Cry 6 talk's rule (DESIGN.md section 3); passes/feedback.h
+// hybrid, the Far Cry 6 talk's rule; passes/feedback.h
 // documents the knobs.
 GLINT_FUNC uint decideTileMode(uint counter, uint minRays, float sslrMissFraction, float rtHitFraction) {
     const uint hits = feedbackHits(counter) + feedbackPreviousHits(counter);

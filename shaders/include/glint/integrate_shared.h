@@ -44,7 +44,7 @@ GLINT_FUNC vec4 integrateSourceColour(uint source) {
     return vec4(0.0f, 0.0f, 0.0f, 1.0f);
 }
 
-// Which trace a traced pixel's reflection takes (issue 5, Far Cry 6 talk):
+// Which trace a traced pixel's reflection takes (the Far Cry 6 talk):
 // full SSLR confidence, SSLR alone; below it the more confident trace: a
 // ray-traced result is fully confident (its miss is the true environment),
 // so RT wins where it traced; else whatever SSLR found; else the

@@ -15,7 +15,7 @@
 
 GLINT_BEGIN
 
-// 8x8 tiles: the Far Cry 6 talk's and FidelityFX's tile (DESIGN.md section 3).
+// 8x8 tiles: the Far Cry 6 talk's and FidelityFX's tile.
 GLINT_CONST uint kTileSize = 8u;
 
 // Pixel classes. Sky: nothing to reflect. Env: rougher than the cutoff, the

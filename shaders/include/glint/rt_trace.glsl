@@ -83,7 +83,7 @@ vec3 rtOffsetOrigin(vec3 p, vec3 n, vec3 reference, float distance, float errorP
 // Rougher reflections blur what they meet, so far hits are worth less than
 // their cost: the length falls linearly from maxDistance at roughness 0 to
 // shortRangeFraction of it at shortRangeRoughness and beyond (the Far Cry 6
-// talk's range shrinking with roughness, DESIGN.md section 3).
+// talk's range shrinking with roughness).
 float rtRayLength(float roughness) {
     const float k = clamp(roughness / max(rt.shortRangeRoughness, 1e-6), 0.0, 1.0);
     return rt.maxDistance * mix(1.0, rt.shortRangeFraction, k);

@@ -3,7 +3,7 @@
 // tests run exactly the maths the shaders run.
 //
 // Noise: every sequence is a pure function of (pixel, frame index), so the
-// same command gives the same image (DESIGN.md section 5, determinism).
+// same command gives the same image (the reference and the goldens rely on it).
 #ifndef GLINT_SAMPLING_GLSL
 #define GLINT_SAMPLING_GLSL
 
