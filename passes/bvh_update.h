@@ -22,9 +22,10 @@
 //   -> barrier -> BLAS builds -> barrier -> TLAS build,
 // with build scratch from the graph.
 //
-// Particles (a TLAS of their own): when the plan says particleTlas and the pass is given the camera, the same pass
-// uploads the scene's particles (per frame in flight), writes three quads
-// per particle, one facing each of the camera's axes
+// Particles (a TLAS of their own): when the plan says particleTlas and the
+// pass is given the camera, the same pass uploads the scene's particles
+// (per frame in flight), writes three quads per particle, one facing each
+// of the camera's axes
 // (shaders/bvh/particle_quads.comp, in the pack step; why three:
 // glint/particles_shared.h), builds a BLAS per axis beside the other
 // BLASes and a particle TLAS of their three instances (mask
@@ -161,8 +162,8 @@ public:
     // `scene` must outlive the manager. Its instances and joint palette may
     // change between frames; edited meshes, materials and textures
     // (scene::Scene::assetRevision) are uploaded again, and the planner
-    // drops every BLAS built from them. `framesInFlight` must be at least the executor's: host-written
-    // buffers are kept once per frame in flight.
+    // drops every BLAS built from them. `framesInFlight` must be at least
+    // the executor's: host-written buffers are kept once per frame in flight.
     BvhManager(gpu::Context& ctx, const scene::Scene& scene, uint32_t framesInFlight = 2,
                const BvhUpdateOptions& options = {});
     ~BvhManager();

@@ -171,9 +171,10 @@ struct TransparentInputs;
 struct TransparentOutputs;
 
 // Owns the scene's GPU geometry (every mesh's LOD 0, uploaded into one
-// vertex and one index buffer, again only when the scene's assets change) and the per-frame host-visible buffers
-// (frame constants, instance transforms of this and last frame, joint
-// palettes), one set per frame in flight.
+// vertex and one index buffer, again only when the scene's assets change)
+// and the per-frame host-visible buffers (frame constants, instance
+// transforms of this and last frame, joint palettes), one set per frame in
+// flight.
 class GBufferRenderer {
 public:
     // `scene` must outlive the renderer. Its instances, joint palettes, sun

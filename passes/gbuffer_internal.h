@@ -54,6 +54,12 @@ inline std::vector<gpu::Binding> surfaceBindings() {
 // 8-bit): the draw binds its slot's fallback.
 inline constexpr size_t kNoImage = std::numeric_limits<size_t>::max();
 
+// glTF's three wrap modes for S and T: nine samplers, this one's index.
+inline constexpr size_t kWrapModes = 3;
+inline size_t samplerIndex(const scene::TextureRef& ref) {
+    return size_t(ref.wrapS) * kWrapModes + size_t(ref.wrapT);
+}
+
 // How a geometry's material covers what lies behind it (glTF alphaMode):
 // the pipelines that draw it, and whether it is in the G-buffer at all.
 enum class Coverage : uint8_t {
