@@ -109,11 +109,6 @@ struct BvhManager::ResidentBlas {
     std::vector<std::vector<gpu::Buffer>> morphedVertices;
 };
 
-struct BvhManager::Retired {
-    uint64_t lastUse = 0;  // the last frame whose commands may touch it
-    std::shared_ptr<void> object;
-};
-
 struct BvhManager::FrameWork {
     struct Pack {
         const SourceGeometry* source = nullptr;
@@ -161,14 +156,7 @@ struct BvhManager::FrameWork {
 template <class T> void BvhManager::retire(T&& object) {
     // Frames up to frame_ - 1 may have recorded uses; frame_ itself when the
     // object is still used by the frame being declared (a pool copy source).
-    retired_.push_back({frame_, std::make_shared<std::decay_t<T>>(std::forward<T>(object))});
-}
-
-void BvhManager::collectRetired() {
-    // Before the executor runs frame N it has waited for frame N - framesInFlight;
-    // prepare() for frame N runs before that wait, so frame N - 1 - framesInFlight
-    // is the newest one known to be finished.
-    std::erase_if(retired_, [&](const Retired& r) { return r.lastUse + framesInFlight_ < frame_; });
+    retired_.keep(std::forward<T>(object), frame_);
 }
 
 BvhManager::BvhManager(gpu::Context& ctx, const scene::Scene& scene, uint32_t framesInFlight,
@@ -178,7 +166,8 @@ BvhManager::BvhManager(gpu::Context& ctx, const scene::Scene& scene, uint32_t fr
       framesInFlight_(std::max(framesInFlight, 1u)),
       options_(options),
       hitMaterials_(std::make_unique<HitMaterials>(ctx, scene, options.hitMaterials)),
-      assets_(scene::assetStamp(scene)) {
+      assets_(scene::assetStamp(scene)),
+      retired_(framesInFlight_) {
     const VkShaderStageFlags cs = VK_SHADER_STAGE_COMPUTE_BIT;
     packPipeline_ = gpu::createComputePipeline(
         ctx, {"bvh/pack_primitives.comp",
@@ -255,7 +244,7 @@ const BvhManager::SourceGeometry& BvhManager::sourceGeometry(uint32_t mesh, uint
         target = gpu::Buffer(ctx_, {size, VK_BUFFER_USAGE_STORAGE_BUFFER_BIT | VK_BUFFER_USAGE_TRANSFER_DST_BIT,
                                     gpu::MemoryUsage::DeviceLocal, name + what, true});
         stats_.uploadBytes += size;
-        retired_.push_back({frame_, staging});
+        retired_.keepShared(staging, frame_);
         work.uploads.push_back({std::move(staging), &target});
     };
     upload(source->vertices, vertices.data(), vertices.size() * sizeof(vertices[0]), ".vertices");
@@ -323,7 +312,7 @@ void BvhManager::ensurePool(uint32_t triangles, FrameWork& work) {
         // Static BLASes were packed once; their primitives must survive.
         work.poolCopyBytes = pool_.size();
         work.poolCopySource = std::make_shared<gpu::Buffer>(std::move(pool_));
-        retired_.push_back({frame_, work.poolCopySource});
+        retired_.keepShared(work.poolCopySource, frame_);
         ++stats_.poolGrowths;
     }
     pool_ = std::move(grown);
@@ -508,7 +497,7 @@ const gpu::Buffer& BvhManager::morphedVertexBuffer(ResidentBlas& blas, size_t ge
 
 std::shared_ptr<BvhManager::FrameWork> BvhManager::prepare(const scene::BvhPlan& plan, const scene::Camera* camera) {
     ++frame_;
-    collectRetired();
+    retired_.release(frame_);
     auto work = std::make_shared<FrameWork>();
     work->slot = uint32_t(frame_ % framesInFlight_);
     stats_.frame = frame_;

@@ -61,6 +61,7 @@
 #include "graph/executor.h"
 #include "graph/graph.h"
 #include "passes/bvh_hit_materials.h"
+#include "passes/retired_objects.h"
 #include "scene/bvh_planner.h"
 #include "scene/camera.h"
 #include "scene/scene.h"
@@ -191,7 +192,6 @@ private:
                                     const scene::Camera* camera);
     struct SourceGeometry;
     struct ResidentBlas;
-    struct Retired;
     struct FrameWork;
     using GeometryKey = std::tuple<uint32_t, uint32_t, uint32_t>;  // mesh, lod, geometry
 
@@ -209,7 +209,6 @@ private:
     void ensureOffsets(size_t entries);
     void ensureJointPalette(size_t matrices);
     template <class T> void retire(T&& object);
-    void collectRetired();
 
     gpu::Context& ctx_;
     const scene::Scene& scene_;
@@ -248,7 +247,7 @@ private:
     std::array<std::unique_ptr<gpu::AccelerationStructure>, shader::kParticleQuadAxes> particleBlases_;
     std::unique_ptr<gpu::AccelerationStructure> particleTlas_;
     std::vector<gpu::Buffer> particleInstances_;
-    std::vector<Retired> retired_;
+    RetiredObjects retired_;
     BvhGpuStats stats_;
 };
 

@@ -182,7 +182,7 @@ shader::GBufferShadow fitSunShadow(const scene::Scene& scene, const scene::Camer
 }
 
 GBufferRenderer::GBufferRenderer(gpu::Context& ctx, const scene::Scene& scene, uint32_t framesInFlight)
-    : ctx_(ctx), scene_(scene), framesInFlight_(std::max(framesInFlight, 1u)) {
+    : ctx_(ctx), scene_(scene), framesInFlight_(std::max(framesInFlight, 1u)), retired_(framesInFlight_) {
     gpu::GraphicsPipelineDesc surface;
     surface.vertexShader = "gbuffer/gbuffer.vert";
     surface.fragmentShader = "gbuffer/gbuffer.frag";

@@ -48,6 +48,7 @@
 #include "graph/graph.h"
 #include "passes/image_clear.h"
 #include "passes/lighting.h"
+#include "passes/retired_objects.h"
 #include "scene/camera.h"
 #include "scene/scene.h"
 
@@ -275,14 +276,7 @@ private:
     // Per mesh with morph targets: its vertices as uploaded (else empty).
     std::vector<std::vector<shader::GBufferVertex>> morphBaseVertices_;
     scene::AssetStamp assets_;  // of the scene the above were made from
-    // What a reload replaced, kept until no frame in flight reads it.
-    struct RetiredAssets {
-        uint64_t lastUse = 0;  // the last frame that may read them
-        std::vector<gpu::Image> textureImages;
-        gpu::Buffer vertices;
-        gpu::Buffer indices;
-    };
-    std::vector<RetiredAssets> retired_;
+    RetiredObjects retired_;    // what a reload replaced, until no frame in flight reads it
     std::vector<std::unique_ptr<FrameSlot>> slots_;
     // The frame addGBufferPass declared last (the transparent pass draws it).
     std::shared_ptr<FrameWork> current_;

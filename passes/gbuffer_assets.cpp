@@ -174,11 +174,12 @@ void GBufferRenderer::loadAssets() {
 }
 
 void GBufferRenderer::reloadAssetsIfEdited() {
-    // Frames up to frame_ - 1 may still read what is retired here; prepare()
-    // for frame N runs before the executor waits for frame N - framesInFlight.
-    std::erase_if(retired_, [&](const RetiredAssets& r) { return r.lastUse + framesInFlight_ < frame_; });
+    retired_.release(frame_);
     if (scene::assetStamp(scene_) == assets_) return;
-    retired_.push_back({frame_, std::move(textureImages_), std::move(vertices_), std::move(indices_)});
+    // Frames up to frame_ - 1 may still read them.
+    retired_.keep(std::move(textureImages_), frame_);
+    retired_.keep(std::move(vertices_), frame_);
+    retired_.keep(std::move(indices_), frame_);
     loadAssets();
     spdlog::info("G-buffer: the scene's assets changed (revision {}): geometry and textures uploaded again",
                  assets_.revision);

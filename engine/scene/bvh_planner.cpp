@@ -5,6 +5,7 @@
 #include "glint/packing.h"
 
 #include <algorithm>
+#include <cstring>
 #include <iterator>
 #include <set>
 #include <sstream>
@@ -160,12 +161,16 @@ void PoolAllocator::advance(uint64_t frame) {
 BvhPlanner::BvhPlanner(const BvhSettings& settings) : settings_(settings) {}
 
 uint64_t deformationStamp(const Scene& scene, const Instance& instance) {
-    // FNV-1a over the bytes of each part.
+    // FNV-1a over each part's 32-bit words (every part is made of them):
+    // it runs every frame for every deformable BLAS, skinned palettes
+    // included, so a word at a time rather than a byte.
     uint64_t hash = 14695981039346656037ull;
     const auto add = [&](const void* data, size_t bytes) {
         const auto* p = static_cast<const uint8_t*>(data);
-        for (size_t i = 0; i < bytes; ++i) {
-            hash = (hash ^ p[i]) * 1099511628211ull;
+        for (size_t i = 0; i + 4 <= bytes; i += 4) {
+            uint32_t word;
+            std::memcpy(&word, p + i, 4);
+            hash = (hash ^ word) * 1099511628211ull;
         }
     };
     add(&instance.deformVersion, sizeof(instance.deformVersion));
