@@ -17,11 +17,11 @@
 #include "bench/scale.h"
 #include "common/app.h"
 #include "common/reflection_run.h"
-#include "metrics/error_map.h"
-#include "metrics/flip.h"
-#include "metrics/image.h"
-#include "metrics/pixel_metrics.h"
-#include "scene/builtin_scenes.h"
+#include "glint/metrics/error_map.h"
+#include "glint/metrics/flip.h"
+#include "glint/metrics/image.h"
+#include "glint/metrics/pixel_metrics.h"
+#include "glint/scene/builtin_scenes.h"
 
 #include "glint_commit.h"  // generated: GLINT_BUILD_COMMIT
 

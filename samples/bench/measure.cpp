@@ -1,7 +1,7 @@
 #include "bench/measure.h"
 
-#include "metrics/flip.h"
-#include "metrics/pixel_metrics.h"
+#include "glint/metrics/flip.h"
+#include "glint/metrics/pixel_metrics.h"
 
 #include <spdlog/spdlog.h>
 

@@ -6,7 +6,7 @@
 
 #include "bench/report.h"
 #include "common/reflection_run.h"
-#include "metrics/image.h"
+#include "glint/metrics/image.h"
 
 #include <cstdint>
 #include <optional>

@@ -1,7 +1,7 @@
 #include "bench/scale.h"
 
 #include "bench/measure.h"
-#include "scene/error.h"
+#include "glint/scene/error.h"
 
 #include <spdlog/spdlog.h>
 

@@ -5,8 +5,8 @@
 
 #include "bench/report.h"
 #include "common/reflection_run.h"
-#include "gpu/context.h"
-#include "scene/builtin_scenes.h"
+#include "glint/gpu/context.h"
+#include "glint/scene/builtin_scenes.h"
 
 #include <cstdint>
 #include <optional>

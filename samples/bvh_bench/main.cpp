@@ -31,15 +31,15 @@
 //   overlap_frame_ms_async=<ms> overlap_frame_ms_graphics=<ms> overlap_saving_pct=<%>
 
 #include "common/app.h"
-#include "gpu/descriptors.h"
-#include "gpu/error.h"
-#include "gpu/pipeline.h"
-#include "graph/executor.h"
-#include "graph/graph.h"
-#include "passes/bvh_update.h"
-#include "scene/animation.h"
-#include "scene/builtin_scenes.h"
-#include "scene/bvh_planner.h"
+#include "glint/gpu/descriptors.h"
+#include "glint/gpu/error.h"
+#include "glint/gpu/pipeline.h"
+#include "glint/graph/executor.h"
+#include "glint/graph/graph.h"
+#include "glint/passes/bvh_update.h"
+#include "glint/scene/animation.h"
+#include "glint/scene/builtin_scenes.h"
+#include "glint/scene/bvh_planner.h"
 
 #include "glint/bvh_shared.h"
 

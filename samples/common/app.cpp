@@ -1,10 +1,10 @@
 #include "common/app.h"
 
-#include "gpu/error.h"
+#include "glint/gpu/error.h"
 
 #include <spdlog/cfg/helpers.h>
 #include <spdlog/spdlog.h>
-#include <stb_image_write.h>
+#include "glint/scene/image_io.h"
 
 #include <cstdio>
 #include <filesystem>
@@ -175,13 +175,7 @@ std::pair<uint32_t, uint32_t> parseSize(const std::string& text) {
 }
 
 void writePng(const std::string& path, uint32_t width, uint32_t height, const std::vector<uint8_t>& rgba) {
-    const auto dir = std::filesystem::path(path).parent_path();
-    if (!dir.empty()) {
-        std::filesystem::create_directories(dir);
-    }
-    if (!stbi_write_png(path.c_str(), int(width), int(height), 4, rgba.data(), int(width * 4))) {
-        throw std::runtime_error("cannot write PNG '" + path + "'");
-    }
+    scene::writePng(path, width, height, rgba);
     spdlog::info("wrote {} ({}x{})", path, width, height);
 }
 

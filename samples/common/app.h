@@ -3,8 +3,8 @@
 // main wrapper that turns any exception into one line on stderr and a
 // non-zero exit.
 
-#include "gpu/context.h"
-#include "scene/gltf_loader.h"
+#include "glint/gpu/context.h"
+#include "glint/scene/gltf_loader.h"
 
 #include <functional>
 #include <map>

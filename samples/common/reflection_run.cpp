@@ -1,9 +1,10 @@
 #include "common/reflection_run.h"
 
-#include "graph/executor.h"
-#include "graph/graph.h"
-#include "graph/verify.h"
-#include "scene/animation.h"
+#include "glint/graph/executor.h"
+#include "glint/graph/transfer.h"
+#include "glint/graph/graph.h"
+#include "glint/graph/verify.h"
+#include "glint/scene/animation.h"
 
 #include "glint/reflection_frame_shared.h"
 
@@ -25,49 +26,12 @@ namespace glint::app {
 
 namespace {
 
-constexpr rg::BoundaryState kHostRead =
-    rg::BoundaryState::raw(VK_PIPELINE_STAGE_2_HOST_BIT, VK_ACCESS_2_HOST_READ_BIT, VK_IMAGE_LAYOUT_UNDEFINED);
 
 double median(std::vector<double> values) {
     if (values.empty()) return 0.0;
     std::sort(values.begin(), values.end());
     const size_t n = values.size();
     return n % 2 ? values[n / 2] : 0.5 * (values[n / 2 - 1] + values[n / 2]);
-}
-
-// Copies `source` (an image, or a buffer) into a host-visible import at the
-// end of the frame.
-void addCopyToHost(rg::Graph& graph, rg::FrameResources& resources, const gpu::Buffer& target, const char* name,
-                   rg::Texture image, rg::Buffer buffer, uint32_t width, uint32_t height) {
-    const rg::Buffer imported = graph.importBuffer(
-        name, {{target.size()}, rg::BoundaryState::of(rg::Access::TransferDst), kHostRead});
-    resources.bind(imported, target);
-    struct CopyData {
-        rg::Texture image;
-        rg::Buffer buffer;
-        rg::Buffer target;
-    };
-    const CopyData& copy = graph.addPass<CopyData>(
-        name, rg::Queue::Graphics,
-        [&](rg::Builder& b, CopyData& d) {
-            if (image.valid()) d.image = b.read(image, rg::Access::TransferSrc);
-            if (buffer.valid()) d.buffer = b.read(buffer, rg::Access::TransferSrc);
-            d.target = b.write(imported, rg::Access::TransferDst);
-        },
-        [width, height](const CopyData& d, rg::PassContext& pc) {
-            const gpu::Buffer& dst = pc.buffer(d.target);
-            if (d.image.valid()) {
-                VkBufferImageCopy region{};
-                region.imageSubresource = {VK_IMAGE_ASPECT_COLOR_BIT, 0, 0, 1};
-                region.imageExtent = {width, height, 1};
-                vkCmdCopyImageToBuffer(pc.cmd(), pc.image(d.image).handle(), VK_IMAGE_LAYOUT_TRANSFER_SRC_OPTIMAL,
-                                       dst.handle(), 1, &region);
-            } else {
-                const VkBufferCopy region{0, 0, dst.size()};
-                vkCmdCopyBuffer(pc.cmd(), pc.buffer(d.buffer).handle(), dst.handle(), 1, &region);
-            }
-        });
-    graph.markOutput(copy.target);
 }
 
 // Each parameter: its name, the field, and where it lives.
@@ -267,8 +231,8 @@ ReflectionRunOptions referenceSettings(const ReflectionRunOptions& in) {
 }
 
 // Mean of the reflected radiance (rgb summed) over the pixels that reflect.
-double meanReflection(const gpu::Buffer& resolved, uint32_t pixels) {
-    const auto halves = resolved.mappedSpan<const uint16_t>();
+double meanReflection(const rg::HostReadback& resolved, uint32_t pixels) {
+    const auto halves = resolved.as<uint16_t>();
     double sum = 0.0;
     uint64_t n = 0;
     for (uint32_t p = 0; p < pixels; ++p) {
@@ -301,15 +265,10 @@ ReflectionRunResult runReflections(gpu::Context& ctx, scene::Scene& scene, const
     result.mode = renderer.tracesRays() ? options.frame.mode : passes::ReflectionMode::Ssr;
     result.passTimer = executor.passTimer();
     const uint32_t w = options.width, h = options.height;
-    gpu::Buffer image(ctx, {VkDeviceSize(w) * h * 4, VK_BUFFER_USAGE_TRANSFER_DST_BIT, gpu::MemoryUsage::Readback,
-                            "glint.output_readback"});
-    gpu::Buffer counts(ctx, {shader::kReflectionCountWords * 4u, VK_BUFFER_USAGE_TRANSFER_DST_BIT,
-                             gpu::MemoryUsage::Readback, "glint.counts_readback"});
-    gpu::Buffer resolved;
-    if (reference || options.readResolved) {
-        resolved = gpu::Buffer(ctx, {VkDeviceSize(w) * h * 8, VK_BUFFER_USAGE_TRANSFER_DST_BIT,
-                                     gpu::MemoryUsage::Readback, "glint.reference_readback"});
-    }
+    const rg::HostReadback image(ctx, VkDeviceSize(w) * h * 4, "readback.output");
+    const rg::HostReadback counts(ctx, shader::kReflectionCountWords * 4u, "readback.counts");
+    std::optional<rg::HostReadback> resolved;
+    if (reference || options.readResolved) resolved.emplace(ctx, VkDeviceSize(w) * h * 8, "readback.resolved");
     std::optional<double> previousMean;
     const uint64_t frameBase = reference ? uint64_t(options.reference.seed) << 20 : 0;
 
@@ -381,11 +340,11 @@ ReflectionRunResult runReflections(gpu::Context& ctx, scene::Scene& scene, const
         rg::FrameResources resources;
         renderer.bind(resources, frame);
         if (last) {
-            addCopyToHost(graph, resources, image, "readback.output", frame.output.color, {}, w, h);
-            addCopyToHost(graph, resources, counts, "readback.counts", {}, frame.counts, w, h);
+            image.copy(graph, resources, frame.output.color);
+            counts.copy(graph, resources, frame.counts);
         }
         if (check || (last && options.readResolved)) {
-            addCopyToHost(graph, resources, resolved, "readback.resolved", frame.temporal.resolved, {}, w, h);
+            resolved->copy(graph, resources, frame.temporal.resolved);
         }
         // Timed frames alternate: per-pass times (odd frames), then the
         // reflection chain as one span without them (reflection_span_ms,
@@ -434,7 +393,7 @@ ReflectionRunResult runReflections(gpu::Context& ctx, scene::Scene& scene, const
         if (i == 0) blockingAfterFirst = ctx.blockingSubmits();
         if (check) {
             executor.waitIdle();
-            const double mean = meanReflection(resolved, w * h);
+            const double mean = meanReflection(*resolved, w * h);
             if (previousMean) {
                 result.lastChange = std::abs(mean - *previousMean) / std::max(std::abs(mean), 1e-6);
                 spdlog::debug("reference: {} frames, mean {:.6f}, change {:.2e}", i + 1, mean, result.lastChange);
@@ -480,14 +439,14 @@ ReflectionRunResult runReflections(gpu::Context& ctx, scene::Scene& scene, const
         result.totalMs = median(totalTimes);
     }
     result.rgba.resize(size_t(w) * h * 4);
-    std::memcpy(result.rgba.data(), image.mapped(), result.rgba.size());
+    std::memcpy(result.rgba.data(), image.bytes().data(), result.rgba.size());
     if (options.readResolved) {
-        const auto halves = resolved.mappedSpan<const uint16_t>();
+        const auto halves = resolved->as<uint16_t>();
         result.resolved.resize(size_t(w) * h * 4);
         for (size_t k = 0; k < result.resolved.size(); ++k) result.resolved[k] = glm::unpackHalf1x16(halves[k]);
     }
     std::vector<uint32_t> words(shader::kReflectionCountWords);
-    std::memcpy(words.data(), counts.mapped(), words.size() * 4);
+    std::memcpy(words.data(), counts.bytes().data(), words.size() * 4);
     result.pixelClasses.assign(words.begin(), words.begin() + shader::kPixelClassCount);
     result.sslrRays = words[shader::kCountSslrRays];
     result.rtRays = words[shader::kCountRtRays];

@@ -4,11 +4,11 @@
 // times (median over frames), ray and pixel-class counts, BVH stats.
 // Shared by glint-render and the benchmark.
 
-#include "gpu/context.h"
-#include "graph/types.h"
-#include "passes/reflection_frame.h"
-#include "scene/camera.h"
-#include "scene/scene.h"
+#include "glint/gpu/context.h"
+#include "glint/graph/types.h"
+#include "glint/passes/reflection_frame.h"
+#include "glint/scene/camera.h"
+#include "glint/scene/scene.h"
 
 #include <array>
 #include <optional>

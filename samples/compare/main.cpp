@@ -3,9 +3,9 @@
 // them), relMSE, PSNR and SSIM. --map writes the FLIP error map in magma.
 
 #include "common/app.h"
-#include "metrics/error_map.h"
-#include "metrics/flip.h"
-#include "metrics/pixel_metrics.h"
+#include "glint/metrics/error_map.h"
+#include "glint/metrics/flip.h"
+#include "glint/metrics/pixel_metrics.h"
 
 #include <cmath>
 #include <cstdio>

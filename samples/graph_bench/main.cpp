@@ -20,10 +20,10 @@
 #include <string>
 #include <vector>
 
-#include "graph/compile.h"
-#include "graph/graph.h"
-#include "graph/synthetic.h"
-#include "graph/verify.h"
+#include "glint/graph/compile.h"
+#include "glint/graph/graph.h"
+#include "glint/graph/synthetic.h"
+#include "glint/graph/verify.h"
 
 namespace {
 

@@ -3,7 +3,7 @@
 // every ray backend the device has, compared against each other.
 
 #include "common/app.h"
-#include "passes/smoke_trace.h"
+#include "glint/passes/smoke_trace.h"
 
 #include <spdlog/spdlog.h>
 

@@ -7,9 +7,9 @@
 
 #include "common/app.h"
 #include "common/reflection_run.h"
-#include "passes/smoke_trace.h"
-#include "scene/builtin_scenes.h"
-#include "scene/image_io.h"
+#include "glint/passes/smoke_trace.h"
+#include "glint/scene/builtin_scenes.h"
+#include "glint/scene/image_io.h"
 
 #include <spdlog/spdlog.h>
 

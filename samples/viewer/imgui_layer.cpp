@@ -1,7 +1,7 @@
 #include "imgui_layer.h"
 
-#include "gpu/commands.h"
-#include "gpu/error.h"
+#include "glint/gpu/commands.h"
+#include "glint/gpu/error.h"
 
 #include <imgui.h>
 #include <imgui_impl_glfw.h>

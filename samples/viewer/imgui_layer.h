@@ -7,9 +7,9 @@
 // colour attachment (ATTACHMENT_OPTIMAL): the graph's barriers around the
 // pass do all synchronisation, the render pass none.
 
-#include "gpu/context.h"
-#include "gpu/handle.h"
-#include "gpu/resources.h"
+#include "glint/gpu/context.h"
+#include "glint/gpu/handle.h"
+#include "glint/gpu/resources.h"
 
 #include <vulkan/vulkan.h>
 

@@ -1,6 +1,6 @@
 #include "present_passes.h"
 
-#include "graph/executor.h"
+#include "glint/graph/executor.h"
 
 namespace glint::viewer {
 

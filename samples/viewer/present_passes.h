@@ -17,7 +17,7 @@
 // the frame is composed in a UNORM image of the viewer's and raw-copied
 // (bytes unchanged) into the swapchain image, still inside the graph.
 
-#include "graph/graph.h"
+#include "glint/graph/graph.h"
 
 #include <vulkan/vulkan.h>
 

@@ -1,6 +1,6 @@
 #include "swapchain.h"
 
-#include "gpu/error.h"
+#include "glint/gpu/error.h"
 
 #include <spdlog/spdlog.h>
 

@@ -15,9 +15,9 @@
 // wrappers (made with each swapchain, with a view each for the UI's
 // framebuffers).
 
-#include "gpu/context.h"
-#include "gpu/handle.h"
-#include "gpu/resources.h"
+#include "glint/gpu/context.h"
+#include "glint/gpu/handle.h"
+#include "glint/gpu/resources.h"
 
 #include <vulkan/vulkan.h>
 

@@ -7,8 +7,8 @@
 
 #include "common/app.h"
 #include "common/reflection_run.h"
-#include "passes/reflection_frame.h"
-#include "scene/camera.h"
+#include "glint/passes/reflection_frame.h"
+#include "glint/scene/camera.h"
 
 #include <glm/glm.hpp>
 

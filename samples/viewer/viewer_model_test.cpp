@@ -3,11 +3,11 @@
 
 #include <doctest/doctest.h>
 
-#include "graph/access.h"
-#include "graph/compile.h"
-#include "graph/plan.h"
-#include "graph/synthetic.h"
-#include "graph/verify.h"
+#include "glint/graph/access.h"
+#include "glint/graph/compile.h"
+#include "glint/graph/plan.h"
+#include "glint/graph/synthetic.h"
+#include "glint/graph/verify.h"
 #include "imgui_layer.h"
 #include "present_passes.h"
 #include "viewer_model.h"

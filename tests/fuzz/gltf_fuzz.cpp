@@ -3,8 +3,8 @@
 // and images beside it, which are then missing), loaded by the scene
 // loader. It must load or throw a SceneError; anything else (a crash,
 // another exception, a sanitizer report) aborts: a finding.
-#include "scene/error.h"
-#include "scene/gltf_loader.h"
+#include "glint/scene/error.h"
+#include "glint/scene/gltf_loader.h"
 
 #include <unistd.h>
 

@@ -7,12 +7,12 @@
 // exception, a plan the verifier rejects) aborts: a finding.
 #include "fuzz_input.h"
 
-#include "graph/compile.h"
-#include "graph/error.h"
-#include "graph/graph.h"
-#include "graph/plan.h"
-#include "graph/synthetic.h"
-#include "graph/verify.h"
+#include "glint/graph/compile.h"
+#include "glint/graph/error.h"
+#include "glint/graph/graph.h"
+#include "glint/graph/plan.h"
+#include "glint/graph/synthetic.h"
+#include "glint/graph/verify.h"
 
 #include <cstdio>
 #include <cstdlib>

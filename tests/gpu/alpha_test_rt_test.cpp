@@ -10,9 +10,9 @@
 #include "support/gpu_test.h"
 #include "support/frame_render.h"
 
-#include "passes/reflection_frame.h"
-#include "scene/animation.h"
-#include "scene/procedural_meshes.h"
+#include "glint/passes/reflection_frame.h"
+#include "glint/scene/animation.h"
+#include "glint/scene/procedural_meshes.h"
 
 #include <doctest/doctest.h>
 

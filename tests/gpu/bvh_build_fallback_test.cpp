@@ -13,14 +13,14 @@
 // nothing in the frame with the BVH still building (its ray passed where an
 // unbuilt box stands).
 #include "support/gpu_test.h"
-#include "support/graph_readback.h"
+#include "glint/graph/transfer.h"
 
-#include "graph/executor.h"
-#include "graph/graph.h"
-#include "passes/reflection_frame.h"
-#include "scene/animation.h"
-#include "scene/procedural_meshes.h"
-#include "scene/scene.h"
+#include "glint/graph/executor.h"
+#include "glint/graph/graph.h"
+#include "glint/passes/reflection_frame.h"
+#include "glint/scene/animation.h"
+#include "glint/scene/procedural_meshes.h"
+#include "glint/scene/scene.h"
 
 #include "glint/ray_generation_shared.h"
 
@@ -89,8 +89,7 @@ class Sequence {
 public:
     Sequence(gpu::Context& ctx, const scene::Scene& s, uint32_t firstBuildBudget)
         : ctx_(ctx), scene_(s), executor_(ctx), renderer_(ctx, scene_, options(firstBuildBudget)) {
-        readback_ = test::readbackBuffer(ctx, kWidth, kHeight, 4, "bvh_fallback_test.readback");
-        camera_.resolution = {kWidth, kHeight};
+                camera_.resolution = {kWidth, kHeight};
         camera_.lens = {glm::radians(60.0f), 0.1f, scene::kInfiniteFar};
         camera_.jitter = false;
     }
@@ -110,13 +109,12 @@ public:
         const passes::ReflectionFrame f = renderer_.addFrame(graph, camera_, settings);
         rg::FrameResources resources;
         renderer_.bind(resources, f);
-        test::addReadback(graph, f.integrate.hitDistance, kWidth, kHeight, readback_, resources,
-                          "bvh_fallback_test.readback");
+        readback_.copy(graph, resources, f.integrate.hitDistance);
         executor_.run(graph.compile(executor_.compileOptions()), resources);
         executor_.waitIdle();
         FrameResult r;
         r.hitDistance.resize(size_t(kWidth) * kHeight);
-        std::memcpy(r.hitDistance.data(), readback_.mapped(), r.hitDistance.size() * sizeof(float));
+        std::memcpy(r.hitDistance.data(), readback_.bytes().data(), r.hitDistance.size() * sizeof(float));
         r.bvhComplete = f.bvhComplete;
         r.built = renderer_.bvhPlanStats().built;
         return r;
@@ -134,7 +132,7 @@ private:
     rg::Executor executor_;
     passes::ReflectionRenderer renderer_;
     scene::Camera camera_;
-    gpu::Buffer readback_;
+    rg::HostReadback readback_{ctx_, VkDeviceSize(kWidth) * kHeight * 4, "bvh_fallback_test.readback"};
 };
 
 bool reflectsSurface(float hitDistance) { return hitDistance < 0.5f * shader::kMissHitDistance; }

@@ -1,10 +1,10 @@
 // Device selection, capabilities and the errors a user meets first.
 #include "support/gpu_test.h"
 
-#include "gpu/commands.h"
-#include "gpu/descriptors.h"
-#include "gpu/error.h"
-#include "gpu/pipeline.h"
+#include "glint/gpu/commands.h"
+#include "glint/gpu/descriptors.h"
+#include "glint/gpu/error.h"
+#include "glint/gpu/pipeline.h"
 
 #include <cstdlib>
 #include <string>

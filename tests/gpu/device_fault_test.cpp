@@ -7,12 +7,12 @@
 // fixture checks) and, under the sanitizers, without a leak.
 #include "support/gpu_test.h"
 
-#include "gpu/error.h"
-#include "gpu/fault.h"
-#include "graph/executor.h"
-#include "graph/graph.h"
-#include "passes/reflection_frame.h"
-#include "scene/builtin_scenes.h"
+#include "glint/gpu/error.h"
+#include "glint/gpu/fault.h"
+#include "glint/graph/executor.h"
+#include "glint/graph/graph.h"
+#include "glint/passes/reflection_frame.h"
+#include "glint/scene/builtin_scenes.h"
 
 #include <doctest/doctest.h>
 

@@ -10,10 +10,10 @@
 #include "support/gpu_test.h"
 #include "support/frame_render.h"
 
-#include "passes/reflection_frame.h"
-#include "scene/animation.h"
-#include "scene/gltf_loader.h"
-#include "scene/procedural_meshes.h"
+#include "glint/passes/reflection_frame.h"
+#include "glint/scene/animation.h"
+#include "glint/scene/gltf_loader.h"
+#include "glint/scene/procedural_meshes.h"
 
 #include <glm/gtc/matrix_transform.hpp>
 

@@ -14,7 +14,7 @@
 #include "support/gpu_test.h"
 
 #include "common/reflection_run.h"
-#include "scene/builtin_scenes.h"
+#include "glint/scene/builtin_scenes.h"
 
 #include <stb_image.h>
 #include <stb_image_write.h>

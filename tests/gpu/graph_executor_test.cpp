@@ -3,13 +3,13 @@
 // numbers back, with aliasing active, across frames in flight.
 #include "support/gpu_test.h"
 
-#include "gpu/commands.h"
-#include "gpu/descriptors.h"
-#include "gpu/error.h"
-#include "gpu/pipeline.h"
-#include "graph/executor.h"
-#include "graph/graph.h"
-#include "graph/verify.h"
+#include "glint/gpu/commands.h"
+#include "glint/gpu/descriptors.h"
+#include "glint/gpu/error.h"
+#include "glint/gpu/pipeline.h"
+#include "glint/graph/executor.h"
+#include "glint/graph/graph.h"
+#include "glint/graph/verify.h"
 
 #include <set>
 

@@ -1,5 +1,5 @@
 // The range allocator behind device-memory suballocation; no GPU needed.
-#include "gpu/memory.h"
+#include "glint/gpu/memory.h"
 
 #include <doctest/doctest.h>
 

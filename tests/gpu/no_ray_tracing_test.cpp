@@ -5,12 +5,12 @@
 #include "support/gpu_test.h"
 #include "support/frame_render.h"
 
-#include "gpu/error.h"
-#include "graph/executor.h"
-#include "graph/graph.h"
-#include "graph/plan.h"
-#include "passes/reflection_frame.h"
-#include "scene/builtin_scenes.h"
+#include "glint/gpu/error.h"
+#include "glint/graph/executor.h"
+#include "glint/graph/graph.h"
+#include "glint/graph/plan.h"
+#include "glint/passes/reflection_frame.h"
+#include "glint/scene/builtin_scenes.h"
 
 #include <doctest/doctest.h>
 

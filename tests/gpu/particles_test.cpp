@@ -14,21 +14,22 @@
 #include "support/gpu_test.h"
 #include "support/pass_test_scene.h"
 
-#include "gpu/error.h"
-#include "graph/executor.h"
-#include "graph/graph.h"
-#include "graph/verify.h"
-#include "passes/bvh_update.h"
-#include "passes/gbuffer.h"
-#include "passes/integrate.h"
-#include "passes/lighting.h"
-#include "passes/particles.h"
-#include "passes/ray_generation.h"
-#include "passes/rt_trace.h"
-#include "passes/sslr.h"
-#include "scene/animation.h"
-#include "scene/builtin_scenes.h"
-#include "scene/bvh_planner.h"
+#include "glint/gpu/error.h"
+#include "glint/graph/executor.h"
+#include "glint/graph/graph.h"
+#include "glint/graph/transfer.h"
+#include "glint/graph/verify.h"
+#include "glint/passes/bvh_update.h"
+#include "glint/passes/gbuffer.h"
+#include "glint/passes/integrate.h"
+#include "glint/passes/lighting.h"
+#include "glint/passes/particles.h"
+#include "glint/passes/ray_generation.h"
+#include "glint/passes/rt_trace.h"
+#include "glint/passes/sslr.h"
+#include "glint/scene/animation.h"
+#include "glint/scene/builtin_scenes.h"
+#include "glint/scene/bvh_planner.h"
 
 #include "glint/particles_shared.h"
 #include "glint/ray_generation_shared.h"
@@ -213,9 +214,8 @@ public:
           rt_(ctx),
           integrate_(ctx),
           particles_(ctx) {
-        for (auto& b : readbacks_) {
-            b = gpu::Buffer(ctx, {kPixels * 8, VK_BUFFER_USAGE_TRANSFER_DST_BIT, gpu::MemoryUsage::Readback,
-                                  "particles_test.readback"});
+        for (uint32_t slot = 0; slot < kReadbacks; ++slot) {
+            readbacks_.emplace_back(ctx, kPixels * 8, "particles_test.readback" + std::to_string(slot));
         }
     }
 
@@ -322,7 +322,7 @@ public:
         for (const auto& [texture, target] : reads) {
             if (texture == particleRadiance) {
                 f.particleBits.resize(kPixels);
-                std::memcpy(f.particleBits.data(), readbacks_[slot].mapped(), kPixels * 8);
+                std::memcpy(f.particleBits.data(), readbacks_[slot].bytes().data(), kPixels * 8);
             }
             *target = unpack(slot++);
         }
@@ -333,7 +333,7 @@ public:
 private:
     std::vector<glm::vec4> unpack(uint32_t slot) const {
         std::vector<glm::vec4> out(kPixels);
-        const auto* bits = reinterpret_cast<const uint16_t*>(readbacks_[slot].mapped());
+        const auto* bits = reinterpret_cast<const uint16_t*>(readbacks_[slot].bytes().data());
         for (size_t i = 0; i < kPixels; ++i) {
             for (int c = 0; c < 4; ++c) out[i][c] = glm::unpackHalf1x16(bits[4 * i + c]);
         }
@@ -343,31 +343,7 @@ private:
     // Copies an RGBA16F texture into readback slot `slot` inside the graph.
     void addReadback(rg::Graph& graph, rg::Texture texture, uint32_t slot, rg::FrameResources& resources) {
         REQUIRE(slot < readbacks_.size());
-        const rg::BoundaryState lastCopy = rg::BoundaryState::of(rg::Access::TransferDst);
-        const rg::BoundaryState hostRead = rg::BoundaryState::raw(VK_PIPELINE_STAGE_2_HOST_BIT,
-                                                                  VK_ACCESS_2_HOST_READ_BIT, VK_IMAGE_LAYOUT_UNDEFINED);
-        const std::string name = "particles_test.readback" + std::to_string(slot);
-        const rg::Buffer target = graph.importBuffer(name, {{readbacks_[slot].size()}, lastCopy, hostRead});
-        resources.bind(target, readbacks_[slot]);
-        struct Data {
-            rg::Texture source;
-            rg::Buffer target;
-        };
-        const Data& data = graph.addPass<Data>(
-            name, rg::Queue::Graphics,
-            [&](rg::Builder& b, Data& d) {
-                d.source = b.read(texture, rg::Access::TransferSrc);
-                d.target = b.write(target, rg::Access::TransferDst);
-            },
-            [](const Data& d, rg::PassContext& pc) {
-                const gpu::Image& image = pc.image(d.source);
-                VkBufferImageCopy region{};
-                region.imageSubresource = {image.aspect(), 0, 0, 1};
-                region.imageExtent = {kSize, kSize, 1};
-                vkCmdCopyImageToBuffer(pc.cmd(), image.handle(), VK_IMAGE_LAYOUT_TRANSFER_SRC_OPTIMAL,
-                                       pc.buffer(d.target).handle(), 1, &region);
-            });
-        graph.markOutput(data.target);
+        readbacks_[slot].copy(graph, resources, texture);
     }
 
     gpu::Context& ctx_;
@@ -382,7 +358,8 @@ private:
     passes::RtTracePipelines rt_;
     passes::IntegratePipelines integrate_;
     passes::ParticlePipelines particles_;
-    std::array<gpu::Buffer, 8> readbacks_;
+    static constexpr uint32_t kReadbacks = 8;
+    std::vector<rg::HostReadback> readbacks_;
     uint64_t frame_ = 1;
 };
 

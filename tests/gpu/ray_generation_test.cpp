@@ -8,12 +8,12 @@
 #include "support/gpu_test.h"
 #include "support/pass_test_scene.h"
 
-#include "graph/executor.h"
-#include "graph/graph.h"
-#include "graph/verify.h"
-#include "passes/gbuffer.h"
-#include "passes/ray_generation.h"
-#include "scene/animation.h"
+#include "glint/graph/executor.h"
+#include "glint/graph/graph.h"
+#include "glint/graph/verify.h"
+#include "glint/passes/gbuffer.h"
+#include "glint/passes/ray_generation.h"
+#include "glint/scene/animation.h"
 
 #include "glint/feedback_shared.h"
 #include "glint/ray_generation_shared.h"

@@ -11,14 +11,14 @@
 // synthetic frame whose SSLR reads the TLAS; these check the real one.
 #include "support/gpu_test.h"
 
-#include "graph/graph.h"
-#include "graph/ir.h"
-#include "graph/plan.h"
-#include "graph/synthetic.h"
-#include "graph/verify.h"
-#include "passes/reflection_frame.h"
-#include "scene/builtin_scenes.h"
-#include "scene/camera.h"
+#include "glint/graph/graph.h"
+#include "glint/graph/ir.h"
+#include "glint/graph/plan.h"
+#include "glint/graph/synthetic.h"
+#include "glint/graph/verify.h"
+#include "glint/passes/reflection_frame.h"
+#include "glint/scene/builtin_scenes.h"
+#include "glint/scene/camera.h"
 
 #include <doctest/doctest.h>
 

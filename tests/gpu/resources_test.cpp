@@ -1,10 +1,10 @@
 // Buffers, images, memory placement (aliasing), transfers and timestamps.
 #include "support/gpu_test.h"
 
-#include "gpu/commands.h"
-#include "gpu/descriptors.h"
-#include "gpu/pipeline.h"
-#include "gpu/timestamps.h"
+#include "glint/gpu/commands.h"
+#include "glint/gpu/descriptors.h"
+#include "glint/gpu/pipeline.h"
+#include "glint/gpu/timestamps.h"
 
 #include <numeric>
 

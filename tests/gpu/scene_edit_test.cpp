@@ -6,14 +6,14 @@
 // primitive offsets, hit materials or G-buffer vertices), with validation
 // on.
 #include "support/gpu_test.h"
-#include "support/graph_readback.h"
+#include "glint/graph/transfer.h"
 
-#include "graph/executor.h"
-#include "graph/graph.h"
-#include "passes/reflection_frame.h"
-#include "scene/builtin_scenes.h"
-#include "scene/mesh_tools.h"
-#include "scene/procedural_meshes.h"
+#include "glint/graph/executor.h"
+#include "glint/graph/graph.h"
+#include "glint/passes/reflection_frame.h"
+#include "glint/scene/builtin_scenes.h"
+#include "glint/scene/mesh_tools.h"
+#include "glint/scene/procedural_meshes.h"
 
 #include <doctest/doctest.h>
 
@@ -35,7 +35,7 @@ constexpr glm::uvec2 kSize{64, 48};
 // last composited image.
 std::vector<uint8_t> render(gpu::Context& ctx, rg::Executor& executor, passes::ReflectionRenderer& renderer,
                             const scene::Scene& s, passes::ReflectionMode mode, uint32_t first, uint32_t count) {
-    const gpu::Buffer readback = test::readbackBuffer(ctx, kSize.x, kSize.y, 4, "scene_edit.readback");
+    const rg::HostReadback readback(ctx, VkDeviceSize(kSize.x) * kSize.y * 4, "scene_edit.readback");
     scene::Camera camera;
     camera.resolution = kSize;
     camera.lens = s.lens;
@@ -55,7 +55,7 @@ std::vector<uint8_t> render(gpu::Context& ctx, rg::Executor& executor, passes::R
         rg::FrameResources resources;
         renderer.bind(resources, f);
         if (i + 1 == first + count) {
-            test::addReadback(graph, f.output.color, kSize.x, kSize.y, readback, resources, "scene_edit.readback");
+            readback.copy(graph, resources, f.output.color);
         }
         executor.run(graph.compile(executor.compileOptions()), resources);
     }
@@ -65,7 +65,7 @@ std::vector<uint8_t> render(gpu::Context& ctx, rg::Executor& executor, passes::R
     // (the readback's, for one) for hazards.
     ctx.waitIdle();
     std::vector<uint8_t> rgba(size_t(kSize.x) * kSize.y * 4);
-    std::memcpy(rgba.data(), readback.mapped(), rgba.size());
+    std::memcpy(rgba.data(), readback.bytes().data(), rgba.size());
     return rgba;
 }
 

@@ -2,7 +2,7 @@
 // CPU reference, and on the same device they must agree with each other.
 #include "support/gpu_test.h"
 
-#include "passes/smoke_trace.h"
+#include "glint/passes/smoke_trace.h"
 
 #include <cmath>
 

@@ -29,13 +29,13 @@
 // Validation is off here: it would multiply the run time and its own
 // bookkeeping grows with the objects it tracks. Every pass runs under
 // validation in the other suites.
-#include "gpu/context.h"
-#include "graph/executor.h"
-#include "graph/graph.h"
-#include "passes/reflection_frame.h"
-#include "scene/animation.h"
-#include "scene/builtin_scenes.h"
-#include "scene/camera.h"
+#include "glint/gpu/context.h"
+#include "glint/graph/executor.h"
+#include "glint/graph/graph.h"
+#include "glint/passes/reflection_frame.h"
+#include "glint/scene/animation.h"
+#include "glint/scene/builtin_scenes.h"
+#include "glint/scene/camera.h"
 
 #include <doctest/doctest.h>
 #include <spdlog/spdlog.h>

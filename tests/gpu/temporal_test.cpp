@@ -12,14 +12,14 @@
 #include "support/gpu_test.h"
 #include "support/pass_test_scene.h"
 
-#include "gpu/error.h"
-#include "graph/executor.h"
-#include "graph/graph.h"
-#include "graph/verify.h"
-#include "passes/composite.h"
-#include "passes/gbuffer.h"
-#include "passes/temporal.h"
-#include "scene/animation.h"
+#include "glint/gpu/error.h"
+#include "glint/graph/executor.h"
+#include "glint/graph/graph.h"
+#include "glint/graph/verify.h"
+#include "glint/passes/composite.h"
+#include "glint/passes/gbuffer.h"
+#include "glint/passes/temporal.h"
+#include "glint/scene/animation.h"
 
 #include "glint/ray_generation_shared.h"
 

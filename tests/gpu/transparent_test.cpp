@@ -8,12 +8,12 @@
 #include "support/gpu_test.h"
 #include "support/frame_render.h"
 
-#include "graph/executor.h"
-#include "graph/graph.h"
-#include "graph/plan.h"
-#include "passes/reflection_frame.h"
-#include "scene/animation.h"
-#include "scene/procedural_meshes.h"
+#include "glint/graph/executor.h"
+#include "glint/graph/graph.h"
+#include "glint/graph/plan.h"
+#include "glint/passes/reflection_frame.h"
+#include "glint/scene/animation.h"
+#include "glint/scene/procedural_meshes.h"
 
 #include "glint/packing.h"
 

@@ -3,9 +3,9 @@
 // correctly synchronised and expect silence.
 #include "support/gpu_test.h"
 
-#include "gpu/commands.h"
-#include "gpu/descriptors.h"
-#include "gpu/pipeline.h"
+#include "glint/gpu/commands.h"
+#include "glint/gpu/descriptors.h"
+#include "glint/gpu/pipeline.h"
 
 using namespace glint;
 

@@ -1,5 +1,5 @@
 // What the validation log keeps and what it sets aside; no GPU needed.
-#include "gpu/validation.h"
+#include "glint/gpu/validation.h"
 
 #include <doctest/doctest.h>
 

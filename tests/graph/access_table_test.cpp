@@ -2,7 +2,7 @@
 
 #include <doctest/doctest.h>
 
-#include "graph/access.h"
+#include "glint/graph/access.h"
 
 using namespace glint::rg;
 

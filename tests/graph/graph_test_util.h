@@ -9,11 +9,11 @@
 #include <string_view>
 #include <vector>
 
-#include "graph/compile.h"
-#include "graph/graph.h"
-#include "graph/plan.h"
-#include "graph/synthetic.h"
-#include "graph/verify.h"
+#include "glint/graph/compile.h"
+#include "glint/graph/graph.h"
+#include "glint/graph/plan.h"
+#include "glint/graph/synthetic.h"
+#include "glint/graph/verify.h"
 
 namespace glint::rg::test {
 

@@ -2,7 +2,7 @@
 // lists what `flip -r reference.png -t posterize3.png [-ppd N]` prints, where
 // posterize3 is reference.png with the 5 low bits of every channel cleared.
 
-#include "metrics/flip.h"
+#include "glint/metrics/flip.h"
 
 #include <doctest/doctest.h>
 

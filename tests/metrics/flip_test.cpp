@@ -1,6 +1,6 @@
 // FLIP on images small enough to work out by hand, and the pooling rules.
 
-#include "metrics/flip.h"
+#include "glint/metrics/flip.h"
 
 #include <doctest/doctest.h>
 

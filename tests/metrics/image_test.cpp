@@ -1,7 +1,7 @@
 // PNG input as the official FLIP tool decodes it, and error maps out.
 
-#include "metrics/error_map.h"
-#include "metrics/image.h"
+#include "glint/metrics/error_map.h"
+#include "glint/metrics/image.h"
 
 #include <doctest/doctest.h>
 #include <stb_image.h>

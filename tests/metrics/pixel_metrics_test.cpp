@@ -1,6 +1,6 @@
 // relMSE, PSNR and SSIM on images with answers known in closed form.
 
-#include "metrics/pixel_metrics.h"
+#include "glint/metrics/pixel_metrics.h"
 
 #include <doctest/doctest.h>
 #include <glm/common.hpp>

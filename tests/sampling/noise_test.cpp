@@ -4,7 +4,7 @@
 // tile and over frames. And the blue noise itself (sampling/blue_noise.h):
 // blue in space and in time, every value once, its file checked.
 #include "glint/sampling.glsl"
-#include "sampling/blue_noise.h"
+#include "glint/sampling/blue_noise.h"
 
 #include <doctest/doctest.h>
 

@@ -3,7 +3,7 @@
 // whole wrap periods so half floats keep them precise) and the vertex
 // alpha; the alpha mask layers resampled from the texture's alpha.
 
-#include "scene/alpha_test.h"
+#include "glint/scene/alpha_test.h"
 
 #include <doctest/doctest.h>
 

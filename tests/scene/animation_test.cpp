@@ -1,6 +1,6 @@
-#include "scene/animation.h"
-#include "scene/error.h"
-#include "scene/gltf_loader.h"
+#include "glint/scene/animation.h"
+#include "glint/scene/error.h"
+#include "glint/scene/gltf_loader.h"
 
 #include "scene_test_support.h"
 

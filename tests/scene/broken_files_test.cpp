@@ -5,8 +5,8 @@
 // element), never a crash, an out-of-bounds read or a huge allocation; the
 // ASan+UBSan build runs this suite too.
 
-#include "scene/error.h"
-#include "scene/gltf_loader.h"
+#include "glint/scene/error.h"
+#include "glint/scene/gltf_loader.h"
 
 #include "scene_test_support.h"
 

@@ -1,6 +1,6 @@
-#include "scene/animation.h"
-#include "scene/builtin_scenes.h"
-#include "scene/error.h"
+#include "glint/scene/animation.h"
+#include "glint/scene/builtin_scenes.h"
+#include "glint/scene/error.h"
 
 #include "scene_test_support.h"
 

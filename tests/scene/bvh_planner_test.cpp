@@ -1,11 +1,11 @@
 // The BVH policy (bvh_planner.h) over synthetic scenes and the plaza.
 
-#include "scene/animation.h"
-#include "scene/builtin_scenes.h"
-#include "scene/bvh_planner.h"
-#include "scene/error.h"
-#include "scene/packed_primitives.h"
-#include "scene/procedural_meshes.h"
+#include "glint/scene/animation.h"
+#include "glint/scene/builtin_scenes.h"
+#include "glint/scene/bvh_planner.h"
+#include "glint/scene/error.h"
+#include "glint/scene/packed_primitives.h"
+#include "glint/scene/procedural_meshes.h"
 
 #include "scene_test_support.h"
 

@@ -1,4 +1,4 @@
-#include "scene/camera.h"
+#include "glint/scene/camera.h"
 
 #include <doctest/doctest.h>
 

@@ -1,5 +1,5 @@
-#include "scene/camera.h"
-#include "scene/frustum.h"
+#include "glint/scene/camera.h"
+#include "glint/scene/frustum.h"
 
 #include <doctest/doctest.h>
 

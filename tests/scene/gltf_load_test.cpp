@@ -2,9 +2,9 @@
 // declares. The expected numbers come from the files' JSON read here with
 // nlohmann::json (accessor counts and POSITION min/max), not from the loader.
 
-#include "scene/builtin_scenes.h"
-#include "scene/error.h"
-#include "scene/gltf_loader.h"
+#include "glint/scene/builtin_scenes.h"
+#include "glint/scene/error.h"
+#include "glint/scene/gltf_loader.h"
 
 #include "scene_test_support.h"
 

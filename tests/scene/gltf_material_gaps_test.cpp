@@ -2,11 +2,11 @@
 // texture coordinate sets, KHR_texture_transform and morph targets, on
 // small documents generated here, with the errors their broken variants give.
 
-#include "scene/animation.h"
-#include "scene/error.h"
-#include "scene/gltf_loader.h"
-#include "scene/mesh_tools.h"
-#include "scene/packed_primitives.h"
+#include "glint/scene/animation.h"
+#include "glint/scene/error.h"
+#include "glint/scene/gltf_loader.h"
+#include "glint/scene/mesh_tools.h"
+#include "glint/scene/packed_primitives.h"
 
 #include "scene_test_support.h"
 

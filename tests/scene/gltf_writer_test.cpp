@@ -1,6 +1,6 @@
-#include "scene/builtin_scenes.h"
-#include "scene/gltf_loader.h"
-#include "scene/gltf_writer.h"
+#include "glint/scene/builtin_scenes.h"
+#include "glint/scene/gltf_loader.h"
+#include "glint/scene/gltf_writer.h"
 
 #include "scene_test_support.h"
 

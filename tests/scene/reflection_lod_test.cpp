@@ -3,10 +3,10 @@
 // exactly the full-detail mesh's, seams and small meshes left alone, and
 // the BVH planner building from them (or from full detail when told to).
 
-#include "scene/bvh_planner.h"
-#include "scene/gltf_loader.h"
-#include "scene/procedural_meshes.h"
-#include "scene/reflection_lod.h"
+#include "glint/scene/bvh_planner.h"
+#include "glint/scene/gltf_loader.h"
+#include "glint/scene/procedural_meshes.h"
+#include "glint/scene/reflection_lod.h"
 
 #include "scene_test_support.h"
 

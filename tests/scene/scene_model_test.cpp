@@ -2,12 +2,12 @@
 // environment mapping and HDR loading, and the CPU reference of the packed
 // primitive pass.
 
-#include "scene/animation.h"
-#include "scene/error.h"
-#include "scene/image_io.h"
-#include "scene/packed_primitives.h"
-#include "scene/procedural_meshes.h"
-#include "scene/scene.h"
+#include "glint/scene/animation.h"
+#include "glint/scene/error.h"
+#include "glint/scene/image_io.h"
+#include "glint/scene/packed_primitives.h"
+#include "glint/scene/procedural_meshes.h"
+#include "glint/scene/scene.h"
 
 #include "scene_test_support.h"
 

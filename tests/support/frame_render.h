@@ -3,13 +3,13 @@
 // few frames from the start of a scene's camera path, for the GPU tests
 // that judge the composited image: the last frame's output read back.
 
-#include "support/graph_readback.h"
+#include "glint/graph/transfer.h"
 
-#include "graph/executor.h"
-#include "graph/graph.h"
-#include "passes/reflection_frame.h"
-#include "scene/camera.h"
-#include "scene/scene.h"
+#include "glint/graph/executor.h"
+#include "glint/graph/graph.h"
+#include "glint/passes/reflection_frame.h"
+#include "glint/scene/camera.h"
+#include "glint/scene/scene.h"
 
 #include <cstring>
 #include <vector>
@@ -24,7 +24,7 @@ inline std::vector<uint8_t> renderComposited(gpu::Context& ctx, const scene::Sce
                                              const passes::ReflectionRendererOptions& options = {}) {
     rg::Executor executor(ctx);
     passes::ReflectionRenderer renderer(ctx, s, options);
-    const gpu::Buffer readback = readbackBuffer(ctx, size.x, size.y, 4, "composited.readback");
+    const rg::HostReadback readback(ctx, VkDeviceSize(size.x) * size.y * 4, "composited.readback");
     scene::Camera camera;
     camera.resolution = size;
     camera.lens = s.lens;
@@ -43,13 +43,13 @@ inline std::vector<uint8_t> renderComposited(gpu::Context& ctx, const scene::Sce
         rg::FrameResources resources;
         renderer.bind(resources, f);
         if (i + 1 == frames) {
-            addReadback(graph, f.output.color, size.x, size.y, readback, resources, "composited.readback");
+            readback.copy(graph, resources, f.output.color);
         }
         executor.run(graph.compile(executor.compileOptions()), resources);
     }
     executor.waitIdle();
     std::vector<uint8_t> rgba(size_t(size.x) * size.y * 4);
-    std::memcpy(rgba.data(), readback.mapped(), rgba.size());
+    std::memcpy(rgba.data(), readback.bytes().data(), rgba.size());
     return rgba;
 }
 

@@ -3,7 +3,7 @@
 // validation on; the test fails on any message it collects (checked when the
 // fixture goes away, after the device is destroyed, so leaks count too).
 
-#include "gpu/context.h"
+#include "glint/gpu/context.h"
 
 #include <doctest/doctest.h>
 

@@ -3,8 +3,8 @@
 // 90-degree camera at the origin looking down -Z (so at distance d the image
 // spans [-d, d] in x and y), and squares to build planes from.
 
-#include "scene/camera.h"
-#include "scene/scene.h"
+#include "glint/scene/camera.h"
+#include "glint/scene/scene.h"
 
 #include <glm/glm.hpp>
 

@@ -1,0 +1,105 @@
+#include "glint/graph/transfer.h"
+
+#include "glint/graph/error.h"
+
+#include <algorithm>
+#include <memory>
+#include <vector>
+
+namespace glint::rg {
+
+namespace {
+
+// vkCmdUpdateBuffer takes at most 65536 bytes per call, in multiples of 4.
+constexpr size_t kUpdateLimit = 65536;
+
+constexpr BoundaryState kHostRead =
+    BoundaryState::raw(VK_PIPELINE_STAGE_2_HOST_BIT, VK_ACCESS_2_HOST_READ_BIT, VK_IMAGE_LAYOUT_UNDEFINED);
+
+} // namespace
+
+Buffer addUpload(Graph& graph, std::string_view name, std::span<const std::byte> bytes, Queue queue) {
+    if (bytes.empty() || bytes.size() % 4 != 0) {
+        throw GraphError(ErrorKind::InvalidDescription, name, name,
+                         "an upload must be a non-zero multiple of 4 bytes, not " + std::to_string(bytes.size()));
+    }
+    struct Data {
+        Buffer target;
+    };
+    auto copy = std::make_shared<std::vector<std::byte>>(bytes.begin(), bytes.end());
+    const Data& data = graph.addPass<Data>(
+        name, queue,
+        [&](Builder& b, Data& d) { d.target = b.write(b.createBuffer(name, {bytes.size()}), Access::TransferDst); },
+        [copy](const Data& d, PassContext& pc) {
+            const VkBuffer target = pc.buffer(d.target).handle();
+            for (size_t offset = 0; offset < copy->size(); offset += kUpdateLimit) {
+                const size_t size = std::min(kUpdateLimit, copy->size() - offset);
+                vkCmdUpdateBuffer(pc.cmd(), target, offset, size, copy->data() + offset);
+            }
+        });
+    return data.target;
+}
+
+HostReadback::HostReadback(gpu::Context& ctx, VkDeviceSize bytes, std::string name)
+    : buffer_(ctx, {bytes, VK_BUFFER_USAGE_TRANSFER_DST_BIT, gpu::MemoryUsage::Readback, name}),
+      name_(std::move(name)) {}
+
+void HostReadback::copy(Graph& graph, FrameResources& resources, Texture texture) const {
+    const ir::Resource& source = graph.declaration().resources.at(texture.index);
+    const TextureDesc& desc = source.texture;
+    const VkDeviceSize needed = VkDeviceSize(desc.width) * desc.height * desc.depth * gpu::bytesPerTexel(desc.format);
+    if (needed > buffer_.size()) {
+        throw GraphError(ErrorKind::InvalidDescription, name_, source.name,
+                         "the readback holds " + std::to_string(buffer_.size()) + " bytes, the texture's mip 0 " +
+                             std::to_string(needed));
+    }
+    const Buffer target = graph.importBuffer(name_, {{buffer_.size()}, BoundaryState::of(Access::TransferDst), kHostRead});
+    resources.bind(target, buffer_);
+    struct Data {
+        Texture source;
+        Buffer target;
+    };
+    const Data& data = graph.addPass<Data>(
+        name_, Queue::Graphics,
+        [&](Builder& b, Data& d) {
+            d.source = b.read(texture, Access::TransferSrc);
+            d.target = b.write(target, Access::TransferDst);
+        },
+        [extent = VkExtent3D{desc.width, desc.height, desc.depth}](const Data& d, PassContext& pc) {
+            const gpu::Image& image = pc.image(d.source);
+            VkBufferImageCopy region{};
+            region.imageSubresource = {image.aspect(), 0, 0, 1};
+            region.imageExtent = extent;
+            vkCmdCopyImageToBuffer(pc.cmd(), image.handle(), VK_IMAGE_LAYOUT_TRANSFER_SRC_OPTIMAL,
+                                   pc.buffer(d.target).handle(), 1, &region);
+        });
+    graph.markOutput(data.target);
+}
+
+void HostReadback::copy(Graph& graph, FrameResources& resources, Buffer buffer) const {
+    const ir::Resource& source = graph.declaration().resources.at(buffer.index);
+    const VkDeviceSize size = std::min<VkDeviceSize>(source.buffer.size, buffer_.size());
+    const Buffer target = graph.importBuffer(name_, {{buffer_.size()}, BoundaryState::of(Access::TransferDst), kHostRead});
+    resources.bind(target, buffer_);
+    struct Data {
+        Buffer source;
+        Buffer target;
+    };
+    const Data& data = graph.addPass<Data>(
+        name_, Queue::Graphics,
+        [&](Builder& b, Data& d) {
+            d.source = b.read(buffer, Access::TransferSrc);
+            d.target = b.write(target, Access::TransferDst);
+        },
+        [size](const Data& d, PassContext& pc) {
+            const VkBufferCopy region{0, 0, size};
+            vkCmdCopyBuffer(pc.cmd(), pc.buffer(d.source).handle(), pc.buffer(d.target).handle(), 1, &region);
+        });
+    graph.markOutput(data.target);
+}
+
+std::span<const std::byte> HostReadback::bytes() const {
+    return {buffer_.mapped(), static_cast<size_t>(buffer_.size())};
+}
+
+} // namespace glint::rg

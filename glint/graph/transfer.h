@@ -1,0 +1,75 @@
+#pragma once
+// Moving small data in and out of a frame through the graph, so that a
+// pass, a sample or a test does not write its own copy pass:
+//
+//   // constants that outgrow push constants, uploaded inside the frame:
+//   const rg::Buffer constants = rg::addUpload(graph, "integrate.constants", values);
+//   ... b.read(constants, rg::Access::StorageRead) ...
+//
+//   // a frame's image read back on the host:
+//   rg::HostReadback readback(ctx, width * height * 4, "output");
+//   readback.copy(graph, resources, frame.output.color);
+//   executor.run(graph.compile(...), resources);
+//   executor.waitIdle();
+//   std::span<const uint8_t> rgba = readback.bytes();
+
+#include "glint/gpu/resources.h"
+#include "glint/graph/executor.h"
+#include "glint/graph/graph.h"
+
+#include <cstddef>
+#include <cstdint>
+#include <span>
+#include <string>
+#include <string_view>
+#include <type_traits>
+
+namespace glint::rg {
+
+// Declares a transient buffer of bytes.size() bytes and a transfer pass on
+// `queue` that fills it with `bytes` (copied now; vkCmdUpdateBuffer in
+// pieces of at most 64 KiB). Readers then declare their own access to the
+// returned handle; the graph orders and synchronizes the rest.
+Buffer addUpload(Graph& graph, std::string_view name, std::span<const std::byte> bytes, Queue queue = Queue::Graphics);
+
+// One value's bytes (a constants struct).
+template <class T>
+    requires(!std::is_convertible_v<const T&, std::span<const std::byte>>)
+Buffer addUpload(Graph& graph, std::string_view name, const T& value, Queue queue = Queue::Graphics) {
+    static_assert(std::is_trivially_copyable_v<T>, "addUpload copies the value's bytes");
+    return addUpload(graph, name, std::span<const std::byte>(reinterpret_cast<const std::byte*>(&value), sizeof(T)),
+                     queue);
+}
+
+// A host-visible buffer that a frame fills at its end: copy() declares a
+// graph import of it and a transfer pass on the graphics queue copying a
+// texture (mip 0, layer 0, tightly packed) or a buffer into it, marked as
+// an output so it is never culled. Read bytes() once the frame's work has
+// finished (Executor::waitIdle, or a later frame's slot wait). One copy per
+// frame per HostReadback.
+class HostReadback {
+public:
+    HostReadback(gpu::Context& ctx, VkDeviceSize bytes, std::string name);
+
+    // The texture's mip 0 must fit (width x height x bytesPerTexel); checked
+    // when the copy runs, against the image the plan bound.
+    void copy(Graph& graph, FrameResources& resources, Texture texture) const;
+    // Copies min(buffer size, this size) bytes from the start.
+    void copy(Graph& graph, FrameResources& resources, Buffer buffer) const;
+
+    std::span<const std::byte> bytes() const;
+    template <class T>
+    std::span<const T> as() const {
+        static_assert(std::is_trivially_copyable_v<T>);
+        const std::span<const std::byte> b = bytes();
+        return {reinterpret_cast<const T*>(b.data()), b.size() / sizeof(T)};
+    }
+    const gpu::Buffer& buffer() const { return buffer_; }
+    const std::string& name() const { return name_; }
+
+private:
+    gpu::Buffer buffer_;
+    std::string name_;
+};
+
+} // namespace glint::rg

@@ -1,0 +1,99 @@
+#include "glint/passes/feedback.h"
+
+#include "glint/gpu/descriptors.h"
+#include "glint/gpu/error.h"
+#include "glint/graph/executor.h"
+
+#include "glint/feedback_shared.h"
+#include "glint/ray_generation_shared.h"
+
+#include <vector>
+
+namespace glint::passes {
+
+namespace {
+
+constexpr uint32_t kGroupSize = 64;  // reproject.comp's local_size_x
+
+std::vector<gpu::Binding> reprojectBindings() {
+    return {{0, VK_DESCRIPTOR_TYPE_COMBINED_IMAGE_SAMPLER, VK_SHADER_STAGE_COMPUTE_BIT},
+            {1, VK_DESCRIPTOR_TYPE_STORAGE_BUFFER, VK_SHADER_STAGE_COMPUTE_BIT},
+            {2, VK_DESCRIPTOR_TYPE_STORAGE_BUFFER, VK_SHADER_STAGE_COMPUTE_BIT},
+            {3, VK_DESCRIPTOR_TYPE_STORAGE_BUFFER, VK_SHADER_STAGE_COMPUTE_BIT}};
+}
+
+} // namespace
+
+FeedbackPipelines::FeedbackPipelines(gpu::Context& ctx)
+    : ctx_(ctx),
+      reproject_(gpu::createComputePipeline(ctx, {"feedback/reproject.comp", reprojectBindings(),
+                                                  uint32_t(sizeof(shader::FeedbackConstants)),
+                                                  "feedback.reproject"})),
+      // The motion is read texel by texel (texelFetch); the sampler only
+      // completes the combined descriptor.
+      nearest_(ctx, {VK_FILTER_NEAREST, VK_SAMPLER_MIPMAP_MODE_NEAREST, VK_SAMPLER_ADDRESS_MODE_CLAMP_TO_EDGE, 0.0f,
+                     "feedback.nearest"}) {}
+
+FeedbackOutputs addFeedbackPass(rg::Graph& graph, FeedbackPipelines& pipelines, const FeedbackInputs& inputs,
+                                const FeedbackSettings& settings) {
+    const GBufferOutputs& gbuf = inputs.gbuffer;
+    if (gbuf.width == 0 || gbuf.height == 0) {
+        throw gpu::GpuError("addFeedbackPass: the G-buffer has no size");
+    }
+    const auto fraction = [](float f) { return f >= 0.0f && f <= 1.0f; };
+    if (!fraction(settings.sslrMissFraction) || !fraction(settings.rtHitFraction)) {
+        throw gpu::GpuError("addFeedbackPass: sslrMissFraction and rtHitFraction must lie in [0, 1] (got " +
+                            std::to_string(settings.sslrMissFraction) + ", " + std::to_string(settings.rtHitFraction) +
+                            ")");
+    }
+    FeedbackOutputs out;
+    out.tilesX = (gbuf.width + shader::kTileSize - 1) / shader::kTileSize;
+    out.tilesY = (gbuf.height + shader::kTileSize - 1) / shader::kTileSize;
+    const uint32_t tiles = out.tilesX * out.tilesY;
+    const uint64_t tileBytes = uint64_t(tiles) * sizeof(uint32_t);
+    // A resize keeps the pair (the executor finds it by name); the shaders
+    // bound their indices by the buffer's own length, and the counters,
+    // mismatched for one frame, only steer which pass traces.
+    out.counters = graph.createHistoryBuffer(kFeedbackHistoryName, {tileBytes});
+
+    shader::FeedbackConstants constants{};
+    constants.size = {gbuf.width, gbuf.height};
+    constants.tiles = {out.tilesX, out.tilesY};
+    // The same 32-bit frame as the rest of the noise (glint/sampling.glsl).
+    constants.frame = uint32_t(inputs.frameIndex);
+    constants.minRays = settings.minRays;
+    constants.sslrMissFraction = settings.sslrMissFraction;
+    constants.rtHitFraction = settings.rtHitFraction;
+    constants.adaptive = settings.adaptive ? 1u : 0u;
+
+    struct ReprojectData {
+        rg::Texture motion;
+        rg::Buffer previous;
+        FeedbackOutputs out;
+    };
+    const ReprojectData& reproject = graph.addPass<ReprojectData>(
+        "feedback", rg::Queue::Graphics,
+        [&](rg::Builder& b, ReprojectData& d) {
+            d.motion = b.read(gbuf.motion, rg::Access::SampledRead);
+            d.previous = b.read(out.counters.previous, rg::Access::StorageRead);
+            d.out = out;
+            d.out.reprojected =
+                b.write(b.createBuffer("feedback.reprojected", {tileBytes}), rg::Access::StorageWrite);
+            d.out.tileModes = b.write(b.createBuffer("feedback.tile_modes", {tileBytes}), rg::Access::StorageWrite);
+        },
+        [&pipelines, constants, tiles](const ReprojectData& d, rg::PassContext& pc) {
+            const gpu::Pipeline& pipeline = pipelines.reproject_;
+            pipeline.bind(pc.cmd());
+            gpu::PushDescriptors(pipeline)
+                .sampledImage(0, pc.view(d.motion), pipelines.nearest_.handle(), pc.layout(d.motion))
+                .storageBuffer(1, pc.buffer(d.previous))
+                .storageBuffer(2, pc.buffer(d.out.reprojected))
+                .storageBuffer(3, pc.buffer(d.out.tileModes))
+                .push(pipelines.ctx_, pc.cmd());
+            pipeline.pushConstants(pc.cmd(), constants);
+            pc.dispatch(pipeline, (tiles + kGroupSize - 1) / kGroupSize);
+        });
+    return reproject.out;
+}
+
+} // namespace glint::passes

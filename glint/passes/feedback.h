@@ -1,0 +1,87 @@
+#pragma once
+// Pass 6 of the reflection pipeline, its first half: the tile
+// feedback. Far Cry 6 keeps one u32 per 8x8 tile with the SSLR hit and miss
+// counts of two frames (layout: glint/feedback_shared.h)
+// and uses it to send each tile's hybrid pixels to SSLR only, to SSLR with
+// the ray tracer behind it, or straight to the ray tracer. At the start of a
+// frame, after the G-buffer, one compute pass
+//   - carries last frame's counters (the history buffer
+//     "reflections.feedback") to this frame's tiles along the motion of one
+//     pseudo-random pixel per tile, new every frame ("reprojected"; content
+//     from off screen gets 0);
+//   - decides each tile's mode from the two frames of counts it carried
+//     ("tileModes": kTileMode*, read by ray generation).
+// Integrate (passes/integrate.h) writes this frame's counts into the
+// history's `current` half, rotating the reprojected counter's counts into
+// the previous half.
+//
+//   passes::FeedbackPipelines feedbackPipelines(ctx);   // once
+//   each frame, after the G-buffer:
+//     const auto feedback = passes::addFeedbackPass(graph, feedbackPipelines, {gbuf, frame}, {});
+//     ... ray generation reads feedback.tileModes ...
+//     ... integrate reads feedback.reprojected and writes feedback.counters.current ...
+
+#include "glint/gpu/context.h"
+#include "glint/gpu/pipeline.h"
+#include "glint/gpu/resources.h"
+#include "glint/graph/graph.h"
+#include "glint/passes/gbuffer.h"
+
+#include <cstdint>
+
+namespace glint::passes {
+
+// The history pair's name: one pair per executor, kept across frames.
+inline constexpr const char* kFeedbackHistoryName = "reflections.feedback";
+
+struct FeedbackInputs {
+    GBufferOutputs gbuffer;  // motion (and the size)
+    // Picks each tile's probe pixel; the same index, the same probes.
+    uint64_t frameIndex = 0;
+};
+
+struct FeedbackSettings {
+    // A tile whose two frames hold fewer traced SSLR rays than this has no
+    // evidence and stays hybrid. 1: any ray is evidence, the talk's rule.
+    // Glint's starting value; the bench may raise it for stability.
+    uint32_t minRays = 1;
+    // A tile goes SSLR-only when at most this fraction of its rays missed,
+    // RT-only when at most this fraction hit. 0: only hits / only misses,
+    // as the Far Cry 6 talk describes it; a small
+    // fraction tolerates a stray ray (Glint's knob, tuned by the bench).
+    float sslrMissFraction = 0.0f;
+    float rtHitFraction = 0.0f;
+    // Off: every tile hybrid, as if there were no feedback (the bench's
+    // baseline); the counters are still carried.
+    bool adaptive = true;
+};
+
+struct FeedbackOutputs {
+    rg::HistoryBuffer counters;  // u32 per tile; previous: last frame's; current: written by integrate
+    rg::Buffer reprojected;      // u32 per tile: last frame's counter carried to this tile
+    rg::Buffer tileModes;        // u32 per tile, shader::kTileMode*
+    uint32_t tilesX = 0;
+    uint32_t tilesY = 0;
+};
+
+// The pipeline and the sampler the pass records with; created once.
+class FeedbackPipelines {
+public:
+    explicit FeedbackPipelines(gpu::Context& ctx);
+
+private:
+    friend FeedbackOutputs addFeedbackPass(rg::Graph&, FeedbackPipelines&, const FeedbackInputs&,
+                                           const FeedbackSettings&);
+    gpu::Context& ctx_;
+    gpu::Pipeline reproject_;
+    gpu::Sampler nearest_;
+};
+
+// Declares the pass (see the top of this file) on the graphics queue. The
+// history pair is created on the graph here; integrate must write its
+// `current` half in the same frame (the executor swaps the pair only in
+// frames that write it).
+FeedbackOutputs addFeedbackPass(rg::Graph& graph, FeedbackPipelines& pipelines, const FeedbackInputs& inputs,
+                                const FeedbackSettings& settings = {});
+
+} // namespace glint::passes

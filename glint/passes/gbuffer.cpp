@@ -1,0 +1,688 @@
+#include "glint/passes/gbuffer.h"
+#include "glint/passes/gbuffer_internal.h"
+
+#include "glint/gpu/commands.h"
+#include "glint/gpu/descriptors.h"
+#include "glint/gpu/error.h"
+#include "glint/graph/executor.h"
+#include "glint/passes/environment.h"
+#include "glint/scene/animation.h"
+#include "glint/scene/frustum.h"
+
+#include "glint/gbuffer_shared.h"
+
+#include <glm/gtc/constants.hpp>
+#include <spdlog/spdlog.h>
+
+#include <algorithm>
+#include <array>
+#include <bit>
+#include <cmath>
+#include <cstring>
+#include <limits>
+#include <string>
+
+namespace glint::passes {
+
+using namespace gbuffer_detail;
+
+namespace {
+
+VkSamplerAddressMode addressMode(scene::Wrap wrap) {
+    switch (wrap) {
+    case scene::Wrap::ClampToEdge: return VK_SAMPLER_ADDRESS_MODE_CLAMP_TO_EDGE;
+    case scene::Wrap::MirroredRepeat: return VK_SAMPLER_ADDRESS_MODE_MIRRORED_REPEAT;
+    case scene::Wrap::Repeat: break;
+    }
+    return VK_SAMPLER_ADDRESS_MODE_REPEAT;
+}
+
+// Shadows fade out over the last tenth of SunShadowSettings::maxDistance.
+constexpr float kShadowFadeStart = 0.9f;
+// Texels added on each side of the fitted square: the filter reaches two
+// texels beyond a lookup, the normal offset moves lookups by up to one and
+// snapping the centre to whole texels moves the square by up to half.
+constexpr uint32_t kShadowBorderTexels = 4;
+
+// `extent` rounded up to a multiple of 1/32 of its enclosing power of two:
+// bounds that change a little (animated instances) keep the same texel size
+// most frames, and a changing texel size is what makes shadow edges swim.
+float quantiseExtent(float extent) {
+    const float step = std::exp2(std::ceil(std::log2(extent)) - 5.0f);
+    return std::ceil(extent / step) * step;
+}
+
+// Colour attachments in the order of the fragment shaders' outputs.
+constexpr std::array<VkFormat, 5> kColorFormats = {kGBufferNormalFormat, kGBufferAlbedoFormat,
+                                                   kGBufferRoughnessMetalFormat, kGBufferMotionFormat,
+                                                   kGBufferLitFormat};
+
+// Host buffers grow to the next power of two, so a slowly growing scene
+// reallocates O(log n) times.
+VkDeviceSize grownCapacity(VkDeviceSize needed) {
+    return std::bit_ceil(std::max<VkDeviceSize>(needed, 256));
+}
+
+} // namespace
+
+shader::GBufferShadow fitSunShadow(const scene::Scene& scene, const scene::Camera& camera,
+                                   const SunShadowSettings& settings) {
+    shader::GBufferShadow fit{};
+    fit.viewProjection = glm::mat4(1.0f);
+    fit.texelWorldSize = 1.0f;
+    fit.depthRange = 1.0f;
+    fit.resolution = 1;
+    if (!settings.enabled || settings.resolution == 0) return fit;
+
+    // Everything that can cast: every instance's bounds this frame (skinned
+    // ones over their whole palette).
+    scene::Aabb casters;
+    for (const scene::Instance& inst : scene.instances) {
+        if (inst.mesh < scene.meshes.size() && !scene.meshes[inst.mesh].lods.empty()) {
+            casters.extend(scene::instanceBounds(scene, inst));
+        }
+    }
+    const glm::vec3 toSun = glm::normalize(scene.sun.directionToLight);
+    if (casters.empty() || !std::isfinite(toSun.x + toSun.y + toSun.z)) return fit;
+
+    // The sun's frame: rays travel along `forward`; `right` and `up` span
+    // the map. Any basis works (the pipelines cull nothing); this one keeps
+    // the map's axes still while the sun is.
+    const glm::vec3 forward = -toSun;
+    const glm::vec3 reference = std::abs(forward.y) < 0.99f ? glm::vec3(0, 1, 0) : glm::vec3(1, 0, 0);
+    const glm::vec3 right = glm::normalize(glm::cross(forward, reference));
+    const glm::vec3 up = glm::cross(right, forward);
+
+    glm::vec3 lightMin(std::numeric_limits<float>::max());
+    glm::vec3 lightMax(-std::numeric_limits<float>::max());
+    for (int c = 0; c < 8; ++c) {
+        const glm::vec3 corner((c & 1) ? casters.max.x : casters.min.x, (c & 2) ? casters.max.y : casters.min.y,
+                               (c & 4) ? casters.max.z : casters.min.z);
+        const glm::vec3 l(glm::dot(corner, right), glm::dot(corner, up), glm::dot(corner, forward));
+        lightMin = glm::min(lightMin, l);
+        lightMax = glm::max(lightMax, l);
+    }
+
+    // The camera's view up to maxDistance, as its bounding sphere: the
+    // sphere's size depends only on the lens, so turning the camera never
+    // changes the texel size (Valient, "Stable Rendering of Cascaded Shadow
+    // Maps", ShaderX6). For the slice [n, f] of a frustum whose corner rays
+    // have squared slope k2, the sphere through both caps' corners is
+    // centred at (n + f)(1 + k2) / 2 along the view axis, or at the far cap
+    // when that lies beyond it.
+    const float tanX = 1.0f / std::max(std::abs(camera.projection[0][0]), 1e-6f);
+    const float tanY = 1.0f / std::max(std::abs(camera.projection[1][1]), 1e-6f);
+    const float k2 = tanX * tanX + tanY * tanY;
+    const float nearDistance = std::max(camera.lens.nearPlane, 0.0f);
+    const float farDistance = std::max(std::min(settings.maxDistance, camera.lens.farPlane), nearDistance + 1e-3f);
+    float centreDistance = 0.5f * (nearDistance + farDistance) * (1.0f + k2);
+    float radius = 0.0f;
+    if (centreDistance >= farDistance) {
+        centreDistance = farDistance;
+        radius = farDistance * std::sqrt(k2);
+    } else {
+        radius = std::sqrt((farDistance - centreDistance) * (farDistance - centreDistance) +
+                           farDistance * farDistance * k2);
+    }
+    const glm::vec3 viewForward = -glm::vec3(glm::inverse(camera.view)[2]);
+    const glm::vec3 viewCentre = camera.position + glm::normalize(viewForward) * centreDistance;
+
+    const float res = float(settings.resolution);
+    const float border = res / std::max(res - 2.0f * float(kShadowBorderTexels), 1.0f);
+    const float sceneExtent =
+        quantiseExtent(std::max(std::max(lightMax.x - lightMin.x, lightMax.y - lightMin.y), 1e-3f));
+    const float viewExtent = 2.0f * radius;
+    glm::vec2 centre;
+    float extent;
+    if (sceneExtent <= viewExtent) {
+        // The whole scene fits in less: use it, and never fade.
+        extent = sceneExtent * border;
+        centre = 0.5f * (glm::vec2(lightMin) + glm::vec2(lightMax));
+        fit.fadeStart = fit.fadeEnd = 0.0f;
+    } else {
+        extent = viewExtent * border;
+        centre = {glm::dot(viewCentre, right), glm::dot(viewCentre, up)};
+        fit.fadeStart = kShadowFadeStart * farDistance;
+        fit.fadeEnd = farDistance;
+    }
+    // Whole texels: the texel grid stays fixed in the world as the centre
+    // moves, so a static edge covers the same texels every frame.
+    const float texel = extent / res;
+    centre = glm::round(centre / texel) * texel;
+
+    // Depth along the rays over all casters, padded so nothing touches the
+    // clip planes. Reversed: 1 nearest the sun (glint/gbuffer_shared.h).
+    const float pad = 0.01f * (lightMax.z - lightMin.z) + 4.0f * texel;
+    const float depthNear = lightMin.z - pad;
+    const float depthFar = lightMax.z + pad;
+    const float depthRange = depthFar - depthNear;
+
+    const float half = 0.5f * extent;
+    glm::mat4 m(0.0f);  // m[column][row]
+    for (int i = 0; i < 3; ++i) {
+        m[i][0] = right[i] / half;
+        m[i][1] = up[i] / half;
+        m[i][2] = -forward[i] / depthRange;
+    }
+    m[3][0] = -centre.x / half;
+    m[3][1] = -centre.y / half;
+    m[3][2] = depthFar / depthRange;
+    m[3][3] = 1.0f;
+
+    fit.viewProjection = m;
+    fit.texelWorldSize = texel;
+    fit.depthRange = depthRange;
+    fit.constantBias = settings.constantBias;
+    fit.slopeBias = settings.slopeBias;
+    fit.normalOffset = settings.normalOffset;
+    fit.maxSlope = settings.maxSlope;
+    fit.resolution = settings.resolution;
+    fit.enabled = 1;
+    return fit;
+}
+
+GBufferRenderer::GBufferRenderer(gpu::Context& ctx, const scene::Scene& scene, uint32_t framesInFlight)
+    : ctx_(ctx), scene_(scene), framesInFlight_(std::max(framesInFlight, 1u)), retired_(framesInFlight_) {
+    gpu::GraphicsPipelineDesc surface;
+    surface.vertexShader = "gbuffer/gbuffer.vert";
+    surface.fragmentShader = "gbuffer/gbuffer.frag";
+    surface.bindings = surfaceBindings();
+    surface.pushConstantBytes = sizeof(shader::GBufferDraw);
+    // Per draw (glTF): back faces culled for single-sided materials, none
+    // for double-sided ones; front faces wind counter-clockwise on screen
+    // (the projection flips Y with the framebuffer), clockwise under a
+    // mirroring transform.
+    surface.dynamicCulling = true;
+    surface.colorFormats.assign(kColorFormats.begin(), kColorFormats.end());
+    surface.depthFormat = kGBufferDepthFormat;
+    surface.name = "gbuffer.surface";
+    surfacePipeline_ = gpu::createGraphicsPipeline(ctx, surface);
+    gpu::GraphicsPipelineDesc masked = surface;
+    masked.fragmentShader = "gbuffer/gbuffer_masked.frag";
+    masked.name = "gbuffer.surface_masked";
+    surfaceMaskedPipeline_ = gpu::createGraphicsPipeline(ctx, masked);
+
+    gpu::GraphicsPipelineDesc sky = surface;
+    sky.vertexShader = "gbuffer/sky.vert";
+    sky.fragmentShader = "gbuffer/sky.frag";
+    // At depth 0 the GREATER_OR_EQUAL test passes only where the clear value
+    // survived; writing would change nothing.
+    sky.depthWrite = false;
+    sky.dynamicCulling = false;
+    sky.cullMode = VK_CULL_MODE_NONE;
+    sky.name = "gbuffer.sky";
+    skyPipeline_ = gpu::createGraphicsPipeline(ctx, sky);
+
+    gpu::GraphicsPipelineDesc shadow;
+    shadow.vertexShader = "gbuffer/shadow.vert";
+    shadow.fragmentShader = "gbuffer/shadow.frag";
+    shadow.bindings = geometryBindings();
+    shadow.pushConstantBytes = sizeof(shader::GBufferDraw);
+    // Open and double-sided geometry casts from both sides, as the
+    // G-buffer draws it and as the shadow rays of the RT hits see it.
+    shadow.cullMode = VK_CULL_MODE_NONE;
+    shadow.depthFormat = kGBufferShadowMapFormat;
+    shadow.name = "gbuffer.shadow_map";
+    shadowPipeline_ = gpu::createGraphicsPipeline(ctx, shadow);
+    // Alpha-tested casters read the base colour texture's alpha, at the
+    // binding the G-buffer samples it from.
+    gpu::GraphicsPipelineDesc shadowMasked = shadow;
+    shadowMasked.fragmentShader = "gbuffer/shadow_masked.frag";
+    shadowMasked.bindings.push_back({kFirstMaterialTextureBinding + kBaseColorSlot,
+                                     VK_DESCRIPTOR_TYPE_COMBINED_IMAGE_SAMPLER, VK_SHADER_STAGE_FRAGMENT_BIT});
+    shadowMasked.name = "gbuffer.shadow_map_masked";
+    shadowMaskedPipeline_ = gpu::createGraphicsPipeline(ctx, shadowMasked);
+
+    nearest_ = gpu::Sampler(ctx, {VK_FILTER_NEAREST, VK_SAMPLER_MIPMAP_MODE_NEAREST,
+                                  VK_SAMPLER_ADDRESS_MODE_CLAMP_TO_EDGE, 0.0f, "gbuffer.nearest"});
+    environmentSampler_ = createEnvironmentSampler(ctx, "gbuffer.environment");
+
+    for (size_t wrapS = 0; wrapS < kWrapModes; ++wrapS) {
+        for (size_t wrapT = 0; wrapT < kWrapModes; ++wrapT) {
+            gpu::SamplerDesc desc{VK_FILTER_LINEAR, VK_SAMPLER_MIPMAP_MODE_LINEAR,
+                                  addressMode(scene::Wrap(wrapS)), VK_LOD_CLAMP_NONE, "gbuffer.material_texture"};
+            desc.addressV = addressMode(scene::Wrap(wrapT));
+            textureSamplers_.emplace_back(ctx, desc);
+        }
+    }
+    // Bound where a draw has no texture in a slot, so every binding is
+    // valid: (0.5, 0.5, 1) is the unperturbed normal; white leaves the
+    // factors as they are.
+    const std::array<uint8_t, 4> flat = {128, 128, 255, 255};
+    const std::array<uint8_t, 4> white = {255, 255, 255, 255};
+    flatNormal_ = gpu::createSampledImageWithMips(
+        ctx, {.width = 1, .height = 1, .format = VK_FORMAT_R8G8B8A8_UNORM, .name = "gbuffer.flat_normal"}, flat.data());
+    white_ = gpu::createSampledImageWithMips(
+        ctx, {.width = 1, .height = 1, .format = VK_FORMAT_R8G8B8A8_UNORM, .name = "gbuffer.white"}, white.data());
+
+    loadAssets();
+    for (uint32_t i = 0; i < framesInFlight_; ++i) {
+        slots_.push_back(std::make_unique<FrameSlot>());
+    }
+}
+
+GBufferRenderer::~GBufferRenderer() {
+    // Frames in flight may still read the geometry and the slots' buffers.
+    ctx_.waitIdleForTeardown("G-buffer renderer");
+}
+
+void GBufferRenderer::ensureCapacity(gpu::Buffer& buffer, VkDeviceSize bytes, const char* name) {
+    if (buffer && buffer.size() >= bytes) return;
+    buffer = gpu::Buffer(ctx_, {grownCapacity(bytes), VK_BUFFER_USAGE_STORAGE_BUFFER_BIT, gpu::MemoryUsage::Upload, name});
+}
+
+std::shared_ptr<GBufferRenderer::FrameWork> GBufferRenderer::prepare(const GBufferInputs& inputs,
+                                                                     const GBufferSettings& settings) {
+    ++frame_;
+    reloadAssetsIfEdited();
+    auto work = std::make_shared<FrameWork>();
+    work->slot = uint32_t(frame_ % framesInFlight_);
+    stats_.frame = frame_;
+    work->drawSky = settings.drawSky;
+
+    const scene::Camera& camera = inputs.camera;
+    shader::GBufferFrame& f = work->frame;
+    f.jitteredViewProjection = camera.jitteredProjection * camera.view;
+    f.viewProjection = camera.viewProjection();
+    f.previousViewProjection = camera.previousViewProjection();
+    f.inverseViewProjection = glm::inverse(f.viewProjection);
+    f.cameraPosition = glm::vec4(camera.position, 1.0f);
+    f.size = glm::vec2(camera.resolution);
+
+    f.lighting = inputs.lighting ? *inputs.lighting : sceneLighting(scene_, settings.lighting);
+    f.shadow = fitSunShadow(scene_, camera, settings.shadow);
+    stats_.shadow = f.shadow;
+
+    work->instances.reserve(scene_.instances.size());
+    const scene::Frustum view(f.jitteredViewProjection);
+    const scene::Frustum sun(f.shadow.viewProjection);
+    stats_.instancesCulled = 0;
+    stats_.shadowInstancesCulled = 0;
+    for (const scene::Instance& inst : scene_.instances) {
+        // Culled instances keep their slot (the shaders index instances by
+        // scene order), they only get no draws.
+        bool drawn = true, casts = f.shadow.enabled != 0;
+        if (settings.frustumCulling) {
+            const scene::Aabb bounds = scene::instanceBounds(scene_, inst);
+            drawn = view.intersects(bounds);
+            casts = casts && sun.intersects(bounds);
+            stats_.instancesCulled += drawn ? 0u : 1u;
+            stats_.shadowInstancesCulled += casts || f.shadow.enabled == 0 ? 0u : 1u;
+        }
+        work->visible.push_back(drawn ? 1 : 0);
+        work->castsShadow.push_back(casts ? 1 : 0);
+        work->mirrored.push_back(glm::determinant(glm::mat3(inst.transform)) < 0.0f ? 1 : 0);
+        shader::GBufferInstance gi{};
+        gi.transform = inst.transform;
+        gi.previousTransform = inst.previousTransform;
+        if (inst.motion == scene::Motion::Skinned && inst.skin != scene::kNone) {
+            gi.jointOffset = inst.jointOffset;
+            gi.jointCount = uint32_t(scene_.skins.at(size_t(inst.skin)).joints.size());
+        }
+        work->morphedFirstVertex.push_back(appendMorphed(inst, work->morphedVertices, gi.previousVertexDelta));
+        work->instances.push_back(gi);
+        work->meshes.push_back(inst.mesh);
+    }
+    work->joints = scene_.jointMatrices;
+    work->previousJoints = scene_.previousJointMatrices;
+    // Before the first advanceScene the previous palette may be missing:
+    // then last frame looked like this one.
+    if (work->previousJoints.size() != work->joints.size()) work->previousJoints = work->joints;
+    return work;
+}
+
+int64_t GBufferRenderer::appendMorphed(const scene::Instance& inst, std::vector<shader::GBufferVertex>& out,
+                                       uint32_t& previousDelta) const {
+    previousDelta = 0;
+    if (inst.mesh >= scene_.meshes.size() || inst.morphWeights.empty() || morphBaseVertices_[inst.mesh].empty()) {
+        return -1;
+    }
+    const int64_t first = int64_t(out.size());
+    const std::vector<shader::GBufferVertex>& base = morphBaseVertices_[inst.mesh];
+    const auto append = [&](const std::vector<float>& weights) {
+        size_t v = 0;
+        for (const scene::Geometry& g : scene_.meshes[inst.mesh].lods[0].geometries) {
+            const scene::Geometry morphed = scene::morphedGeometry(g, weights);
+            for (uint32_t k = 0; k < morphed.vertexCount(); ++k, ++v) {
+                shader::GBufferVertex vertex = base.at(v);
+                vertex.position = morphed.positions[k];
+                if (k < morphed.normals.size()) vertex.normal = morphed.normals[k];
+                if (k < morphed.tangents.size()) vertex.tangent = morphed.tangents[k];
+                out.push_back(vertex);
+            }
+        }
+    };
+    append(inst.morphWeights);
+    // Motion vectors of the morph itself: last frame's shape follows this
+    // one's (only positions are read from it).
+    if (inst.previousMorphWeights.size() == inst.morphWeights.size() &&
+        inst.previousMorphWeights != inst.morphWeights) {
+        previousDelta = uint32_t(int64_t(out.size()) - first);
+        append(inst.previousMorphWeights);
+    }
+    return first;
+}
+
+void GBufferRenderer::upload(const FrameWork& work) {
+    FrameSlot& slot = *slots_[work.slot];
+    ensureCapacity(slot.morphedVertices,
+                   std::max<size_t>(work.morphedVertices.size(), 1) * sizeof(shader::GBufferVertex),
+                   "gbuffer.morphed_vertices");
+    if (!work.morphedVertices.empty()) {
+        std::memcpy(slot.morphedVertices.mapped(), work.morphedVertices.data(),
+                    work.morphedVertices.size() * sizeof(shader::GBufferVertex));
+    }
+
+    // Host writes before the submit are visible to the device without a
+    // barrier; this slot's previous frame has finished.
+    ensureCapacity(slot.frame, sizeof(shader::GBufferFrame), "gbuffer.frame");
+    ensureCapacity(slot.instances, std::max<size_t>(work.instances.size(), 1) * sizeof(shader::GBufferInstance),
+                   "gbuffer.instances");
+    ensureCapacity(slot.joints, std::max<size_t>(work.joints.size(), 1) * sizeof(glm::mat4), "gbuffer.joints");
+    ensureCapacity(slot.previousJoints, std::max<size_t>(work.previousJoints.size(), 1) * sizeof(glm::mat4),
+                   "gbuffer.previous_joints");
+    std::memcpy(slot.frame.mapped(), &work.frame, sizeof(work.frame));
+    if (!work.instances.empty()) {
+        std::memcpy(slot.instances.mapped(), work.instances.data(),
+                    work.instances.size() * sizeof(shader::GBufferInstance));
+    }
+    if (!work.joints.empty()) {
+        std::memcpy(slot.joints.mapped(), work.joints.data(), work.joints.size() * sizeof(glm::mat4));
+        std::memcpy(slot.previousJoints.mapped(), work.previousJoints.data(),
+                    work.previousJoints.size() * sizeof(glm::mat4));
+    }
+}
+
+std::pair<const gpu::Buffer*, int32_t> GBufferRenderer::vertexSource(const FrameWork& work, size_t instance,
+                                                                     const FrameSlot& slot) const {
+    const int64_t first = work.morphedFirstVertex[instance];
+    if (first < 0) return {&vertices_, 0};
+    // The morphed copy lies at `first`; the draw ranges index the shared buffer.
+    return {&slot.morphedVertices, int32_t(first) - meshFirstVertex_[work.meshes[instance]]};
+}
+
+void GBufferRenderer::recordShadowMap(const FrameWork& work, rg::PassContext& pc, rg::Texture shadowMap) {
+    // The frame's first pass (always declared; the G-buffer reads its
+    // output, so it records first) fills the buffers both passes read.
+    upload(work);
+    const VkCommandBuffer cmd = pc.cmd();
+    FrameSlot& slot = *slots_[work.slot];
+    const uint32_t size = pc.image(shadowMap).desc().width;
+
+    // Cleared to 0, the far end of the reversed depth: no caster.
+    VkRenderingAttachmentInfo depth{VK_STRUCTURE_TYPE_RENDERING_ATTACHMENT_INFO};
+    depth.imageView = pc.view(shadowMap);
+    depth.imageLayout = VK_IMAGE_LAYOUT_ATTACHMENT_OPTIMAL;
+    depth.loadOp = VK_ATTACHMENT_LOAD_OP_CLEAR;
+    depth.storeOp = VK_ATTACHMENT_STORE_OP_STORE;
+    depth.clearValue.depthStencil = {0.0f, 0};
+    VkRenderingInfo rendering{VK_STRUCTURE_TYPE_RENDERING_INFO};
+    rendering.renderArea = {{0, 0}, {size, size}};
+    rendering.layerCount = 1;
+    rendering.pDepthAttachment = &depth;
+    vkCmdBeginRendering(cmd, &rendering);
+
+    stats_.shadowDraws = 0;
+    if (work.frame.shadow.enabled != 0) {
+        const VkViewport viewport{0.0f, 0.0f, float(size), float(size), 0.0f, 1.0f};
+        const VkRect2D scissor{{0, 0}, {size, size}};
+        vkCmdSetViewport(cmd, 0, 1, &viewport);
+        vkCmdSetScissor(cmd, 0, 1, &scissor);
+        // Opaque casters, then alpha-tested ones (their own pipeline reads
+        // the base colour texture's alpha and discards).
+        vkCmdBindIndexBuffer(cmd, indices_.handle(), 0, VK_INDEX_TYPE_UINT32);
+        for (const bool masked : {false, true}) {
+            const gpu::Pipeline& pipeline = masked ? shadowMaskedPipeline_ : shadowPipeline_;
+            pipeline.bind(cmd);
+            const gpu::Buffer* boundVertices = nullptr;
+            const gpu::Image* boundImage = nullptr;
+            const gpu::Sampler* boundSampler = nullptr;
+            for (size_t i = 0; i < work.instances.size(); ++i) {
+                if (!work.castsShadow[i]) continue;
+                const auto [vertices, vertexShift] = vertexSource(work, i, slot);
+                for (const DrawRange& range : meshDraws_.at(work.meshes[i])) {
+                    // Blended surfaces cast no shadow (nor do they in the
+                    // BVH the shadow rays of the RT hits trace).
+                    if (range.indexCount == 0 || range.coverage != (masked ? Coverage::Masked : Coverage::Opaque)) {
+                        continue;
+                    }
+                    const size_t image = range.image[kBaseColorSlot];
+                    const gpu::Image* baseColor = image == kNoImage ? &white_ : &textureImages_[image];
+                    const gpu::Sampler* sampler =
+                        image == kNoImage ? &textureSamplers_[0] : &textureSamplers_[range.sampler[kBaseColorSlot]];
+                    if (vertices != boundVertices || (masked && (baseColor != boundImage || sampler != boundSampler))) {
+                        boundVertices = vertices;
+                        boundImage = baseColor;
+                        boundSampler = sampler;
+                        gpu::PushDescriptors push(pipeline);
+                        push.storageBuffer(0, slot.frame)
+                            .storageBuffer(1, slot.instances)
+                            .storageBuffer(2, *vertices)
+                            .storageBuffer(3, slot.joints)
+                            .storageBuffer(4, slot.previousJoints);
+                        if (masked) {
+                            push.sampledImage(kFirstMaterialTextureBinding + kBaseColorSlot, baseColor->view(),
+                                              sampler->handle());
+                        }
+                        push.push(ctx_, cmd);
+                    }
+                    shader::GBufferDraw draw{};
+                    draw.instance = uint32_t(i);
+                    if (masked) {
+                        draw.alphaCutoff = range.material.alphaCutoff;
+                        draw.baseColorMap = range.material.baseColorMap;
+                        draw.baseColorUvTransform = range.material.baseColorUvTransform;
+                    }
+                    pipeline.pushConstants(cmd, draw);
+                    vkCmdDrawIndexed(cmd, range.indexCount, 1, range.firstIndex, range.vertexOffset + vertexShift, 0);
+                    ++stats_.shadowDraws;
+                }
+            }
+        }
+    }
+    vkCmdEndRendering(cmd);
+}
+
+GBufferRenderer::MaterialTextures GBufferRenderer::fallbackTextures() const {
+    return {std::pair{&flatNormal_, &textureSamplers_[0]}, std::pair{&white_, &textureSamplers_[0]},
+            std::pair{&white_, &textureSamplers_[0]}, std::pair{&white_, &textureSamplers_[0]}};
+}
+
+bool GBufferRenderer::rangeTextures(const DrawRange& range, MaterialTextures& textures) const {
+    bool textured = false;
+    for (size_t t = 0; t < kMaterialSlots; ++t) {
+        if (range.image[t] == kNoImage) continue;
+        textures[t] = {&textureImages_[range.image[t]], &textureSamplers_[range.sampler[t]]};
+        textured = true;
+    }
+    return textured;
+}
+
+void GBufferRenderer::pushSurfaceBindings(const gpu::Pipeline& pipeline, rg::PassContext& pc, const FrameSlot& slot,
+                                          const gpu::Buffer& vertices, const MaterialTextures& textures,
+                                          rg::Texture shadowMap, rg::Texture environment) const {
+    gpu::PushDescriptors push(pipeline);
+    push.storageBuffer(0, slot.frame)
+        .storageBuffer(1, slot.instances)
+        .storageBuffer(2, vertices)
+        .storageBuffer(3, slot.joints)
+        .storageBuffer(4, slot.previousJoints)
+        .sampledImage(kShadowMapBinding, pc.view(shadowMap), nearest_.handle(), pc.layout(shadowMap));
+    for (uint32_t t = 0; t < kMaterialSlots; ++t) {
+        push.sampledImage(kFirstMaterialTextureBinding + t, textures[t].first->view(), textures[t].second->handle());
+    }
+    // The procedural sky reads no texture: the shadow map, which the
+    // passes read anyway, fills the environment's binding.
+    if (environment.valid()) {
+        push.sampledImage(kEnvironmentBinding, pc.view(environment), environmentSampler_.handle(),
+                          pc.layout(environment));
+    } else {
+        push.sampledImage(kEnvironmentBinding, pc.view(shadowMap), nearest_.handle(), pc.layout(shadowMap));
+    }
+    push.push(ctx_, pc.cmd());
+}
+
+void GBufferRenderer::record(const FrameWork& work, rg::PassContext& pc, const GBufferOutputs& targets,
+                             rg::Texture environment) {
+    const VkCommandBuffer cmd = pc.cmd();
+    FrameSlot& slot = *slots_[work.slot];
+
+    // Load-op clears: depth 0 is the reversed-Z far plane; zero normal w and
+    // albedo mark "no surface" for the passes that read them.
+    const std::array<rg::Texture, 5> colorTargets = {targets.normal, targets.albedo, targets.roughnessMetal,
+                                                     targets.motion, targets.lit};
+    std::array<VkRenderingAttachmentInfo, 5> colors{};
+    for (size_t i = 0; i < colors.size(); ++i) {
+        VkRenderingAttachmentInfo& a = colors[i];
+        a.sType = VK_STRUCTURE_TYPE_RENDERING_ATTACHMENT_INFO;
+        a.imageView = pc.view(colorTargets[i]);
+        a.imageLayout = VK_IMAGE_LAYOUT_ATTACHMENT_OPTIMAL;
+        a.loadOp = VK_ATTACHMENT_LOAD_OP_CLEAR;
+        a.storeOp = VK_ATTACHMENT_STORE_OP_STORE;
+        a.clearValue.color = {{0.0f, 0.0f, 0.0f, 0.0f}};
+    }
+    VkRenderingAttachmentInfo depth{VK_STRUCTURE_TYPE_RENDERING_ATTACHMENT_INFO};
+    depth.imageView = pc.view(targets.depth);
+    depth.imageLayout = VK_IMAGE_LAYOUT_ATTACHMENT_OPTIMAL;
+    depth.loadOp = VK_ATTACHMENT_LOAD_OP_CLEAR;
+    depth.storeOp = VK_ATTACHMENT_STORE_OP_STORE;
+    depth.clearValue.depthStencil = {0.0f, 0};
+
+    VkRenderingInfo rendering{VK_STRUCTURE_TYPE_RENDERING_INFO};
+    rendering.renderArea = {{0, 0}, {targets.width, targets.height}};
+    rendering.layerCount = 1;
+    rendering.colorAttachmentCount = uint32_t(colors.size());
+    rendering.pColorAttachments = colors.data();
+    rendering.pDepthAttachment = &depth;
+    vkCmdBeginRendering(cmd, &rendering);
+
+    // Positive height: the projection already flips Y for Vulkan.
+    const VkViewport viewport{0.0f, 0.0f, float(targets.width), float(targets.height), 0.0f, 1.0f};
+    const VkRect2D scissor{{0, 0}, {targets.width, targets.height}};
+    vkCmdSetViewport(cmd, 0, 1, &viewport);
+    vkCmdSetScissor(cmd, 0, 1, &scissor);
+
+    const MaterialTextures fallbacks = fallbackTextures();
+    // Pushed again only when a draw's vertex buffer (a morphing instance's
+    // own) or one of its material textures differs from the last draw's.
+    const auto pushBindings = [&](const gpu::Pipeline& pipeline, const gpu::Buffer& vertices,
+                                  const MaterialTextures& textures) {
+        pushSurfaceBindings(pipeline, pc, slot, vertices, textures, targets.shadowMap, environment);
+    };
+
+    stats_.draws = 0;
+    stats_.triangles = 0;
+    stats_.normalMappedDraws = 0;
+    stats_.texturedDraws = 0;
+    stats_.maskedDraws = 0;
+    vkCmdBindIndexBuffer(cmd, indices_.handle(), 0, VK_INDEX_TYPE_UINT32);
+    Facing facing;
+    // Opaque draws first, then the alpha-tested ones with their own
+    // pipeline: the discard costs early depth testing only where it exists,
+    // and the opaque depth already rejects what the cutouts hide behind.
+    for (const bool masked : {false, true}) {
+        const gpu::Pipeline& pipeline = masked ? surfaceMaskedPipeline_ : surfacePipeline_;
+        pipeline.bind(cmd);
+        facing.bind(cmd);
+        const gpu::Buffer* boundVertices = &vertices_;
+        MaterialTextures boundTextures = fallbacks;
+        pushBindings(pipeline, *boundVertices, boundTextures);
+        for (size_t i = 0; i < work.instances.size(); ++i) {
+            if (!work.visible[i]) continue;
+            const auto [vertices, vertexShift] = vertexSource(work, i, slot);
+            for (const DrawRange& range : meshDraws_.at(work.meshes[i])) {
+                // Blended surfaces are drawn by the transparent pass.
+                if (range.indexCount == 0 || range.coverage != (masked ? Coverage::Masked : Coverage::Opaque)) {
+                    continue;
+                }
+                facing.set(cmd, work.mirrored[i] != 0, range.doubleSided);
+                MaterialTextures textures = boundTextures;
+                const bool textured = rangeTextures(range, textures);
+                stats_.normalMappedDraws += range.material.normalMap != 0 ? 1u : 0u;
+                stats_.texturedDraws += textured ? 1u : 0u;
+                stats_.maskedDraws += masked ? 1u : 0u;
+                if (vertices != boundVertices || textures != boundTextures) {
+                    boundVertices = vertices;
+                    boundTextures = textures;
+                    pushBindings(pipeline, *boundVertices, boundTextures);
+                }
+                shader::GBufferDraw draw = range.material;
+                draw.instance = uint32_t(i);
+                draw.doubleSided = range.doubleSided ? 1u : 0u;
+                pipeline.pushConstants(cmd, draw);
+                vkCmdDrawIndexed(cmd, range.indexCount, 1, range.firstIndex, range.vertexOffset + vertexShift, 0);
+                ++stats_.draws;
+                stats_.triangles += range.indexCount / 3;
+            }
+        }
+    }
+    if (work.drawSky) {
+        skyPipeline_.bind(cmd);
+        pushBindings(skyPipeline_, vertices_, fallbacks);
+        skyPipeline_.pushConstants(cmd, shader::GBufferDraw{});
+        vkCmdDraw(cmd, 3, 1, 0, 0);
+    }
+    vkCmdEndRendering(cmd);
+}
+
+GBufferOutputs addGBufferPass(rg::Graph& graph, GBufferRenderer& renderer, const GBufferInputs& inputs,
+                              const GBufferSettings& settings) {
+    const uint32_t width = inputs.camera.resolution.x;
+    const uint32_t height = inputs.camera.resolution.y;
+    if (width == 0 || height == 0) {
+        throw gpu::GpuError("G-buffer: the camera's resolution is " + std::to_string(width) + "x" +
+                            std::to_string(height) + "; both sides must be positive");
+    }
+    std::shared_ptr<GBufferRenderer::FrameWork> work = renderer.prepare(inputs, settings);
+    renderer.current_ = work;
+    if (work->frame.lighting.environment.x != 0.0f && !inputs.environment.valid()) {
+        throw gpu::GpuError("G-buffer: the lighting looks up an environment image but no environment texture was given "
+                            "(passes::importEnvironment)");
+    }
+
+    // With shadows off the map is one cleared texel: the G-buffer's
+    // pipelines keep one layout and the frame one shape.
+    const uint32_t shadowSize = work->frame.shadow.enabled != 0 ? work->frame.shadow.resolution : 1u;
+    struct ShadowData {
+        rg::Texture map;
+    };
+    const ShadowData& shadow = graph.addPass<ShadowData>(
+        "shadow_map", rg::Queue::Graphics,
+        [&](rg::Builder& b, ShadowData& d) {
+            b.setPipeline(rg::Pipeline::Raster);
+            d.map = b.write(b.createTexture("gbuffer.shadow_map", {.width = shadowSize,
+                                                                    .height = shadowSize,
+                                                                    .format = kGBufferShadowMapFormat}),
+                            rg::Access::DepthWrite);
+        },
+        [&renderer, work](const ShadowData& d, rg::PassContext& pc) { renderer.recordShadowMap(*work, pc, d.map); });
+
+    const GBufferOutputs& out = graph.addPass<GBufferOutputs>(
+        "gbuffer", rg::Queue::Graphics,
+        [&](rg::Builder& b, GBufferOutputs& d) {
+            b.setPipeline(rg::Pipeline::Raster);
+            const auto target = [&](const char* name, VkFormat format, rg::Access access) {
+                return b.write(b.createTexture(name, {.width = width, .height = height, .format = format}), access);
+            };
+            d.depth = target("gbuffer.depth", kGBufferDepthFormat, rg::Access::DepthWrite);
+            d.normal = target("gbuffer.normal", kGBufferNormalFormat, rg::Access::ColorAttachment);
+            d.albedo = target("gbuffer.albedo", kGBufferAlbedoFormat, rg::Access::ColorAttachment);
+            d.roughnessMetal =
+                target("gbuffer.roughness_metal", kGBufferRoughnessMetalFormat, rg::Access::ColorAttachment);
+            d.motion = target("gbuffer.motion", kGBufferMotionFormat, rg::Access::ColorAttachment);
+            d.lit = target("gbuffer.lit", kGBufferLitFormat, rg::Access::ColorAttachment);
+            d.shadowMap = b.read(shadow.map, rg::Access::SampledRead);
+            if (inputs.environment.valid()) {
+                b.read(inputs.environment, rg::Access::SampledRead);
+            }
+            d.width = width;
+            d.height = height;
+            d.shadowResolution = shadowSize;
+        },
+        [&renderer, work, environment = inputs.environment](const GBufferOutputs& d, rg::PassContext& pc) {
+            renderer.record(*work, pc, d, environment);
+        });
+    return out;
+}
+
+} // namespace glint::passes

@@ -1,0 +1,42 @@
+#include "glint/passes/image_clear.h"
+
+#include "glint/gpu/descriptors.h"
+#include "glint/gpu/error.h"
+
+namespace glint::passes {
+
+namespace {
+
+struct ClearConstants {
+    glm::vec4 value;
+    glm::uvec2 size;
+};
+
+gpu::Pipeline createClearPipeline(gpu::Context& ctx) {
+    VkPhysicalDeviceFeatures features{};
+    vkGetPhysicalDeviceFeatures(ctx.physicalDevice(), &features);
+    if (!features.shaderStorageImageWriteWithoutFormat) {
+        throw gpu::GpuError("ImageClearer: device '" + ctx.caps().deviceName +
+                            "' lacks shaderStorageImageWriteWithoutFormat");
+    }
+    return gpu::createComputePipeline(
+        ctx, {"common/clear_image.comp",
+              {{0, VK_DESCRIPTOR_TYPE_STORAGE_IMAGE, VK_SHADER_STAGE_COMPUTE_BIT}},
+              uint32_t(sizeof(ClearConstants)),
+              "common.clear_image"});
+}
+
+} // namespace
+
+ImageClearer::ImageClearer(gpu::Context& ctx) : ctx_(ctx), pipeline_(createClearPipeline(ctx)) {}
+
+void ImageClearer::clear(rg::PassContext& pc, rg::Texture texture, glm::vec4 value) const {
+    const gpu::Image& image = pc.image(texture);
+    const ClearConstants constants{value, {image.extent().width, image.extent().height}};
+    pipeline_.bind(pc.cmd());
+    gpu::PushDescriptors(pipeline_).storageImage(0, pc.view(texture)).push(ctx_, pc.cmd());
+    pipeline_.pushConstants(pc.cmd(), constants);
+    pc.dispatch(pipeline_, (constants.size.x + 7) / 8, (constants.size.y + 7) / 8);
+}
+
+} // namespace glint::passes

@@ -1,0 +1,127 @@
+#pragma once
+// Pass 5 of the reflection pipeline: integrate. One compute pass
+// over every pixel picks where its reflection comes from:
+//   sky                        nothing (radiance 0, a = 0)
+//   env class (too rough)      the environment map
+//   SSLR confidence >= threshold   SSLR alone
+//   below it                   the more confident trace: RT where it traced
+//                              (its miss is the true environment, so it is
+//                              fully confident), else SSLR where it found
+//                              anything, else the environment map
+// The environment map is environmentRadiance(lighting, reflect(-V, N),
+// roughness) (glint/brdf.glsl), the one the hit shaders' misses use. A
+// follower pixel of a shared quad ray reads its leader's traces. It also
+// counts each tile's SSLR hits and misses over the traced SSLR/hybrid rays
+// and writes the tile's feedback counter (glint/feedback_shared.h), this
+// frame's counts with the reprojected counts rotated behind them.
+// Layouts: glint/integrate_shared.h.
+//
+//   passes::IntegratePipelines integratePipelines(ctx);    // once
+//   each frame, after SSLR and the ray tracer:
+//     const auto refl = passes::addIntegratePass(graph, integratePipelines,
+//         {gbuf, rays, sslr, rt.radiance, rt.hitDistance, feedback, lighting, camera}, {});
+//     ... temporal accumulation reads refl.radiance and refl.hitDistance ...
+//
+// With IntegrateInputs::particles the particle trace is composited in
+// front of each traced pixel's reflection (see there).
+//
+// Frames without SSLR ("rt" mode) or without the ray tracer ("ssr" mode)
+// leave those inputs empty, and a frame without the feedback pass leaves
+// IntegrateInputs::feedback default (then no counters are written and
+// IntegrateOutputs::counters is invalid); the pass runs a shader variant
+// that neither declares nor binds what is absent.
+
+#include "glint/gpu/context.h"
+#include "glint/gpu/pipeline.h"
+#include "glint/gpu/resources.h"
+#include "glint/graph/graph.h"
+#include "glint/passes/feedback.h"
+#include "glint/passes/gbuffer.h"
+#include "glint/passes/ray_generation.h"
+#include "glint/passes/sslr.h"
+#include "glint/scene/camera.h"
+
+#include "glint/gbuffer_shared.h"
+
+#include <array>
+#include <cstdint>
+#include <optional>
+
+namespace glint::passes {
+
+inline constexpr VkFormat kReflectionRadianceFormat = VK_FORMAT_R16G16B16A16_SFLOAT;
+inline constexpr VkFormat kReflectionHitDistanceFormat = VK_FORMAT_R32_SFLOAT;
+inline constexpr VkFormat kReflectionSourceDebugFormat = VK_FORMAT_R8G8B8A8_UNORM;
+
+struct IntegrateInputs {
+    GBufferOutputs gbuffer;
+    RayGenerationOutputs rays;         // classes, rays (pixelFlags name a follower's leader)
+    std::optional<SslrOutputs> sslr;   // absent in "rt" mode
+    // The ray tracer's outputs, both or neither (invalid in "ssr" mode):
+    // RGBA16F radiance, a = 1 where traced (at ray leaders); R32F hit distance.
+    rg::Texture rtRadiance;
+    rg::Texture rtHitDistance;
+    FeedbackOutputs feedback;          // reprojected in, counters.current out
+    // Optional: the particle trace's radiance (passes/particles.h,
+    // ParticleTraceOutputs::radiance: RGBA16F, premultiplied rgb, a =
+    // coverage, at ray leaders; the G-buffer's size). Where valid, every
+    // traced pixel's reflection becomes
+    //   particles.rgb + (1 - particles.a) * reflection
+    // (its leader's particles, as for the traces); the hit distance stays
+    // the reflected surface's.
+    rg::Texture particles;
+    shader::SceneLighting lighting;    // EnvironmentMap::lighting or passes::sceneLighting(...)
+    // The prefiltered environment (passes/environment.h, SampledRead);
+    // needed when `lighting` looks up an image, else left invalid.
+    rg::Texture environment;
+    scene::Camera camera;              // the G-buffer's; its unjittered matrices rebuild positions
+};
+
+struct IntegrateSettings {
+    // SSLR confidence at which SSLR alone is trusted, and at which a traced
+    // ray counts as a hit in the feedback counters: the Far Cry 6 talk's 0.9
+    //. It must equal SslrSettings's, which lists the
+    // hybrid rays below it for the ray tracer: the RT outputs are read only
+    // where the stored SSLR confidence is below it (compared, as SSLR does,
+    // at sslrStoredThreshold), since nothing clears the traces' outputs.
+    float confidenceThreshold = 0.9f;
+    // Whether a ray-traced miss may override a partial SSLR hit. False
+    // while the BVH is still building objects in range
+    // (scene::BvhPlan::complete; ReflectionRenderer sets it per frame): a
+    // miss may have passed where an unbuilt object stands, and the SSLR hit
+    // may be that object. SSLR is the fallback while the BVH builds (the
+    // Far Cry 6 talk).
+    bool rtMissesTrusted = true;
+};
+
+struct IntegrateOutputs {
+    rg::Texture radiance;     // kReflectionRadianceFormat: reflected radiance, a = 1 where a surface reflects
+    rg::Texture hitDistance;  // kReflectionHitDistanceFormat: world units; kMissHitDistance for env/miss/sky
+    rg::Texture sourceDebug;  // kReflectionSourceDebugFormat: a colour per source (debug view "reflection_source")
+    rg::Buffer counters;      // the new version of feedback.counters.current (invalid without feedback)
+    uint32_t width = 0;
+    uint32_t height = 0;
+};
+
+// The pipelines (one variant per combination of present traces) and the
+// sampler the pass records with; created once.
+class IntegratePipelines {
+public:
+    explicit IntegratePipelines(gpu::Context& ctx);
+
+private:
+    friend IntegrateOutputs addIntegratePass(rg::Graph&, IntegratePipelines&, const IntegrateInputs&,
+                                             const IntegrateSettings&);
+    gpu::Context& ctx_;
+    // Indexed by (SSLR bound) | (RT bound) << 1 | (feedback bound) << 2.
+    std::array<gpu::Pipeline, 8> variants_;
+    gpu::Sampler nearest_;
+    gpu::Sampler environmentSampler_;
+};
+
+// Declares the pass (see the top of this file) on the graphics queue, with
+// a small transfer pass before it that uploads the frame's constants.
+IntegrateOutputs addIntegratePass(rg::Graph& graph, IntegratePipelines& pipelines, const IntegrateInputs& inputs,
+                                  const IntegrateSettings& settings = {});
+
+} // namespace glint::passes

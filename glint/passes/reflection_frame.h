@@ -1,0 +1,195 @@
+#pragma once
+// The whole hybrid-reflections frame wired
+// from the pass functions: what glint-render, the benchmark, the viewer and
+// the golden-image tests declare every frame, and the reference for an
+// engine that wires the passes into its own frame.
+//
+//   BVH update (async compute) -> G-buffer -> feedback -> ray generation
+//   -> SSLR -> ray-traced hits -> particles trace -> integrate -> temporal
+//   -> particles forward -> transparent (when blended surfaces are in view)
+//   -> composite
+// (with ReflectionFrameSettings::sslrParticles the particles forward pass
+// comes right after the G-buffer, so that SSLR sees the particles)
+//
+// Each mode declares only what it uses: ssr has no BVH, no ray-traced pass
+// and no reflected particles (the direct view still draws them), rt no
+// SSLR and no feedback; a scene without particles no particle passes.
+//
+//   passes::ReflectionRenderer renderer(ctx, scene, {});
+//   each frame (after scene::advanceScene and camera.advance):
+//     rg::Graph graph(executor.queueCaps());
+//     const passes::ReflectionFrame frame = renderer.addFrame(graph, camera, settings);
+//     rg::FrameResources resources;
+//     renderer.bind(resources, frame);
+//     executor.run(graph.compile(executor.compileOptions()), resources);
+
+#include "glint/gpu/context.h"
+#include "glint/gpu/pipeline.h"
+#include "glint/graph/graph.h"
+#include "glint/passes/bvh_update.h"
+#include "glint/passes/composite.h"
+#include "glint/passes/environment.h"
+#include "glint/passes/feedback.h"
+#include "glint/passes/gbuffer.h"
+#include "glint/passes/integrate.h"
+#include "glint/passes/particles.h"
+#include "glint/passes/ray_generation.h"
+#include "glint/passes/rt_trace.h"
+#include "glint/passes/sslr.h"
+#include "glint/passes/temporal.h"
+#include "glint/passes/transparent.h"
+#include "glint/scene/bvh_planner.h"
+#include "glint/scene/camera.h"
+#include "glint/scene/scene.h"
+
+#include <memory>
+#include <optional>
+#include <span>
+#include <string>
+#include <string_view>
+
+namespace glint::passes {
+
+std::string_view modeName(ReflectionMode mode);
+// "hybrid", "ssr" or "rt"; throws std::invalid_argument naming the value otherwise.
+ReflectionMode parseMode(std::string_view name);
+std::string_view backendName(RtBackend backend);
+// "auto", "query" or "pipeline"; throws std::invalid_argument otherwise.
+RtBackend parseBackend(std::string_view name);
+
+struct ReflectionRendererOptions {
+    uint32_t framesInFlight = 2;  // at least the executor's
+    RtBackend backend = RtBackend::Auto;
+    scene::BvhSettings bvh;
+    BvhUpdateOptions bvhUpdate;
+    EnvironmentSettings environment;  // the prefilter of an equirectangular environment
+};
+
+struct ReflectionFrameSettings {
+    ReflectionMode mode = ReflectionMode::Hybrid;
+    GBufferSettings gbuffer;
+    RayGenerationSettings rays;  // rays.mode is taken from `mode`
+    SslrSettings sslr;
+    RtTraceSettings rt;          // rt.backend is the renderer's
+    FeedbackSettings feedback;
+    IntegrateSettings integrate;  // integrate.confidenceThreshold is taken from sslr
+    TemporalSettings temporal;
+    CompositeSettings composite;
+    // The Far Cry 6 talk's "SSLR particles": the particles are drawn into
+    // the lit colour before SSLR samples it, and the particle trace covers
+    // only the reflections SSLR did not resolve
+    // (ParticleTraceSettings::sslrSeesParticles). Off: drawn after SSLR,
+    // and every traced reflection takes its particles from the trace.
+    bool sslrParticles = false;
+    // Particles in the reflections: off, no particle TLAS is built and no
+    // particle trace runs (the direct view still draws the particles); what
+    // reflected particles cost is the difference.
+    bool reflectParticles = true;
+    // While the BVH is still building objects in range (its first-build
+    // budget, scene::BvhSettings), SSLR is the fallback (the Far Cry 6
+    // talk): in hybrid mode every pixel tries SSLR first, and a ray-traced
+    // miss no longer overrides a partial SSLR hit
+    // (RayGenerationSettings::sslrFirst, IntegrateSettings::rtMissesTrusted).
+    // Off: the incomplete BVH is traced as it is.
+    bool sslrWhileBvhBuilds = true;
+    // Empty or "final": the composited image; otherwise one of
+    // debugViewNames(), shown in `output` instead.
+    std::string debugView;
+    // Discards the temporal history (first frame, camera cut).
+    bool resetHistory = false;
+    // Declares a small pass counting pixel classes and traced rays into
+    // ReflectionFrame::counts (for stats).
+    bool countRays = false;
+};
+
+// Everything a frame declared, for debug views, readbacks and stats.
+struct ReflectionFrame {
+    // The mode declared: the settings' own, or ssr on a device without ray
+    // tracing (ReflectionRenderer::tracesRays).
+    ReflectionMode mode = ReflectionMode::Hybrid;
+    GBufferOutputs gbuffer;
+    std::optional<BvhUpdateOutputs> bvh;
+    // The TLAS holds every object in range (scene::BvhPlan::complete);
+    // false while first builds wait for their budget.
+    bool bvhComplete = true;
+    std::optional<FeedbackOutputs> feedback;
+    RayGenerationOutputs rays;
+    std::optional<SslrOutputs> sslr;
+    std::optional<RtTraceOutputs> rt;
+    std::optional<ParticleTraceOutputs> particles;  // reflected particles (a BVH with particles)
+    IntegrateOutputs integrate;
+    TemporalOutputs temporal;
+    // The blended surfaces' layer (passes/transparent.h); invalid when none
+    // is in view or a debug view other than "transparent" is shown.
+    rg::Texture transparent;
+    CompositeOutputs output;  // RGBA8, sRGB-encoded: the image or the debug view
+    // The prefiltered environment image (passes/environment.h); invalid for
+    // the procedural sky.
+    rg::Texture environment;
+    // When ReflectionFrameSettings::countRays: kReflectionCountWords uints,
+    // glint/reflection_frame_shared.h.
+    rg::Buffer counts;
+    uint32_t width = 0;
+    uint32_t height = 0;
+};
+
+// Names accepted by ReflectionFrameSettings::debugView.
+std::span<const std::string_view> debugViewNames();
+
+// The passes whose GPU time is the reflections' cost (ray generation
+// through temporal accumulation: the stats' reflection_ms).
+bool isReflectionPass(std::string_view passName);
+
+class ReflectionRenderer {
+public:
+    // `scene` must outlive the renderer; see GBufferRenderer and BvhManager
+    // for what may change in it between frames.
+    ReflectionRenderer(gpu::Context& ctx, const scene::Scene& scene, const ReflectionRendererOptions& options = {});
+    ~ReflectionRenderer();
+    ReflectionRenderer(const ReflectionRenderer&) = delete;
+    ReflectionRenderer& operator=(const ReflectionRenderer&) = delete;
+
+    // Declares one frame seen through `camera` (its frameIndex drives all
+    // noise). Frames are declared and run one at a time, once each. The
+    // output is marked as the graph's output, so every frame compiles to
+    // the same passes whether or not the caller reads it back: the graph
+    // plans history images from this frame's own uses (graph.h).
+    ReflectionFrame addFrame(rg::Graph& graph, const scene::Camera& camera, const ReflectionFrameSettings& settings);
+    // Binds the frame's imports (the BVH's objects, the environment).
+    void bind(rg::FrameResources& resources, const ReflectionFrame& frame) const;
+
+    // The ray backend; Auto on a device without ray tracing.
+    RtBackend backend() const;
+    // False on a device without ray tracing (gpu::Capabilities::canTraceRays):
+    // then every frame is declared in ssr mode, whatever the settings ask
+    // (ReflectionFrame::mode says which), and no BVH memory is allocated.
+    bool tracesRays() const { return rt_ != nullptr; }
+    const GBufferStats& gbufferStats() const { return gbuffer_.stats(); }
+    // Of the last frame that declared BVH work (none in ssr mode).
+    const scene::BvhStats& bvhPlanStats() const { return lastPlanStats_; }
+    const BvhGpuStats& bvhGpuStats() const;
+    const EnvironmentStats& environmentStats() const { return environment_.stats(); }
+
+private:
+    gpu::Context& ctx_;
+    const scene::Scene& scene_;
+    // Prefiltered when the renderer is created and when addFrame sees a new
+    // environment (EnvironmentMap::update).
+    EnvironmentMap environment_;
+    GBufferRenderer gbuffer_;
+    scene::BvhPlanner planner_;
+    std::unique_ptr<BvhManager> bvh_;  // null without ray tracing
+    FeedbackPipelines feedback_;
+    RayGenerationPipelines rays_;
+    SslrPipelines sslr_;
+    std::unique_ptr<RtTracePipelines> rt_;  // null without ray tracing
+    IntegratePipelines integrate_;
+    TemporalPipelines temporal_;
+    CompositePipelines composite_;
+    ParticlePipelines particles_;
+    gpu::Pipeline tileView_;
+    gpu::Pipeline classCount_;
+    scene::BvhStats lastPlanStats_;
+};
+
+} // namespace glint::passes

@@ -1,0 +1,275 @@
+#include "glint/passes/sslr.h"
+
+#include "glint/gpu/descriptors.h"
+#include "glint/gpu/error.h"
+#include "glint/graph/executor.h"
+
+#include "glint/ray_generation_shared.h"
+#include "glint/sslr_shared.h"
+
+#include <glm/gtc/packing.hpp>
+
+#include <algorithm>
+#include <array>
+#include <bit>
+#include <cmath>
+
+namespace glint::passes {
+
+namespace {
+
+constexpr uint32_t kBindingCount = 15;
+
+std::vector<gpu::Binding> traceBindings() {
+    std::vector<gpu::Binding> bindings;
+    for (uint32_t i = 0; i < kBindingCount; ++i) {
+        VkDescriptorType type = VK_DESCRIPTOR_TYPE_STORAGE_BUFFER;
+        if (i < 3 || i == 11 || i == 12) type = VK_DESCRIPTOR_TYPE_COMBINED_IMAGE_SAMPLER;
+        if (i >= 6 && i <= 8) type = VK_DESCRIPTOR_TYPE_STORAGE_IMAGE;
+        bindings.push_back({i, type, VK_SHADER_STAGE_COMPUTE_BIT});
+    }
+    return bindings;
+}
+
+// pyramid.glsl: the source (the lit colour through a sampler, whose reads
+// are texelFetch, or level 5 as a storage image), then the levels written.
+std::vector<gpu::Binding> pyramidBindings(VkDescriptorType source) {
+    std::vector<gpu::Binding> bindings = {{0, source, VK_SHADER_STAGE_COMPUTE_BIT}};
+    for (uint32_t o = 0; o < shader::kSslrPyramidOutputs; ++o) {
+        bindings.push_back({1 + o, VK_DESCRIPTOR_TYPE_STORAGE_IMAGE, VK_SHADER_STAGE_COMPUTE_BIT});
+    }
+    return bindings;
+}
+
+// The trace inverts the projection from P00, P11, P22 and P32 alone
+// (glint/sslr_shared.h); anything else (an off-centre or orthographic
+// projection) would be reconstructed wrongly, so it is refused.
+void checkProjection(const glm::mat4& p) {
+    const bool perspective = p[2][0] == 0.0f && p[2][1] == 0.0f && p[2][3] == -1.0f && p[3][3] == 0.0f &&
+                             p[0][1] == 0.0f && p[1][0] == 0.0f && p[3][0] == 0.0f && p[3][1] == 0.0f;
+    if (!perspective) {
+        throw gpu::GpuError("addSslrPass: the projection must be an unjittered, centred perspective");
+    }
+}
+
+} // namespace
+
+SslrPipelines::SslrPipelines(gpu::Context& ctx)
+    : ctx_(ctx),
+      trace_(gpu::createComputePipeline(
+          ctx, {"sslr/trace.comp", traceBindings(), uint32_t(sizeof(shader::SslrConstants)), "sslr.trace"})),
+      pyramidBase_(gpu::createComputePipeline(
+          ctx, {"sslr/pyramid_base.comp", pyramidBindings(VK_DESCRIPTOR_TYPE_COMBINED_IMAGE_SAMPLER),
+                uint32_t(sizeof(shader::SslrPyramidConstants)), "sslr.pyramid_base"})),
+      pyramidDown_(gpu::createComputePipeline(
+          ctx, {"sslr/pyramid_down.comp", pyramidBindings(VK_DESCRIPTOR_TYPE_STORAGE_IMAGE),
+                uint32_t(sizeof(shader::SslrPyramidConstants)), "sslr.pyramid_down"})),
+      nearest_(ctx, {VK_FILTER_NEAREST, VK_SAMPLER_MIPMAP_MODE_NEAREST, VK_SAMPLER_ADDRESS_MODE_CLAMP_TO_EDGE, 0.0f,
+                     "sslr.nearest"}),
+      trilinear_(ctx, {VK_FILTER_LINEAR, VK_SAMPLER_MIPMAP_MODE_LINEAR, VK_SAMPLER_ADDRESS_MODE_CLAMP_TO_EDGE,
+                       VK_LOD_CLAMP_NONE, "sslr.trilinear"}),
+      clearer_(ctx) {}
+
+float sslrStoredThreshold(float threshold) {
+    // Round to the nearest half float, as the confidence image stores.
+    return glm::unpackHalf1x16(glm::packHalf1x16(threshold));
+}
+
+SslrOutputs addSslrPass(rg::Graph& graph, SslrPipelines& pipelines, const SslrInputs& inputs,
+                        const SslrSettings& settings) {
+    const GBufferOutputs& gbuf = inputs.gbuffer;
+    const RayGenerationOutputs& rays = inputs.rays;
+    if (gbuf.width == 0 || gbuf.height == 0 || rays.width != gbuf.width || rays.height != gbuf.height) {
+        throw gpu::GpuError("addSslrPass: the G-buffer and the rays must have the same, non-zero size");
+    }
+    if (settings.linearSteps == 0 || !(settings.minStepPixels >= 0.0f)) {
+        throw gpu::GpuError("addSslrPass: linearSteps must be at least 1 and minStepPixels not negative");
+    }
+    checkProjection(inputs.projection);
+    if (rays.blueNoiseBuffer == nullptr) {
+        throw gpu::GpuError("addSslrPass: the rays carry no blue noise buffer (not from addRayGenerationPass)");
+    }
+
+    SslrOutputs out;
+    out.width = gbuf.width;
+    out.height = gbuf.height;
+
+    // The trace writes its ray leaders' pixels only, and its readers read
+    // nothing else (glint/sslr_shared.h): no clear, unless asked for.
+    const auto texture = [&](const char* name, VkFormat format) {
+        return graph.createTexture(name, {.width = gbuf.width, .height = gbuf.height, .format = format});
+    };
+    rg::Texture radiance = texture("sslr.radiance", kSslrRadianceFormat);
+    rg::Texture confidence = texture("sslr.confidence", kSslrConfidenceFormat);
+    rg::Texture hitDebug = texture("sslr.hit_debug", kSslrHitDebugFormat);
+    if (settings.clearUntraced) {
+        struct ClearData {
+            rg::Texture radiance, confidence, hitDebug;
+        };
+        const ClearData& clear = graph.addPass<ClearData>(
+            "sslr.clear", rg::Queue::Graphics,
+            [&](rg::Builder& b, ClearData& d) {
+                d.radiance = b.write(radiance, rg::Access::StorageWrite);
+                d.confidence = b.write(confidence, rg::Access::StorageWrite);
+                d.hitDebug = b.write(hitDebug, rg::Access::StorageWrite);
+            },
+            [&pipelines](const ClearData& d, rg::PassContext& pc) {
+                for (const rg::Texture t : {d.radiance, d.confidence, d.hitDebug}) {
+                    pipelines.clearer_.clear(pc, t);
+                }
+            });
+        radiance = clear.radiance;
+        confidence = clear.confidence;
+        hitDebug = clear.hitDebug;
+    }
+
+    // The cone trace's colour pyramid (glint/sslr_shared.h): two passes,
+    // each five levels, dispatched from the SSLR list's args, which give
+    // them no groups unless ray generation listed a ray that cone-traces.
+    uint32_t pyramidMips = 0;
+    rg::Texture pyramid;
+    if (settings.coneTrace) {
+        pyramidMips = std::min(shader::kSslrPyramidMaxMips, uint32_t(std::bit_width(std::max(gbuf.width, gbuf.height))));
+        pyramid = graph.createTexture("sslr.lit_pyramid", {.width = gbuf.width,
+                                                            .height = gbuf.height,
+                                                            .mips = pyramidMips,
+                                                            .format = kSslrRadianceFormat});
+        const glm::uvec2 size{gbuf.width, gbuf.height};
+        for (uint32_t pass = 0; pass < 2; ++pass) {
+            // Pass 0 writes levels 0-5 (the copy and five means), pass 1 the
+            // levels from 6 on, from level 5.
+            const uint32_t first = pass == 0 ? 0 : shader::kSslrPyramidLevelsPerPass + 1;
+            const uint32_t end = std::min(pyramidMips, pass == 0 ? shader::kSslrPyramidOutputs
+                                                                 : first + shader::kSslrPyramidLevelsPerPass);
+            if (first >= end) break;
+            shader::SslrPyramidConstants constants{};
+            constants.sourceSize = shader::sslrMipSize(size, pass * shader::kSslrPyramidLevelsPerPass);
+            constants.outputs = end - first;
+            for (uint32_t o = 0; o < constants.outputs; ++o) {
+                constants.outputSize[o] = shader::sslrMipSize(size, first + o);
+            }
+            struct PyramidData {
+                rg::Texture source, pyramid;
+                rg::Buffer args;
+                uint32_t first = 0, outputs = 0;
+                bool fromLit = false;
+            };
+            const PyramidData& level = graph.addPass<PyramidData>(
+                "sslr.pyramid", rg::Queue::Graphics,
+                [&](rg::Builder& b, PyramidData& d) {
+                    d.args = b.read(rays.sslrArgs, rg::Access::IndirectArgs);
+                    d.fromLit = pass == 0;
+                    // Level 5 is read and the levels below it written through
+                    // the handle the read returns (the graph orders both by
+                    // subresource).
+                    rg::Texture target = pyramid;
+                    if (d.fromLit) {
+                        d.source = b.read(gbuf.lit, rg::Access::SampledRead);
+                    } else {
+                        d.source = target = b.read(pyramid, rg::Access::StorageRead,
+                                                   rg::Subresource::mip(shader::kSslrPyramidLevelsPerPass));
+                    }
+                    d.pyramid = b.write(target, rg::Access::StorageWrite,
+                                        rg::Subresource{first, end - first, 0, rg::Subresource::kAll});
+                    d.first = first;
+                    d.outputs = end - first;
+                },
+                [&pipelines, constants, pass](const PyramidData& d, rg::PassContext& pc) {
+                    const gpu::Pipeline& pipeline = d.fromLit ? pipelines.pyramidBase_ : pipelines.pyramidDown_;
+                    const gpu::Image& image = pc.image(d.pyramid);
+                    pipeline.bind(pc.cmd());
+                    gpu::PushDescriptors push(pipeline);
+                    if (d.fromLit) {
+                        push.sampledImage(0, pc.view(d.source), pipelines.nearest_.handle(), pc.layout(d.source));
+                    } else {
+                        push.storageImage(0, image.mipView(shader::kSslrPyramidLevelsPerPass));
+                    }
+                    // Bindings past the levels written repeat the last one (never stored to).
+                    for (uint32_t o = 0; o < shader::kSslrPyramidOutputs; ++o) {
+                        push.storageImage(1 + o, image.mipView(d.first + std::min(o, d.outputs - 1)));
+                    }
+                    push.push(pipelines.ctx_, pc.cmd());
+                    pipeline.pushConstants(pc.cmd(), constants);
+                    pc.dispatchIndirect(pipeline, d.args,
+                                        (shader::kSslrArgsPyramidOffset + 3 * pass) * sizeof(uint32_t));
+                });
+            pyramid = level.pyramid;
+        }
+    }
+
+    shader::SslrConstants constants{};
+    constants.view = inputs.view;
+    const glm::mat4& p = inputs.projection;
+    constants.projection = {p[0][0], p[1][1], p[2][2], p[3][2]};
+    constants.size = {gbuf.width, gbuf.height};
+    // The same 32-bit frame as ray generation's noise (glint/sampling.glsl).
+    constants.frame = uint32_t(inputs.frameIndex);
+    constants.linearSteps = settings.linearSteps;
+    constants.minStepPixels = settings.minStepPixels;
+    constants.refineSteps = settings.refineSteps;
+    constants.thickness = settings.thickness;
+    constants.maxDistance = settings.maxDistance;
+    constants.edgeFade = settings.edgeFade;
+    constants.confidenceThreshold = sslrStoredThreshold(settings.confidenceThreshold);
+    constants.pyramidMips = pyramidMips;
+    constants.blueNoise = rays.blueNoise ? 1u : 0u;
+
+    struct TraceData {
+        rg::Texture depth, normal, lit, roughnessMetal, pyramid;
+        rg::Buffer rays, classes, sslrRays, sslrArgs;
+        SslrOutputs out;
+    };
+    const TraceData& trace = graph.addPass<TraceData>(
+        "sslr", rg::Queue::Graphics,
+        [&](rg::Builder& b, TraceData& d) {
+            d.depth = b.read(gbuf.depth, rg::Access::SampledRead);
+            d.normal = b.read(gbuf.normal, rg::Access::SampledRead);
+            d.lit = b.read(gbuf.lit, rg::Access::SampledRead);
+            d.roughnessMetal = b.read(gbuf.roughnessMetal, rg::Access::SampledRead);
+            if (pyramid.valid()) d.pyramid = b.read(pyramid, rg::Access::SampledRead);
+            d.rays = b.read(rays.rays, rg::Access::StorageRead);
+            d.classes = b.read(rays.classes, rg::Access::StorageRead);
+            d.sslrRays = b.read(rays.sslrRays, rg::Access::StorageRead);
+            // The dispatch's size, and the list's length for the shader.
+            d.sslrArgs = b.read(rays.sslrArgs, rg::Access::IndirectArgs);
+            b.read(rays.sslrArgs, rg::Access::StorageRead);
+            d.out = out;
+            d.out.radiance = b.write(radiance, rg::Access::StorageWrite);
+            d.out.confidence = b.write(confidence, rg::Access::StorageWrite);
+            d.out.hitDebug = b.write(hitDebug, rg::Access::StorageWrite);
+            // Appends after ray generation's RT rays.
+            d.out.rtRayList = b.write(rays.rtRays, rg::Access::StorageReadWrite);
+            d.out.rtArgs = b.write(rays.rtArgs, rg::Access::StorageReadWrite);
+            d.out.litPyramid = d.pyramid;
+        },
+        [&pipelines, constants, blueNoise = rays.blueNoiseBuffer](const TraceData& d, rg::PassContext& pc) {
+            const gpu::Pipeline& pipeline = pipelines.trace_;
+            const VkSampler sampler = pipelines.nearest_.handle();
+            pipeline.bind(pc.cmd());
+            gpu::PushDescriptors(pipeline)
+                .sampledImage(0, pc.view(d.depth), sampler, pc.layout(d.depth))
+                .sampledImage(1, pc.view(d.normal), sampler, pc.layout(d.normal))
+                .sampledImage(2, pc.view(d.lit), sampler, pc.layout(d.lit))
+                .storageBuffer(3, pc.buffer(d.rays))
+                .storageBuffer(4, pc.buffer(d.classes))
+                .storageBuffer(5, pc.buffer(d.sslrRays))
+                .storageImage(6, pc.view(d.out.radiance))
+                .storageImage(7, pc.view(d.out.confidence))
+                .storageImage(8, pc.view(d.out.hitDebug))
+                .storageBuffer(9, pc.buffer(d.out.rtRayList))
+                .storageBuffer(10, pc.buffer(d.out.rtArgs))
+                .sampledImage(11, pc.view(d.roughnessMetal), sampler, pc.layout(d.roughnessMetal))
+                // Without the cone trace (pyramidMips 0) binding 12 is never
+                // read; the lit colour completes the descriptor set.
+                .sampledImage(12, pc.view(d.pyramid.valid() ? d.pyramid : d.lit), pipelines.trilinear_.handle(),
+                              pc.layout(d.pyramid.valid() ? d.pyramid : d.lit))
+                .storageBuffer(13, pc.buffer(d.sslrArgs))
+                .storageBuffer(14, *blueNoise)
+                .push(pipelines.ctx_, pc.cmd());
+            pipeline.pushConstants(pc.cmd(), constants);
+            pc.dispatchIndirect(pipeline, d.sslrArgs, kRayListDispatchArgsBytes);
+        });
+    return trace.out;
+}
+
+} // namespace glint::passes

@@ -1,0 +1,142 @@
+#pragma once
+// Pass 7 of the reflection pipeline: reflection motion, temporal
+// accumulation and a spatial filter for rough reflections. Two compute
+// passes on the graphics queue (after temporal.constants, a transfer that
+// fills their uniform buffer):
+//   temporal.accumulate  per pixel: sanitise this frame's radiance (NaN and
+//                        Inf never reach the history), reproject through the
+//                        reflected (virtual) point at the hit distance and
+//                        through the surface (G-buffer motion), blend the two
+//                        by roughness, reject history whose surface differs
+//                        (plane, normal, roughness: disocclusions), clip it
+//                        to the 3x3 neighbourhood's variance in YCoCg, and
+//                        accumulate with weight 1 / history length;
+//   temporal.spatial     an edge-aware blur of the accumulation for rough
+//                        surfaces, into the resolved image only.
+// History lives in two graph history textures (glint/temporal_shared.h);
+// the executor ping-pongs them, so two frames in flight are safe. The first
+// frame finds them cleared (length 0: no history); resetHistory discards
+// them on a camera cut. The pairs are named by the image size, so a graph
+// holds one temporal pass per size.
+//
+//   passes::TemporalPipelines temporalPipelines(ctx);  // once
+//   each frame, after the integrate pass:
+//     const auto stable = passes::addTemporalPass(graph, temporalPipelines,
+//         {gbuf, refl.radiance, refl.hitDistance, camera, frame, cut}, settings.temporal);
+//     ... composite reads stable.resolved ...
+
+#include "glint/gpu/context.h"
+#include "glint/gpu/pipeline.h"
+#include "glint/gpu/resources.h"
+#include "glint/graph/graph.h"
+#include "glint/passes/gbuffer.h"
+#include "glint/scene/camera.h"
+
+#include <cstdint>
+
+namespace glint::passes {
+
+inline constexpr VkFormat kTemporalResolvedFormat = VK_FORMAT_R16G16B16A16_SFLOAT;
+inline constexpr VkFormat kTemporalMotionFormat = VK_FORMAT_R16G16_SFLOAT;
+inline constexpr VkFormat kTemporalHistoryLengthFormat = VK_FORMAT_R16_SFLOAT;
+// Float: at a weight of 1/32 per frame a half float's step (2^-11 relative)
+// would stall the average up to 16 steps from the mean (32 where stores
+// round towards zero, as Vulkan allows for 16-bit floats): a bias of
+// 1-3%, visible as darkening.
+inline constexpr VkFormat kTemporalRadianceHistoryFormat = VK_FORMAT_R32G32B32A32_SFLOAT;
+inline constexpr VkFormat kTemporalSurfaceHistoryFormat = VK_FORMAT_R16G16B16A16_SFLOAT;
+
+struct TemporalInputs {
+    GBufferOutputs gbuffer;   // depth, normal, roughnessMetal, motion
+    rg::Texture radiance;     // reflection radiance (any float format), a > 0 where a surface reflects
+    rg::Texture hitDistance;  // r: distance to the reflected hit; >= shader::kMissHitDistance: at infinity
+    // This and last frame's unjittered matrices and positions (the
+    // G-buffer's camera).
+    scene::Camera camera;
+    // The frame's index (the pass draws no noise of its own; kept so the
+    // inputs name the frame like every pass's).
+    uint64_t frameIndex = 0;
+    // Discard the history (a camera cut, a teleport, a new scene).
+    bool resetHistory = false;
+};
+
+struct TemporalSettings {
+    // The longest history, in frames: a new frame's weight never drops
+    // below 1 / maxHistoryFrames. Glint's starting value: 32 frames halve
+    // the noise of a single-ray reflection about 5.6 times; the clamp keeps
+    // longer histories from lagging.
+    float maxHistoryFrames = 32.0f;
+    // Variance clipping in YCoCg over the 3x3 neighbourhood, to
+    // mean +- clampGamma * sigma (Salvi, GDC 2016, suggests gamma near 1;
+    // the little extra keeps single-ray noise from clipping a converged
+    // history every frame).
+    bool neighbourhoodClamp = true;
+    float clampGamma = 1.25f;
+    // History rejection: a history texel counts only if last frame's
+    // surface there lies within planeTolerance x view depth of this pixel's
+    // tangent plane, its normal within acos(normalTolerance) and its
+    // roughness within roughnessTolerance. Glint's starting values: 2%
+    // passes 16-bit depth and motion rounding at every distance and rejects
+    // any object a visible distance in front.
+    float planeTolerance = 0.02f;
+    float normalTolerance = 0.9f;  // ~26 degrees
+    float roughnessTolerance = 0.1f;
+    // Reflection motion: mirrors follow the virtual point, surfaces from
+    // start to end blend towards the surface motion (a rough reflection is
+    // a blur of many directions and moves with its surface). Glint's
+    // starting values around ray generation's quad-reuse roughness 0.1.
+    float surfaceMotionRoughnessStart = 0.1f;
+    float surfaceMotionRoughnessEnd = 0.3f;
+    // Radiance is clamped to [0, maxRadiance] before it is accumulated: the
+    // largest half float, so the RGBA16F resolved image never overflows to
+    // Inf.
+    float maxRadiance = 65504.0f;
+    // The spatial filter: a (2 radius + 1)^2 edge-aware Gaussian, off below
+    // spatialRoughnessStart (mirrors need none), full from
+    // spatialRoughnessEnd. Radius 0 turns it off; at most
+    // shader::kTemporalMaxSpatialRadius. Glint's starting values: rays are
+    // traced up to the 0.22 roughness cutoff and are
+    // noisiest there.
+    uint32_t spatialRadius = 2;
+    float spatialRoughnessStart = 0.1f;
+    float spatialRoughnessEnd = 0.2f;
+    // Tap weights: exp(-plane distance / (spatialPlaneSigma x view depth)),
+    // max(N.Ntap, 0)^spatialNormalPower, exp(-|roughness difference| /
+    // spatialRoughnessSigma). SVGF's normal power (Schied et al., HPG 2017).
+    float spatialPlaneSigma = 0.01f;
+    float spatialNormalPower = 128.0f;
+    float spatialRoughnessSigma = 0.05f;
+    // Pixels rougher than this are not filtered: above ray generation's
+    // roughness cutoff a pixel takes the environment, which has no noise to
+    // remove (the frame passes its cutoff; on the plaza that skips the 5x5
+    // filter on over half the pixels).
+    float spatialRoughnessMax = 1.0f;
+};
+
+struct TemporalOutputs {
+    rg::Texture resolved;          // kTemporalResolvedFormat: reflections after both passes, a = 1 where they exist
+    rg::Texture reflectionMotion;  // kTemporalMotionFormat: pixels to last frame (debug view "reflection_motion")
+    rg::Texture historyLength;     // kTemporalHistoryLengthFormat: frames, 0 = none (debug view "history_length")
+    uint32_t width = 0;
+    uint32_t height = 0;
+};
+
+// The pipelines and the sampler the pass records with; created once.
+class TemporalPipelines {
+public:
+    explicit TemporalPipelines(gpu::Context& ctx);
+
+private:
+    friend TemporalOutputs addTemporalPass(rg::Graph&, TemporalPipelines&, const TemporalInputs&,
+                                           const TemporalSettings&);
+    gpu::Context& ctx_;
+    gpu::Pipeline accumulate_;
+    gpu::Pipeline spatial_;
+    gpu::Sampler nearest_;
+};
+
+// Declares the passes (see the top of this file) on the graphics queue.
+TemporalOutputs addTemporalPass(rg::Graph& graph, TemporalPipelines& pipelines, const TemporalInputs& inputs,
+                                const TemporalSettings& settings = {});
+
+} // namespace glint::passes
