@@ -1,7 +1,7 @@
 #pragma once
 // The Vulkan context: instance (with the validation harness when asked),
 // physical device selection, logical device, queues, extension entry points,
-// and the memory allocator. Everything else in engine/gpu takes a Context&.
+// and the memory allocator. Everything else in glint/gpu takes a Context&.
 
 #include "glint/gpu/fault.h"
 #include "glint/gpu/memory.h"

@@ -7,6 +7,7 @@
 #include "glint/gpu/pipeline.h"
 
 #include <deque>
+#include <string_view>
 #include <vector>
 
 namespace glint::gpu {
@@ -26,9 +27,29 @@ public:
                                   VkImageLayout layout = VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL);
     PushDescriptors& accelerationStructure(uint32_t binding, VkAccelerationStructureKHR as);
 
+    // The same by the binding's GLSL name (a buffer block's block name, any
+    // other resource's variable name): the shader states the number once.
+    PushDescriptors& storageBuffer(std::string_view name, const Buffer& buffer, VkDeviceSize offset = 0,
+                                   VkDeviceSize range = VK_WHOLE_SIZE) {
+        return storageBuffer(number(name), buffer, offset, range);
+    }
+    PushDescriptors& uniformBuffer(std::string_view name, const Buffer& buffer, VkDeviceSize offset = 0,
+                                   VkDeviceSize range = VK_WHOLE_SIZE) {
+        return uniformBuffer(number(name), buffer, offset, range);
+    }
+    PushDescriptors& storageImage(std::string_view name, VkImageView view) { return storageImage(number(name), view); }
+    PushDescriptors& sampledImage(std::string_view name, VkImageView view, VkSampler sampler,
+                                  VkImageLayout layout = VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL) {
+        return sampledImage(number(name), view, sampler, layout);
+    }
+    PushDescriptors& accelerationStructure(std::string_view name, VkAccelerationStructureKHR as) {
+        return accelerationStructure(number(name), as);
+    }
+
     void push(const Context& ctx, VkCommandBuffer cmd) const;
 
 private:
+    uint32_t number(std::string_view name) const { return pipeline_.layout().binding(name).binding; }
     VkWriteDescriptorSet& add(uint32_t binding, VkDescriptorType type);
 
     const Pipeline& pipeline_;

@@ -5,6 +5,7 @@
 
 #include <spdlog/spdlog.h>
 
+#include <algorithm>
 #include <cstdlib>
 #include <dlfcn.h>
 #include <fstream>
@@ -62,6 +63,59 @@ std::vector<std::filesystem::path> shaderSearchPath() {
 
 uint32_t alignUp(uint32_t v, uint32_t a) { return (v + a - 1) / a * a; }
 
+std::string bindingText(const Binding& b) {
+    return "binding " + std::to_string(b.binding) + (b.name.empty() ? "" : " '" + b.name + "'");
+}
+
+// The layout of a pipeline of `modules`: their reflected bindings, checked
+// against and completed by the description's (see ComputePipelineDesc).
+std::vector<Binding> resolveBindings(const std::vector<Binding>& declared, uint32_t& pushConstantBytes,
+                                     const std::vector<const ShaderModule*>& modules, const std::string& pipeline) {
+    std::vector<ShaderInterface> stages;
+    for (const ShaderModule* m : modules) stages.push_back(m->interface());
+    const ShaderInterface merged = mergeInterfaces(stages, pipeline);
+    std::vector<Binding> out;
+    for (const ReflectedBinding& r : merged.bindings) {
+        Binding b{r.binding, r.type, r.stages, r.count, r.name};
+        const auto d = std::find_if(declared.begin(), declared.end(),
+                                    [&](const Binding& x) { return x.binding == r.binding; });
+        if (d != declared.end()) {
+            if (d->type != r.type) {
+                throw GpuError("pipeline '" + pipeline + "': " + bindingText(b) + " is descriptor type " +
+                               std::to_string(int(r.type)) + " in the shader, declared as type " +
+                               std::to_string(int(d->type)));
+            }
+            if (r.count != 0 && d->count != r.count) {
+                throw GpuError("pipeline '" + pipeline + "': " + bindingText(b) + " has " + std::to_string(r.count) +
+                               " elements in the shader, declared with " + std::to_string(d->count));
+            }
+            b.count = d->count;
+        }
+        if (b.count == 0) {
+            throw GpuError("pipeline '" + pipeline + "': " + bindingText(b) +
+                           " is a runtime-sized array: state its count in the pipeline description");
+        }
+        out.push_back(std::move(b));
+    }
+    // A binding listed that no stage has stays in the layout as listed:
+    // pipelines that share one layout and one push code (the G-buffer's
+    // sky and surface pipelines) push it whether or not they read it.
+    for (const Binding& d : declared) {
+        if (std::none_of(out.begin(), out.end(), [&](const Binding& b) { return b.binding == d.binding; })) {
+            out.push_back(d);
+        }
+    }
+    std::sort(out.begin(), out.end(), [](const Binding& a, const Binding& b) { return a.binding < b.binding; });
+    if (pushConstantBytes == 0) {
+        pushConstantBytes = alignUp(merged.pushConstantBytes, 4);
+    } else if (pushConstantBytes < merged.pushConstantBytes) {
+        throw GpuError("pipeline '" + pipeline + "': " + std::to_string(pushConstantBytes) +
+                       " bytes of push constants declared, the shaders' block has " +
+                       std::to_string(merged.pushConstantBytes));
+    }
+    return out;
+}
+
 } // namespace
 
 std::filesystem::path shaderDirectory() {
@@ -104,8 +158,9 @@ std::vector<uint32_t> loadSpirv(const std::string& name) {
                    "]: build the project (scripts/demo or ninja -C build) or set GLINT_SHADER_DIR to build/shaders");
 }
 
-ShaderModule::ShaderModule(Context& ctx, const std::string& name) : name_(name) {
+ShaderModule::ShaderModule(Context& ctx, const std::string& name, VkShaderStageFlags stage) : name_(name) {
     const auto code = loadSpirv(name);
+    interface_ = reflectShader(code, stage, name);
     VkShaderModuleCreateInfo info{VK_STRUCTURE_TYPE_SHADER_MODULE_CREATE_INFO};
     info.codeSize = code.size() * sizeof(uint32_t);
     info.pCode = code.data();
@@ -119,7 +174,7 @@ ShaderModule::ShaderModule(Context& ctx, const std::string& name) : name_(name) 
 
 PipelineLayout::PipelineLayout(Context& ctx, std::vector<Binding> bindings, uint32_t pushConstantBytes,
                                std::string_view name)
-    : bindings_(std::move(bindings)), pushConstantBytes_(pushConstantBytes) {
+    : name_(name), bindings_(std::move(bindings)), pushConstantBytes_(pushConstantBytes) {
     uint32_t descriptorCount = 0;
     std::vector<VkDescriptorSetLayoutBinding> vkBindings;
     for (const auto& b : bindings_) {
@@ -152,22 +207,34 @@ PipelineLayout::PipelineLayout(Context& ctx, std::vector<Binding> bindings, uint
     ctx.setName(layout, VK_OBJECT_TYPE_PIPELINE_LAYOUT, name);
 }
 
+const Binding& PipelineLayout::binding(std::string_view name) const {
+    for (const Binding& b : bindings_) {
+        if (b.name == name) return b;
+    }
+    std::string names;
+    for (const Binding& b : bindings_) names += (names.empty() ? "" : ", ") + b.name;
+    throw GpuError("pipeline '" + name_ + "' has no binding named '" + std::string(name) + "' (it has: " + names + ")");
+}
+
 // ---------------------------------------------------------------- Pipeline
 
 void Pipeline::pushConstants(VkCommandBuffer cmd, const void* data, uint32_t size) const {
-    if (size != layout_.pushConstantBytes()) {
+    // At least the layout's range; bytes beyond it are a C++ struct's
+    // trailing padding, which the shaders' block does not have.
+    if (size < layout_.pushConstantBytes() || layout_.pushConstantBytes() == 0) {
         throw GpuError("pipeline '" + name_ + "': " + std::to_string(size) + " bytes of push constants, layout has " +
                        std::to_string(layout_.pushConstantBytes()));
     }
-    vkCmdPushConstants(cmd, layout_.handle(), VK_SHADER_STAGE_ALL, 0, size, data);
+    vkCmdPushConstants(cmd, layout_.handle(), VK_SHADER_STAGE_ALL, 0, layout_.pushConstantBytes(), data);
 }
 
 Pipeline createComputePipeline(Context& ctx, const ComputePipelineDesc& desc) {
     Pipeline p;
     p.name_ = desc.name.empty() ? desc.shader : desc.name;
     p.bindPoint_ = VK_PIPELINE_BIND_POINT_COMPUTE;
-    p.layout_ = PipelineLayout(ctx, desc.bindings, desc.pushConstantBytes, p.name_);
-    ShaderModule module(ctx, desc.shader);
+    ShaderModule module(ctx, desc.shader, VK_SHADER_STAGE_COMPUTE_BIT);
+    uint32_t pushBytes = desc.pushConstantBytes;
+    p.layout_ = PipelineLayout(ctx, resolveBindings(desc.bindings, pushBytes, {&module}, p.name_), pushBytes, p.name_);
     VkComputePipelineCreateInfo info{VK_STRUCTURE_TYPE_COMPUTE_PIPELINE_CREATE_INFO};
     info.stage = {VK_STRUCTURE_TYPE_PIPELINE_SHADER_STAGE_CREATE_INFO};
     info.stage.stage = VK_SHADER_STAGE_COMPUTE_BIT;
@@ -186,9 +253,10 @@ Pipeline createGraphicsPipeline(Context& ctx, const GraphicsPipelineDesc& desc) 
     Pipeline p;
     p.name_ = desc.name.empty() ? desc.vertexShader : desc.name;
     p.bindPoint_ = VK_PIPELINE_BIND_POINT_GRAPHICS;
-    p.layout_ = PipelineLayout(ctx, desc.bindings, desc.pushConstantBytes, p.name_);
-    ShaderModule vs(ctx, desc.vertexShader);
-    ShaderModule fs(ctx, desc.fragmentShader);
+    ShaderModule vs(ctx, desc.vertexShader, VK_SHADER_STAGE_VERTEX_BIT);
+    ShaderModule fs(ctx, desc.fragmentShader, VK_SHADER_STAGE_FRAGMENT_BIT);
+    uint32_t pushBytes = desc.pushConstantBytes;
+    p.layout_ = PipelineLayout(ctx, resolveBindings(desc.bindings, pushBytes, {&vs, &fs}, p.name_), pushBytes, p.name_);
     VkPipelineShaderStageCreateInfo stages[2] = {{VK_STRUCTURE_TYPE_PIPELINE_SHADER_STAGE_CREATE_INFO},
                                                  {VK_STRUCTURE_TYPE_PIPELINE_SHADER_STAGE_CREATE_INFO}};
     stages[0].stage = VK_SHADER_STAGE_VERTEX_BIT;
@@ -276,14 +344,13 @@ Pipeline createRayTracingPipeline(Context& ctx, const RayTracingPipelineDesc& de
                        " exceeds the device's " + std::to_string(ctx.caps().rayTracing.maxRayRecursionDepth));
     }
     p.bindPoint_ = VK_PIPELINE_BIND_POINT_RAY_TRACING_KHR;
-    p.layout_ = PipelineLayout(ctx, desc.bindings, desc.pushConstantBytes, p.name_);
 
     std::vector<ShaderModule> modules;
     std::vector<VkPipelineShaderStageCreateInfo> stages;
     std::vector<VkRayTracingShaderGroupCreateInfoKHR> groups;
     modules.reserve(1 + desc.misses.size() + 2 * desc.hitGroups.size());
     auto addStage = [&](const std::string& name, VkShaderStageFlagBits stage) -> uint32_t {
-        modules.emplace_back(ctx, name);
+        modules.emplace_back(ctx, name, stage);
         VkPipelineShaderStageCreateInfo s{VK_STRUCTURE_TYPE_PIPELINE_SHADER_STAGE_CREATE_INFO};
         s.stage = stage;
         s.module = modules.back().handle();
@@ -311,6 +378,11 @@ Pipeline createRayTracingPipeline(Context& ctx, const RayTracingPipelineDesc& de
         if (!h.anyHit.empty()) g.anyHitShader = addStage(h.anyHit, VK_SHADER_STAGE_ANY_HIT_BIT_KHR);
         groups.push_back(g);
     }
+
+    std::vector<const ShaderModule*> reflected;
+    for (const ShaderModule& m : modules) reflected.push_back(&m);
+    uint32_t pushBytes = desc.pushConstantBytes;
+    p.layout_ = PipelineLayout(ctx, resolveBindings(desc.bindings, pushBytes, reflected, p.name_), pushBytes, p.name_);
 
     VkRayTracingPipelineCreateInfoKHR info{VK_STRUCTURE_TYPE_RAY_TRACING_PIPELINE_CREATE_INFO_KHR};
     info.stageCount = static_cast<uint32_t>(stages.size());

@@ -5,6 +5,7 @@
 
 #include "glint/gpu/handle.h"
 #include "glint/gpu/resources.h"
+#include "glint/gpu/shader_reflection.h"
 
 #include <vulkan/vulkan.h>
 
@@ -28,22 +29,29 @@ std::filesystem::path shaderDirectory();
 // Throws GpuError naming the file and the folders searched.
 std::vector<uint32_t> loadSpirv(const std::string& name);
 
+// One stage's SPIR-V, loaded and reflected (gpu/shader_reflection.h).
 class ShaderModule {
 public:
-    ShaderModule(Context& ctx, const std::string& name);
+    ShaderModule(Context& ctx, const std::string& name, VkShaderStageFlags stage);
     VkShaderModule handle() const { return module_.get(); }
     const std::string& name() const { return name_; }
+    const ShaderInterface& interface() const { return interface_; }
 
 private:
     std::string name_;
+    ShaderInterface interface_;
     Unique<VkShaderModule> module_;
 };
 
+// A descriptor binding of a pipeline layout. Pipelines take their bindings
+// from the shaders' SPIR-V; a pipeline description lists only what SPIR-V
+// cannot say (the count of a runtime-sized array) or what it wants checked.
 struct Binding {
     uint32_t binding = 0;
     VkDescriptorType type = VK_DESCRIPTOR_TYPE_STORAGE_BUFFER;
     VkShaderStageFlags stages = VK_SHADER_STAGE_ALL;
     uint32_t count = 1;
+    std::string name;  // the GLSL name (reflected)
 };
 
 // A push-descriptor set layout plus push-constant range.
@@ -53,15 +61,25 @@ public:
     PipelineLayout(Context& ctx, std::vector<Binding> bindings, uint32_t pushConstantBytes, std::string_view name);
     VkPipelineLayout handle() const { return layout_.get(); }
     const std::vector<Binding>& bindings() const { return bindings_; }
+    // The binding whose GLSL name is `name`; throws GpuError naming the
+    // pipeline layout's bindings otherwise.
+    const Binding& binding(std::string_view name) const;
     uint32_t pushConstantBytes() const { return pushConstantBytes_; }
 
 private:
+    std::string name_;
     std::vector<Binding> bindings_;
     uint32_t pushConstantBytes_ = 0;
     Unique<VkDescriptorSetLayout> setLayout_;
     Unique<VkPipelineLayout> layout_;
 };
 
+// In every pipeline description: `bindings` and `pushConstantBytes` may
+// stay empty and 0, and the layout is the shaders' (reflected from SPIR-V).
+// A binding listed that a shader has must have its type there (the listed
+// count sizes a runtime-sized array); one no shader has is added as listed
+// (for pipelines sharing one layout). A push-constant size given must
+// cover the shaders' block (a C++ struct may carry trailing padding).
 struct ComputePipelineDesc {
     std::string shader;  // e.g. "smoke/trace_query.comp"
     std::vector<Binding> bindings;

@@ -26,7 +26,7 @@ struct ValidationMessage {
 // timeline semaphores (KhronosGroup/Vulkan-ValidationLayers#7600, fixed in
 // 2024 releases), so every cross-queue dependency the render graph makes
 // with them is reported as a race. Those dependencies are proven by the
-// graph's own verifier (engine/graph/verify.h) instead; the set-aside
+// graph's own verifier (glint/graph/verify.h) instead; the set-aside
 // messages are counted and logged at debug level.
 class ValidationLog {
 public:

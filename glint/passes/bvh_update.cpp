@@ -168,22 +168,10 @@ BvhManager::BvhManager(gpu::Context& ctx, const scene::Scene& scene, uint32_t fr
       hitMaterials_(std::make_unique<HitMaterials>(ctx, scene, options.hitMaterials)),
       assets_(scene::assetStamp(scene)),
       retired_(framesInFlight_) {
-    const VkShaderStageFlags cs = VK_SHADER_STAGE_COMPUTE_BIT;
     packPipeline_ = gpu::createComputePipeline(
-        ctx, {"bvh/pack_primitives.comp",
-              {{0, VK_DESCRIPTOR_TYPE_STORAGE_BUFFER, cs},
-               {1, VK_DESCRIPTOR_TYPE_STORAGE_BUFFER, cs},
-               {2, VK_DESCRIPTOR_TYPE_STORAGE_BUFFER, cs},
-               {3, VK_DESCRIPTOR_TYPE_STORAGE_BUFFER, cs},
-               {4, VK_DESCRIPTOR_TYPE_STORAGE_BUFFER, cs},
-               {5, VK_DESCRIPTOR_TYPE_STORAGE_BUFFER, cs}},
-              sizeof(shader::BvhPackParams),
-              "bvh.pack_primitives"});
+        ctx, {"bvh/pack_primitives.comp", {}, sizeof(shader::BvhPackParams), "bvh.pack_primitives"});
     particleQuadsPipeline_ = gpu::createComputePipeline(
-        ctx, {"bvh/particle_quads.comp",
-              {{0, VK_DESCRIPTOR_TYPE_STORAGE_BUFFER, cs}, {1, VK_DESCRIPTOR_TYPE_STORAGE_BUFFER, cs}},
-              sizeof(shader::ParticleBillboardParams),
-              "bvh.particle_quads"});
+        ctx, {"bvh/particle_quads.comp", {}, sizeof(shader::ParticleBillboardParams), "bvh.particle_quads"});
     particleStaging_.resize(framesInFlight_);
     particleInstances_.resize(framesInFlight_);
     offsetStaging_.resize(framesInFlight_);
@@ -469,7 +457,10 @@ void BvhManager::prepareParticles(const scene::BvhPlan& plan, const scene::Camer
 void BvhManager::recordParticleQuads(const FrameWork& work, VkCommandBuffer cmd, const gpu::Buffer& particles) {
     gpu::ScopedLabel label(ctx_, cmd, "bvh.particle_quads");
     particleQuadsPipeline_.bind(cmd);
-    gpu::PushDescriptors(particleQuadsPipeline_).storageBuffer(0, particles).storageBuffer(1, particleQuads_).push(ctx_, cmd);
+    gpu::PushDescriptors(particleQuadsPipeline_)
+        .storageBuffer("Particles", particles)
+        .storageBuffer("Positions", particleQuads_)
+        .push(ctx_, cmd);
     particleQuadsPipeline_.pushConstants(cmd, work.billboard);
     vkCmdDispatch(cmd, (work.billboard.count + shader::kParticleBillboardGroupSize - 1) / shader::kParticleBillboardGroupSize,
                   1, 1);
@@ -772,12 +763,12 @@ void BvhManager::record(FrameWork& work, rg::PassContext& pc, const BvhUpdateOut
         for (const FrameWork::Pack& pack : work.packs) {
             const gpu::Buffer& skin = pack.source->skin ? pack.source->skin : pack.source->vertices;
             gpu::PushDescriptors(packPipeline_)
-                .storageBuffer(0, pack.vertices ? *pack.vertices : pack.source->vertices)
-                .storageBuffer(1, pack.source->indices)
-                .storageBuffer(2, skin)  // unread when jointCount is 0; the binding must still be valid
-                .storageBuffer(3, jointPalettes_[slot])
-                .storageBuffer(4, *pack.positions)
-                .storageBuffer(5, pool)
+                .storageBuffer("Vertices", pack.vertices ? *pack.vertices : pack.source->vertices)
+                .storageBuffer("Indices", pack.source->indices)
+                .storageBuffer("Skin", skin)  // unread when jointCount is 0; the binding must still be valid
+                .storageBuffer("Joints", jointPalettes_[slot])
+                .storageBuffer("Positions", *pack.positions)
+                .storageBuffer("Pool", pool)
                 .push(ctx_, cmd);
             packPipeline_.pushConstants(cmd, pack.params);
             vkCmdDispatch(cmd, (pack.params.triangleCount + shader::kBvhPackGroupSize - 1) / shader::kBvhPackGroupSize,

@@ -14,15 +14,6 @@ namespace glint::passes {
 
 namespace {
 
-std::vector<gpu::Binding> sampledThenStorage(uint32_t sampled) {
-    std::vector<gpu::Binding> out;
-    for (uint32_t i = 0; i < sampled; ++i) {
-        out.push_back({i, VK_DESCRIPTOR_TYPE_COMBINED_IMAGE_SAMPLER, VK_SHADER_STAGE_COMPUTE_BIT});
-    }
-    out.push_back({sampled, VK_DESCRIPTOR_TYPE_STORAGE_IMAGE, VK_SHADER_STAGE_COMPUTE_BIT});
-    return out;
-}
-
 uint32_t groups(uint32_t pixels) { return (pixels + shader::kCompositeGroupSize - 1) / shader::kCompositeGroupSize; }
 
 enum class SourceClass { Float, Uint, Unsupported };
@@ -76,11 +67,11 @@ CompositeOutputs outputOf(rg::Builder& b, const char* name, uint32_t width, uint
 
 CompositePipelines::CompositePipelines(gpu::Context& ctx)
     : ctx_(ctx),
-      composite_(gpu::createComputePipeline(ctx, {"composite/composite.comp", sampledThenStorage(7),
+      composite_(gpu::createComputePipeline(ctx, {"composite/composite.comp", {},
                                                   uint32_t(sizeof(shader::CompositeConstants)), "composite"})),
-      debugView_(gpu::createComputePipeline(ctx, {"composite/debug_view.comp", sampledThenStorage(1),
+      debugView_(gpu::createComputePipeline(ctx, {"composite/debug_view.comp", {},
                                                   uint32_t(sizeof(shader::DebugViewConstants)), "debug_view"})),
-      debugViewUint_(gpu::createComputePipeline(ctx, {"composite/debug_view_uint.comp", sampledThenStorage(1),
+      debugViewUint_(gpu::createComputePipeline(ctx, {"composite/debug_view_uint.comp", {},
                                                       uint32_t(sizeof(shader::DebugViewConstants)),
                                                       "debug_view.uint"})),
       // Every read is a texelFetch; the sampler only completes the combined
@@ -146,14 +137,14 @@ CompositeOutputs addCompositePass(rg::Graph& graph, CompositePipelines& pipeline
             const rg::Texture transparency = d.transparency.valid() ? d.transparency : d.lit;
             pipeline.bind(pc.cmd());
             gpu::PushDescriptors(pipeline)
-                .sampledImage(0, pc.view(d.lit), sampler, pc.layout(d.lit))
-                .sampledImage(1, pc.view(d.albedo), sampler, pc.layout(d.albedo))
-                .sampledImage(2, pc.view(d.normal), sampler, pc.layout(d.normal))
-                .sampledImage(3, pc.view(d.roughnessMetal), sampler, pc.layout(d.roughnessMetal))
-                .sampledImage(4, pc.view(d.depth), sampler, pc.layout(d.depth))
-                .sampledImage(5, pc.view(reflections), sampler, pc.layout(reflections))
-                .sampledImage(6, pc.view(transparency), sampler, pc.layout(transparency))
-                .storageImage(7, pc.view(d.out.color))
+                .sampledImage("litTexture", pc.view(d.lit), sampler, pc.layout(d.lit))
+                .sampledImage("albedoTexture", pc.view(d.albedo), sampler, pc.layout(d.albedo))
+                .sampledImage("normalTexture", pc.view(d.normal), sampler, pc.layout(d.normal))
+                .sampledImage("roughnessMetalTexture", pc.view(d.roughnessMetal), sampler, pc.layout(d.roughnessMetal))
+                .sampledImage("depthTexture", pc.view(d.depth), sampler, pc.layout(d.depth))
+                .sampledImage("reflectionTexture", pc.view(reflections), sampler, pc.layout(reflections))
+                .sampledImage("transparencyTexture", pc.view(transparency), sampler, pc.layout(transparency))
+                .storageImage("outputImage", pc.view(d.out.color))
                 .push(pipelines.ctx_, pc.cmd());
             pipeline.pushConstants(pc.cmd(), constants);
             pc.dispatch(pipeline, groups(constants.size.x), groups(constants.size.y));
@@ -169,9 +160,11 @@ CompositeOutputs addDebugViewPass(rg::Graph& graph, CompositePipelines& pipeline
     }
     const rg::TextureDesc& desc = graph.declaration().resources[source.index].texture;
     const std::string name(graph.declaration().resources[source.index].name);
-    if (desc.mips != 1 || desc.layers != 1 || desc.depth != 1) {
-        throw gpu::GpuError("addDebugViewPass: '" + name + "' must be a 2D texture of one mip and one layer");
+    if (desc.layers != 1 || desc.depth != 1) {
+        throw gpu::GpuError("addDebugViewPass: '" + name + "' must be a 2D texture of one layer");
     }
+    // Of a texture with mips (the SSLR pyramid), mip 0 is shown.
+    const bool mipped = desc.mips > 1;
     if (width == 0 || height == 0 || width > desc.width || height > desc.height) {
         throw gpu::GpuError("addDebugViewPass: " + std::to_string(width) + "x" + std::to_string(height) +
                             " does not fit in '" + name + "'");
@@ -199,14 +192,15 @@ CompositeOutputs addDebugViewPass(rg::Graph& graph, CompositePipelines& pipeline
     const Data& data = graph.addPass<Data>(
         "debug_view." + name, rg::Queue::Graphics,
         [&](rg::Builder& b, Data& d) {
-            d.source = b.read(source, rg::Access::SampledRead);
+            d.source = b.read(source, rg::Access::SampledRead, mipped ? rg::Subresource::mip(0) : rg::Subresource{});
             d.out = outputOf(b, "debug_view.color", width, height);
         },
-        [&pipelines, pipeline, constants](const Data& d, rg::PassContext& pc) {
+        [&pipelines, pipeline, constants, mipped](const Data& d, rg::PassContext& pc) {
             pipeline->bind(pc.cmd());
+            const VkImageView view = mipped ? pc.image(d.source).mipView(0) : pc.view(d.source);
             gpu::PushDescriptors(*pipeline)
-                .sampledImage(0, pc.view(d.source), pipelines.nearest_.handle(), pc.layout(d.source))
-                .storageImage(1, pc.view(d.out.color))
+                .sampledImage("sourceTexture", view, pipelines.nearest_.handle(), pc.layout(d.source))
+                .storageImage("outputImage", pc.view(d.out.color))
                 .push(pipelines.ctx_, pc.cmd());
             pipeline->pushConstants(pc.cmd(), constants);
             pc.dispatch(*pipeline, groups(constants.size.x), groups(constants.size.y));

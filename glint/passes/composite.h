@@ -108,7 +108,7 @@ private:
 CompositeOutputs addCompositePass(rg::Graph& graph, CompositePipelines& pipelines, const CompositeInputs& inputs,
                                   const CompositeSettings& settings = {});
 
-// Declares a debug view of `source` (a 2D texture of one mip and layer;
+// Declares a debug view of `source` (a 2D texture of one layer; mip 0 of one with mips;
 // its first width x height texels are shown) on the graphics queue.
 // Signed-integer and stencil sources are refused.
 CompositeOutputs addDebugViewPass(rg::Graph& graph, CompositePipelines& pipelines, rg::Texture source, uint32_t width,

@@ -28,8 +28,6 @@ constexpr uint32_t kIrradianceMaxWidth = 64;
 constexpr uint32_t kSourceMinWidth = 32;
 constexpr uint32_t kMaxSamples = 1024;
 
-constexpr VkShaderStageFlags kCompute = VK_SHADER_STAGE_COMPUTE_BIT;
-
 uint32_t groups(uint32_t n) { return (n + 7) / 8; }
 
 uint32_t mipCount(uint32_t width, uint32_t height) {
@@ -51,20 +49,16 @@ gpu::Sampler createEnvironmentSampler(gpu::Context& ctx, const std::string& name
 EnvironmentMap::EnvironmentMap(gpu::Context& ctx, const scene::Scene& scene, const EnvironmentSettings& settings)
     : ctx_(ctx), scene_(scene), settings_(settings) {
     source_ = gpu::createComputePipeline(
-        ctx, {"environment/source.comp",
-              {{0, VK_DESCRIPTOR_TYPE_STORAGE_BUFFER, kCompute}, {1, VK_DESCRIPTOR_TYPE_STORAGE_IMAGE, kCompute}},
+        ctx, {"environment/source.comp", {},
               uint32_t(sizeof(shader::EnvironmentPrefilterConstants)), "environment.source"});
     downsample_ = gpu::createComputePipeline(
-        ctx, {"environment/downsample.comp",
-              {{0, VK_DESCRIPTOR_TYPE_STORAGE_IMAGE, kCompute}, {1, VK_DESCRIPTOR_TYPE_STORAGE_IMAGE, kCompute}},
+        ctx, {"environment/downsample.comp", {},
               uint32_t(sizeof(shader::EnvironmentPrefilterConstants)), "environment.downsample"});
     prefilter_ = gpu::createComputePipeline(
-        ctx, {"environment/prefilter.comp",
-              {{0, VK_DESCRIPTOR_TYPE_COMBINED_IMAGE_SAMPLER, kCompute}, {1, VK_DESCRIPTOR_TYPE_STORAGE_IMAGE, kCompute}},
+        ctx, {"environment/prefilter.comp", {},
               uint32_t(sizeof(shader::EnvironmentPrefilterConstants)), "environment.prefilter"});
     irradiance_ = gpu::createComputePipeline(
-        ctx, {"environment/irradiance.comp",
-              {{0, VK_DESCRIPTOR_TYPE_COMBINED_IMAGE_SAMPLER, kCompute}, {1, VK_DESCRIPTOR_TYPE_STORAGE_BUFFER, kCompute}},
+        ctx, {"environment/irradiance.comp", {},
               uint32_t(sizeof(shader::EnvironmentPrefilterConstants)), "environment.irradiance"});
     sampler_ = createEnvironmentSampler(ctx, "environment.trilinear");
     refresh();
@@ -179,7 +173,10 @@ void EnvironmentMap::prefilter(const scene::Texture& image) {
         shader::EnvironmentPrefilterConstants c = base;
         c.size = {image.width, image.height};
         source_.bind(cmd);
-        gpu::PushDescriptors(source_).storageBuffer(0, upload).storageImage(1, chain.mipView(0)).push(ctx_, cmd);
+        gpu::PushDescriptors(source_)
+            .storageBuffer("Source", upload)
+            .storageImage("chainImage", chain.mipView(0))
+            .push(ctx_, cmd);
         source_.pushConstants(cmd, c);
         vkCmdDispatch(cmd, groups(c.size.x), groups(c.size.y), 1);
 
@@ -189,8 +186,8 @@ void EnvironmentMap::prefilter(const scene::Texture& image) {
             afterWrites(VK_ACCESS_2_SHADER_STORAGE_READ_BIT | VK_ACCESS_2_SHADER_STORAGE_WRITE_BIT);
             c.size = {std::max(image.width >> mip, 1u), std::max(image.height >> mip, 1u)};
             gpu::PushDescriptors(downsample_)
-                .storageImage(0, chain.mipView(mip - 1))
-                .storageImage(1, chain.mipView(mip))
+                .storageImage("aboveImage", chain.mipView(mip - 1))
+                .storageImage("mipImage", chain.mipView(mip))
                 .push(ctx_, cmd);
             downsample_.pushConstants(cmd, c);
             vkCmdDispatch(cmd, groups(c.size.x), groups(c.size.y), 1);
@@ -209,8 +206,8 @@ void EnvironmentMap::prefilter(const scene::Texture& image) {
             c.samples = std::min(base.samples << std::min(level > 0 ? level - 1 : 0u, 8u), kMaxSamples);
             c.sourceLevel = top;
             gpu::PushDescriptors(prefilter_)
-                .sampledImage(0, chain.view(), sampler_.handle(), VK_IMAGE_LAYOUT_GENERAL)
-                .storageImage(1, radiance_.mipView(level))
+                .sampledImage("sourceTexture", chain.view(), sampler_.handle(), VK_IMAGE_LAYOUT_GENERAL)
+                .storageImage("levelImage", radiance_.mipView(level))
                 .push(ctx_, cmd);
             prefilter_.pushConstants(cmd, c);
             vkCmdDispatch(cmd, groups(c.size.x), groups(c.size.y), 1);
@@ -222,8 +219,8 @@ void EnvironmentMap::prefilter(const scene::Texture& image) {
         c.sourceLevel = irradianceMip;
         irradiance_.bind(cmd);
         gpu::PushDescriptors(irradiance_)
-            .sampledImage(0, chain.view(), sampler_.handle(), VK_IMAGE_LAYOUT_GENERAL)
-            .storageBuffer(1, coefficients)
+            .sampledImage("sourceTexture", chain.view(), sampler_.handle(), VK_IMAGE_LAYOUT_GENERAL)
+            .storageBuffer("Coefficients", coefficients)
             .push(ctx_, cmd);
         irradiance_.pushConstants(cmd, c);
         vkCmdDispatch(cmd, 1, 1, 1);

@@ -15,18 +15,11 @@ namespace {
 
 constexpr uint32_t kGroupSize = 64;  // reproject.comp's local_size_x
 
-std::vector<gpu::Binding> reprojectBindings() {
-    return {{0, VK_DESCRIPTOR_TYPE_COMBINED_IMAGE_SAMPLER, VK_SHADER_STAGE_COMPUTE_BIT},
-            {1, VK_DESCRIPTOR_TYPE_STORAGE_BUFFER, VK_SHADER_STAGE_COMPUTE_BIT},
-            {2, VK_DESCRIPTOR_TYPE_STORAGE_BUFFER, VK_SHADER_STAGE_COMPUTE_BIT},
-            {3, VK_DESCRIPTOR_TYPE_STORAGE_BUFFER, VK_SHADER_STAGE_COMPUTE_BIT}};
-}
-
 } // namespace
 
 FeedbackPipelines::FeedbackPipelines(gpu::Context& ctx)
     : ctx_(ctx),
-      reproject_(gpu::createComputePipeline(ctx, {"feedback/reproject.comp", reprojectBindings(),
+      reproject_(gpu::createComputePipeline(ctx, {"feedback/reproject.comp", {},
                                                   uint32_t(sizeof(shader::FeedbackConstants)),
                                                   "feedback.reproject"})),
       // The motion is read texel by texel (texelFetch); the sampler only
@@ -85,10 +78,10 @@ FeedbackOutputs addFeedbackPass(rg::Graph& graph, FeedbackPipelines& pipelines, 
             const gpu::Pipeline& pipeline = pipelines.reproject_;
             pipeline.bind(pc.cmd());
             gpu::PushDescriptors(pipeline)
-                .sampledImage(0, pc.view(d.motion), pipelines.nearest_.handle(), pc.layout(d.motion))
-                .storageBuffer(1, pc.buffer(d.previous))
-                .storageBuffer(2, pc.buffer(d.out.reprojected))
-                .storageBuffer(3, pc.buffer(d.out.tileModes))
+                .sampledImage("motionTexture", pc.view(d.motion), pipelines.nearest_.handle(), pc.layout(d.motion))
+                .storageBuffer("Previous", pc.buffer(d.previous))
+                .storageBuffer("Reprojected", pc.buffer(d.out.reprojected))
+                .storageBuffer("TileModes", pc.buffer(d.out.tileModes))
                 .push(pipelines.ctx_, pc.cmd());
             pipeline.pushConstants(pc.cmd(), constants);
             pc.dispatch(pipeline, (tiles + kGroupSize - 1) / kGroupSize);

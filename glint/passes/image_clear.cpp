@@ -20,10 +20,7 @@ gpu::Pipeline createClearPipeline(gpu::Context& ctx) {
                             "' lacks shaderStorageImageWriteWithoutFormat");
     }
     return gpu::createComputePipeline(
-        ctx, {"common/clear_image.comp",
-              {{0, VK_DESCRIPTOR_TYPE_STORAGE_IMAGE, VK_SHADER_STAGE_COMPUTE_BIT}},
-              uint32_t(sizeof(ClearConstants)),
-              "common.clear_image"});
+        ctx, {"common/clear_image.comp", {}, uint32_t(sizeof(ClearConstants)), "common.clear_image"});
 }
 
 } // namespace
@@ -34,7 +31,7 @@ void ImageClearer::clear(rg::PassContext& pc, rg::Texture texture, glm::vec4 val
     const gpu::Image& image = pc.image(texture);
     const ClearConstants constants{value, {image.extent().width, image.extent().height}};
     pipeline_.bind(pc.cmd());
-    gpu::PushDescriptors(pipeline_).storageImage(0, pc.view(texture)).push(ctx_, pc.cmd());
+    gpu::PushDescriptors(pipeline_).storageImage("target", pc.view(texture)).push(ctx_, pc.cmd());
     pipeline_.pushConstants(pc.cmd(), constants);
     pc.dispatch(pipeline_, (constants.size.x + 7) / 8, (constants.size.y + 7) / 8);
 }

@@ -21,13 +21,6 @@ constexpr uint32_t kVariantSslr = 1u;
 constexpr uint32_t kVariantRt = 2u;
 constexpr uint32_t kVariantFeedback = 4u;
 
-// integrate.glsl's bindings.
-constexpr uint32_t kBindingDepth = 0, kBindingNormal = 1, kBindingRoughness = 2, kBindingConstants = 3,
-                   kBindingRays = 4, kBindingClasses = 5, kBindingRadiance = 6, kBindingHitDistance = 7,
-                   kBindingSource = 8, kBindingReprojected = 9, kBindingCounters = 10, kBindingSslrRadiance = 11,
-                   kBindingSslrConfidence = 12, kBindingSslrHit = 13, kBindingRtRadiance = 14,
-                   kBindingRtHitDistance = 15, kBindingParticles = 16, kBindingEnvironment = 17;
-
 std::string variantShader(uint32_t variant) {
     const bool sslr = (variant & kVariantSslr) != 0;
     const bool rt = (variant & kVariantRt) != 0;
@@ -35,40 +28,12 @@ std::string variantShader(uint32_t variant) {
     return std::string("integrate/") + traces + ((variant & kVariantFeedback) != 0 ? "" : "_no_feedback") + ".comp";
 }
 
-std::vector<gpu::Binding> variantBindings(uint32_t variant) {
-    constexpr VkShaderStageFlags kStage = VK_SHADER_STAGE_COMPUTE_BIT;
-    constexpr VkDescriptorType kSampled = VK_DESCRIPTOR_TYPE_COMBINED_IMAGE_SAMPLER;
-    constexpr VkDescriptorType kStorage = VK_DESCRIPTOR_TYPE_STORAGE_BUFFER;
-    constexpr VkDescriptorType kImage = VK_DESCRIPTOR_TYPE_STORAGE_IMAGE;
-    std::vector<gpu::Binding> bindings = {
-        {kBindingDepth, kSampled, kStage},     {kBindingNormal, kSampled, kStage},
-        {kBindingRoughness, kSampled, kStage}, {kBindingConstants, kStorage, kStage},
-        {kBindingRays, kStorage, kStage},      {kBindingClasses, kStorage, kStage},
-        {kBindingRadiance, kImage, kStage},    {kBindingHitDistance, kImage, kStage},
-        {kBindingSource, kImage, kStage},      {kBindingParticles, kSampled, kStage},
-        {kBindingEnvironment, kSampled, kStage},
-    };
-    if ((variant & kVariantFeedback) != 0) {
-        bindings.push_back({kBindingReprojected, kStorage, kStage});
-        bindings.push_back({kBindingCounters, kStorage, kStage});
-    }
-    if ((variant & kVariantSslr) != 0) {
-        bindings.push_back({kBindingSslrRadiance, kSampled, kStage});
-        bindings.push_back({kBindingSslrConfidence, kSampled, kStage});
-        bindings.push_back({kBindingSslrHit, kSampled, kStage});
-    }
-    if ((variant & kVariantRt) != 0) {
-        bindings.push_back({kBindingRtRadiance, kSampled, kStage});
-        bindings.push_back({kBindingRtHitDistance, kSampled, kStage});
-    }
-    return bindings;
-}
-
 std::array<gpu::Pipeline, 8> createVariants(gpu::Context& ctx) {
     std::array<gpu::Pipeline, 8> variants;
     for (uint32_t v = 0; v < variants.size(); ++v) {
         const std::string shader = variantShader(v);
-        variants[v] = gpu::createComputePipeline(ctx, {shader, variantBindings(v), 0, shader});
+        // The layout is the variant's own bindings (integrate.glsl), reflected.
+        variants[v] = gpu::createComputePipeline(ctx, {shader, {}, 0, shader});
     }
     return variants;
 }
@@ -124,7 +89,7 @@ IntegrateOutputs addIntegratePass(rg::Graph& graph, IntegratePipelines& pipeline
     constants.lighting = inputs.lighting;
     constants.size = {gbuf.width, gbuf.height};
     constants.tiles = {tilesX, tilesY};
-    constants.confidenceThreshold = sslrStoredThreshold(settings.confidenceThreshold);
+    constants.confidenceThreshold = sslrStoredThreshold(inputs.confidenceThreshold);
     constants.particlesBound = hasParticles ? 1u : 0u;
     constants.rtMissesTrusted = settings.rtMissesTrusted ? 1u : 0u;
 
@@ -182,32 +147,32 @@ IntegrateOutputs addIntegratePass(rg::Graph& graph, IntegratePipelines& pipeline
             pipeline.bind(pc.cmd());
             gpu::PushDescriptors push(pipeline);
             // Layouts as the plan chose them (a sampled depth image stays depth read-only).
-            push.sampledImage(kBindingDepth, pc.view(d.depth), sampler, pc.layout(d.depth))
-                .sampledImage(kBindingNormal, pc.view(d.normal), sampler, pc.layout(d.normal))
-                .sampledImage(kBindingRoughness, pc.view(d.roughnessMetal), sampler, pc.layout(d.roughnessMetal))
-                .storageBuffer(kBindingConstants, pc.buffer(d.constants))
-                .storageBuffer(kBindingRays, pc.buffer(d.rays))
-                .storageBuffer(kBindingClasses, pc.buffer(d.classes))
-                .storageImage(kBindingRadiance, pc.view(d.out.radiance))
-                .storageImage(kBindingHitDistance, pc.view(d.out.hitDistance))
-                .storageImage(kBindingSource, pc.view(d.out.sourceDebug))
-                .sampledImage(kBindingParticles, pc.view(d.particles), sampler, pc.layout(d.particles))
-                .sampledImage(kBindingEnvironment, pc.view(d.environment),
+            push.sampledImage("depthTexture", pc.view(d.depth), sampler, pc.layout(d.depth))
+                .sampledImage("normalTexture", pc.view(d.normal), sampler, pc.layout(d.normal))
+                .sampledImage("roughnessMetalTexture", pc.view(d.roughnessMetal), sampler, pc.layout(d.roughnessMetal))
+                .storageBuffer("Constants", pc.buffer(d.constants))
+                .storageBuffer("Rays", pc.buffer(d.rays))
+                .storageBuffer("Classes", pc.buffer(d.classes))
+                .storageImage("radianceImage", pc.view(d.out.radiance))
+                .storageImage("hitDistanceImage", pc.view(d.out.hitDistance))
+                .storageImage("sourceImage", pc.view(d.out.sourceDebug))
+                .sampledImage("particlesTexture", pc.view(d.particles), sampler, pc.layout(d.particles))
+                .sampledImage("environmentTexture", pc.view(d.environment),
                               d.environment == d.normal ? sampler : pipelines.environmentSampler_.handle(),
                               pc.layout(d.environment));
             if ((variant & kVariantFeedback) != 0) {
-                push.storageBuffer(kBindingReprojected, pc.buffer(d.reprojected))
-                    .storageBuffer(kBindingCounters, pc.buffer(d.out.counters));
+                push.storageBuffer("Reprojected", pc.buffer(d.reprojected))
+                    .storageBuffer("Counters", pc.buffer(d.out.counters));
             }
             if ((variant & kVariantSslr) != 0) {
-                push.sampledImage(kBindingSslrRadiance, pc.view(d.sslrRadiance), sampler, pc.layout(d.sslrRadiance))
-                    .sampledImage(kBindingSslrConfidence, pc.view(d.sslrConfidence), sampler,
+                push.sampledImage("sslrRadianceTexture", pc.view(d.sslrRadiance), sampler, pc.layout(d.sslrRadiance))
+                    .sampledImage("sslrConfidenceTexture", pc.view(d.sslrConfidence), sampler,
                                   pc.layout(d.sslrConfidence))
-                    .sampledImage(kBindingSslrHit, pc.view(d.sslrHit), sampler, pc.layout(d.sslrHit));
+                    .sampledImage("sslrHitTexture", pc.view(d.sslrHit), sampler, pc.layout(d.sslrHit));
             }
             if ((variant & kVariantRt) != 0) {
-                push.sampledImage(kBindingRtRadiance, pc.view(d.rtRadiance), sampler, pc.layout(d.rtRadiance))
-                    .sampledImage(kBindingRtHitDistance, pc.view(d.rtHitDistance), sampler,
+                push.sampledImage("rtRadianceTexture", pc.view(d.rtRadiance), sampler, pc.layout(d.rtRadiance))
+                    .sampledImage("rtHitDistanceTexture", pc.view(d.rtHitDistance), sampler,
                                   pc.layout(d.rtHitDistance));
             }
             push.push(pipelines.ctx_, pc.cmd());

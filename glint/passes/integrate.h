@@ -75,16 +75,16 @@ struct IntegrateInputs {
     // needed when `lighting` looks up an image, else left invalid.
     rg::Texture environment;
     scene::Camera camera;              // the G-buffer's; its unjittered matrices rebuild positions
+    // SSLR confidence at which SSLR alone is trusted, and at which a traced
+    // ray counts as a hit in the feedback counters. It must be SSLR's
+    // (SslrInputs::confidenceThreshold), which lists the hybrid rays below
+    // it for the ray tracer: the RT outputs are read only where the stored
+    // SSLR confidence is below it (compared, as SSLR does, at
+    // sslrStoredThreshold), since nothing clears the traces' outputs.
+    float confidenceThreshold = kDefaultConfidenceThreshold;
 };
 
 struct IntegrateSettings {
-    // SSLR confidence at which SSLR alone is trusted, and at which a traced
-    // ray counts as a hit in the feedback counters: the Far Cry 6 talk's 0.9
-    //. It must equal SslrSettings's, which lists the
-    // hybrid rays below it for the ray tracer: the RT outputs are read only
-    // where the stored SSLR confidence is below it (compared, as SSLR does,
-    // at sslrStoredThreshold), since nothing clears the traces' outputs.
-    float confidenceThreshold = 0.9f;
     // Whether a ray-traced miss may override a partial SSLR hit. False
     // while the BVH is still building objects in range
     // (scene::BvhPlan::complete; ReflectionRenderer sets it per frame): a

@@ -21,35 +21,6 @@ namespace glint::passes {
 
 namespace {
 
-// Binding numbers of glint/particles_trace.glsl.
-enum TraceBinding : uint32_t {
-    kTlas,
-    kDepth,
-    kRays,
-    kClasses,
-    kParticles,
-    kConstants,
-    kSslrRadiance,
-    kSslrConfidence,
-    kSslrHit,
-    kRtRadiance,
-    kRtHitDistance,
-    kOutput,
-    kTraceBindingCount
-};
-
-std::vector<gpu::Binding> traceBindings(VkShaderStageFlags stages) {
-    std::vector<gpu::Binding> bindings;
-    for (uint32_t i = 0; i < kTraceBindingCount; ++i) {
-        VkDescriptorType type = VK_DESCRIPTOR_TYPE_COMBINED_IMAGE_SAMPLER;
-        if (i == kTlas) type = VK_DESCRIPTOR_TYPE_ACCELERATION_STRUCTURE_KHR;
-        if (i >= kRays && i <= kConstants) type = VK_DESCRIPTOR_TYPE_STORAGE_BUFFER;
-        if (i == kOutput) type = VK_DESCRIPTOR_TYPE_STORAGE_IMAGE;
-        bindings.push_back({i, type, stages});
-    }
-    return bindings;
-}
-
 std::string unsupportedMessage(const gpu::Context& ctx, RtBackend backend) {
     const std::string device = "device '" + ctx.caps().deviceName + "'";
     switch (backend) {
@@ -104,7 +75,6 @@ ParticlePipelines::ParticlePipelines(gpu::Context& ctx, RtBackend backend)
     gpu::GraphicsPipelineDesc forward;
     forward.vertexShader = "particles/forward.vert";
     forward.fragmentShader = "particles/forward.frag";
-    forward.bindings = {{0, VK_DESCRIPTOR_TYPE_STORAGE_BUFFER, VK_SHADER_STAGE_VERTEX_BIT}};
     forward.pushConstantBytes = sizeof(ForwardPush);
     forward.cullMode = VK_CULL_MODE_NONE;
     forward.colorFormats = {kGBufferLitFormat};
@@ -135,7 +105,7 @@ RtBackend ParticlePipelines::prepare(RtBackend requested) {
     }
     if (backend == RtBackend::RayQuery && !query_) {
         query_ = gpu::createComputePipeline(
-            ctx_, {"particles/trace_query.comp", traceBindings(VK_SHADER_STAGE_COMPUTE_BIT), 0, "particles.trace_query"});
+            ctx_, {"particles/trace_query.comp", {}, 0, "particles.trace_query"});
     }
     if (backend == RtBackend::Pipeline && !pipeline_) {
         // Hit record kSbtOffsetParticles is the particle group (the particle
@@ -147,7 +117,7 @@ RtBackend ParticlePipelines::prepare(RtBackend requested) {
             ctx_, {"particles/trace.rgen",
                    {"particles/trace.rmiss"},
                    {{"", ""}, {"", "particles/trace.rahit"}},
-                   traceBindings(VK_SHADER_STAGE_RAYGEN_BIT_KHR | VK_SHADER_STAGE_ANY_HIT_BIT_KHR),
+                   {},
                    0,
                    1,
                    "particles.trace_pipeline"});
@@ -237,23 +207,23 @@ ParticleTraceOutputs addParticleTracePass(rg::Graph& graph, ParticlePipelines& p
         [&pipelines, backend](const TraceData& d, rg::PassContext& pc) {
             const gpu::Pipeline& pipeline = backend == RtBackend::RayQuery ? *pipelines.query_ : *pipelines.pipeline_;
             const VkSampler sampler = pipelines.nearest_.handle();
-            const auto sampled = [&](gpu::PushDescriptors& push, uint32_t binding, rg::Texture t) {
-                push.sampledImage(binding, pc.view(t), sampler, pc.layout(t));
+            const auto sampled = [&](gpu::PushDescriptors& push, std::string_view name, rg::Texture t) {
+                push.sampledImage(name, pc.view(t), sampler, pc.layout(t));
             };
             pipeline.bind(pc.cmd());
             gpu::PushDescriptors push(pipeline);
-            push.accelerationStructure(kTlas, pc.accel(d.tlas).handle())
-                .storageBuffer(kRays, pc.buffer(d.rays))
-                .storageBuffer(kClasses, pc.buffer(d.classes))
-                .storageBuffer(kParticles, pc.buffer(d.particles))
-                .storageBuffer(kConstants, pc.buffer(d.constants))
-                .storageImage(kOutput, pc.view(d.out.radiance));
-            sampled(push, kDepth, d.depth);
-            sampled(push, kSslrRadiance, d.sslrRadiance);
-            sampled(push, kSslrConfidence, d.sslrConfidence);
-            sampled(push, kSslrHit, d.sslrHit);
-            sampled(push, kRtRadiance, d.rtRadiance);
-            sampled(push, kRtHitDistance, d.rtHitDistance);
+            push.accelerationStructure("particleTlas", pc.accel(d.tlas).handle())
+                .storageBuffer("Rays", pc.buffer(d.rays))
+                .storageBuffer("Classes", pc.buffer(d.classes))
+                .storageBuffer("Particles", pc.buffer(d.particles))
+                .storageBuffer("Constants", pc.buffer(d.constants))
+                .storageImage("particleImage", pc.view(d.out.radiance));
+            sampled(push, "depthTexture", d.depth);
+            sampled(push, "sslrRadianceTexture", d.sslrRadiance);
+            sampled(push, "sslrConfidenceTexture", d.sslrConfidence);
+            sampled(push, "sslrHitTexture", d.sslrHit);
+            sampled(push, "rtRadianceTexture", d.rtRadiance);
+            sampled(push, "rtHitDistanceTexture", d.rtHitDistance);
             push.push(pc.gpu(), pc.cmd());
             if (backend == RtBackend::RayQuery) {
                 const uint32_t group = shader::kParticleTraceGroupSize;
@@ -332,7 +302,7 @@ ParticleForwardOutputs addParticleForwardPass(rg::Graph& graph, ParticlePipeline
                                          {d.width, d.height});
             const gpu::Pipeline& pipeline = pipelines.forward_;
             pipeline.bind(cmd);
-            gpu::PushDescriptors(pipeline).storageBuffer(0, pc.buffer(d.particles)).push(pc.gpu(), cmd);
+            gpu::PushDescriptors(pipeline).storageBuffer("Particles", pc.buffer(d.particles)).push(pc.gpu(), cmd);
             pipeline.pushConstants(cmd, push);
             vkCmdDraw(cmd, push.basis.count * shader::kParticleQuadVertices, 1, 0, 0);
             vkCmdEndRendering(cmd);

@@ -100,12 +100,12 @@ struct ParticleTraceSettings {
     // Auto: the backend ParticlePipelines resolved to; naming the other
     // creates its pipeline on first use (throws where unsupported).
     RtBackend backend = RtBackend::Auto;
-    // Integrate's IntegrateSettings::confidenceThreshold: the trace picks
+    // Integrate's IntegrateInputs::confidenceThreshold: the trace picks
     // the reflection's end as integrate does.
-    float confidenceThreshold = 0.9f;
+    float confidenceThreshold = kDefaultConfidenceThreshold;
     // How far a ray whose reflection missed (the environment) looks for
-    // particles: the BVH's radius (RtTraceSettings::maxDistance).
-    float maxDistance = 100.0f;
+    // particles: the BVH's radius (RtTraceInputs::maxDistance).
+    float maxDistance = scene::kDefaultBvhRadius;
     // The Far Cry 6 talk's "SSLR particles": the forward pass drew the
     // particles into the lit colour before SSLR sampled it, so a pixel
     // whose reflection integrate takes from SSLR shows the particles SSLR

@@ -21,19 +21,6 @@ static_assert(uint32_t(ReflectionMode::Hybrid) == shader::kModeHybrid && uint32_
 
 namespace {
 
-constexpr uint32_t kBindingCount = 12;
-
-std::vector<gpu::Binding> classifyBindings() {
-    std::vector<gpu::Binding> bindings;
-    for (uint32_t i = 0; i < kBindingCount; ++i) {
-        VkDescriptorType type = VK_DESCRIPTOR_TYPE_STORAGE_BUFFER;
-        if (i < 3) type = VK_DESCRIPTOR_TYPE_COMBINED_IMAGE_SAMPLER;
-        if (i == 8) type = VK_DESCRIPTOR_TYPE_STORAGE_IMAGE;
-        bindings.push_back({i, type, VK_SHADER_STAGE_COMPUTE_BIT});
-    }
-    return bindings;
-}
-
 // The blue noise in a device-local buffer: staged, copied and made
 // visible to every later shader read on the graphics queue, once.
 gpu::Buffer uploadBlueNoise(gpu::Context& ctx) {
@@ -79,7 +66,7 @@ std::vector<uint32_t> loadBlueNoiseWords() {
 
 RayGenerationPipelines::RayGenerationPipelines(gpu::Context& ctx)
     : ctx_(ctx),
-      classify_(gpu::createComputePipeline(ctx, {"ray_generation/classify.comp", classifyBindings(),
+      classify_(gpu::createComputePipeline(ctx, {"ray_generation/classify.comp", {},
                                                  uint32_t(sizeof(shader::RayGenerationConstants)),
                                                  "ray_generation.classify"})),
       // The G-buffer is read texel by texel (texelFetch); the sampler only
@@ -141,8 +128,8 @@ RayGenerationOutputs addRayGenerationPass(rg::Graph& graph, RayGenerationPipelin
     constants.roughnessCutoff = settings.roughnessCutoff;
     constants.reuseRoughness = settings.reuseRoughness;
     constants.rtMaxDistance = settings.rtMaxDistance;
-    constants.sslrMinDistance = settings.sslrMinDistance;
-    constants.flags = uint32_t(settings.mode) | (settings.reuse ? shader::kRayGenReuse : 0u) |
+    constants.sslrMinDistance = inputs.sslrMinDistance;
+    constants.flags = uint32_t(inputs.mode) | (settings.reuse ? shader::kRayGenReuse : 0u) |
                       (inputs.tileModes.valid() ? shader::kRayGenTileModes : 0u) |
                       (settings.checkerboard ? shader::kRayGenCheckerboard : 0u) |
                       (settings.blueNoise ? shader::kRayGenBlueNoise : 0u) |
@@ -186,20 +173,20 @@ RayGenerationOutputs addRayGenerationPass(rg::Graph& graph, RayGenerationPipelin
             pipeline.bind(pc.cmd());
             gpu::PushDescriptors(pipeline)
                 // Layouts as the plan chose them (a sampled depth image stays depth read-only).
-                .sampledImage(0, pc.view(d.depth), sampler, pc.layout(d.depth))
-                .sampledImage(1, pc.view(d.normal), sampler, pc.layout(d.normal))
-                .sampledImage(2, pc.view(d.roughnessMetal), sampler, pc.layout(d.roughnessMetal))
-                .storageBuffer(3, pc.buffer(d.out.rays))
-                .storageBuffer(4, pc.buffer(d.out.classes))
-                .storageBuffer(5, pc.buffer(d.out.sslrRays))
-                .storageBuffer(6, pc.buffer(d.out.rtRays))
-                .storageBuffer(7, pc.buffer(d.out.sslrArgs))
-                .storageImage(8, pc.view(d.out.classDebug))
-                .storageBuffer(9, pc.buffer(d.out.rtArgs))
-                // Without tile modes the shader never reads binding 10; the
-                // class buffer only completes the descriptor set.
-                .storageBuffer(10, pc.buffer(d.tileModes.valid() ? d.tileModes : d.out.classes))
-                .storageBuffer(11, pipelines.blueNoise_)
+                .sampledImage("depthTexture", pc.view(d.depth), sampler, pc.layout(d.depth))
+                .sampledImage("normalTexture", pc.view(d.normal), sampler, pc.layout(d.normal))
+                .sampledImage("roughnessMetalTexture", pc.view(d.roughnessMetal), sampler, pc.layout(d.roughnessMetal))
+                .storageBuffer("Rays", pc.buffer(d.out.rays))
+                .storageBuffer("Classes", pc.buffer(d.out.classes))
+                .storageBuffer("SslrRays", pc.buffer(d.out.sslrRays))
+                .storageBuffer("SslrArgs", pc.buffer(d.out.sslrArgs))
+                .storageBuffer("RtRays", pc.buffer(d.out.rtRays))
+                .storageImage("classDebug", pc.view(d.out.classDebug))
+                .storageBuffer("RtArgs", pc.buffer(d.out.rtArgs))
+                // Without tile modes the shader never reads them; the class
+                // buffer only completes the descriptor set.
+                .storageBuffer("TileModes", pc.buffer(d.tileModes.valid() ? d.tileModes : d.out.classes))
+                .storageBuffer("BlueNoise", pipelines.blueNoise_)
                 .push(pipelines.ctx_, pc.cmd());
             pipeline.pushConstants(pc.cmd(), constants);
             pc.dispatch(pipeline, d.out.tilesX, d.out.tilesY);

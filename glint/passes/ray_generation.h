@@ -24,6 +24,7 @@
 #include "glint/gpu/resources.h"
 #include "glint/graph/graph.h"
 #include "glint/passes/gbuffer.h"
+#include "glint/scene/bvh_planner.h"
 #include "glint/scene/camera.h"
 
 #include <cstdint>
@@ -52,6 +53,12 @@ struct RayGenerationInputs {
     // The feedback pass's tile modes (u32 per tile, glint/feedback_shared.h)
     // for the hybrid band; without them (invalid) hybrid pixels stay hybrid.
     rg::Buffer tileModes;
+    // The frame's mode: which classes a pixel may take.
+    ReflectionMode mode = ReflectionMode::Hybrid;
+    // Pixels at or beyond this distance from the camera go to SSLR only:
+    // the BVH holds nothing farther (ReflectionFrameSettings::reach; Far
+    // Cry 6: 100 around the camera).
+    float sslrMinDistance = scene::kDefaultBvhRadius;
 };
 
 struct RayGenerationSettings {
@@ -80,10 +87,6 @@ struct RayGenerationSettings {
     // only the player's arm and what is at arm's length does, and the
     // feedback decides the floor. The bench sweeps it (rt_near_distance).
     float rtMaxDistance = 3.0f;
-    // Pixels at or beyond this go to SSLR only: the BVH covers a radius of
-    // 100 around the camera (Far Cry 6 talk).
-    float sslrMinDistance = 100.0f;
-    ReflectionMode mode = ReflectionMode::Hybrid;
     // SSLR and hybrid pixels at least this rough (perceptual) cone-trace in
     // SSLR: they march the mirror direction and sample a box-filtered
     // pyramid of the lit colour at the GGX lobe's footprint, noise-free,
@@ -103,7 +106,7 @@ struct RayGenerationSettings {
     // pixels kept hybrid) and of SSLR (its start offsets, which follow this
     // choice through RayGenerationOutputs) come from, each use its own
     // dimension (glint/sampling.glsl): spatiotemporal blue noise
-    // (engine/sampling/blue_noise.h), blue in space and over a pixel's
+    // (glint/sampling/blue_noise.h), blue in space and over a pixel's
     // frames, so that the temporal filter averages out the error faster;
     // false: per-pixel hashed low-discrepancy sequences (R2 for the GGX
     // sample, a Weyl sequence for each other use). The bench compares both.

@@ -21,51 +21,9 @@ namespace {
 constexpr std::array<std::string_view, 3> kModeNames = {"hybrid", "ssr", "rt"};
 constexpr std::array<std::string_view, 3> kBackendNames = {"auto", "query", "pipeline"};
 
-// Debug views: name, what they show. Kept in one table so the list printed
-// by --help, the parser and the wiring agree.
-constexpr std::array<std::string_view, 24> kDebugViews = {
-    "final",              // the composited, tonemapped image
-    "lit",                // G-buffer: lit colour of the opaque scene
-    "ray_classes",        // ray generation: sky black, env grey, SSLR blue, hybrid purple, RT red
-    "tile_modes",         // feedback: the tile decisions ray generation used (hybrid mode)
-    "feedback_counters",  // integrate: SSLR hits green, misses red, per 8x8 tile
-    "sslr_radiance",      // SSLR: lit colour at the hit
-    "sslr_confidence",    // SSLR: [0, 1]
-    "sslr_hits",          // SSLR: hit uv, confidence
-    "rt_radiance",        // RT: radiance along the traced rays
-    "rt_hit_distance",    // RT: world distance, 0..100
-    "particles",          // particles trace: particles seen in the reflections (premultiplied)
-    "transparent",        // transparent pass: blended surfaces (premultiplied; scenes with alphaMode BLEND)
-    "shadow_map",         // G-buffer: the sun's shadow map (reversed depth)
-    "lit_pyramid",        // SSLR: the cone trace's colour pyramid (level 0)
-    "reflection_source",  // integrate: which trace each pixel used
-    "reflections",        // integrate: reflection radiance
-    "hit_distance",       // integrate: world distance to the reflected point, 0..100
-    "resolved",           // temporal: accumulated reflections
-    "reflection_motion",  // temporal: the reprojection's motion, pixels
-    "history_length",     // temporal: frames accumulated
-    "motion",             // G-buffer: surface motion, pixels
-    "normal",             // G-buffer: world normal
-    "albedo",             // G-buffer: base colour
-    "roughness",          // G-buffer: perceptual roughness
-};
-
 // Passes that make up the reflections' cost, by name prefix.
 constexpr std::array<std::string_view, 7> kReflectionPassPrefixes = {
     "feedback", "ray_generation", "sslr", "rt_trace", "particles.trace", "integrate", "temporal"};
-
-std::vector<gpu::Binding> storageBindings(uint32_t buffers, bool lastIsImage) {
-    std::vector<gpu::Binding> bindings;
-    for (uint32_t i = 0; i < buffers; ++i) {
-        bindings.push_back({i, VK_DESCRIPTOR_TYPE_STORAGE_BUFFER, VK_SHADER_STAGE_COMPUTE_BIT});
-    }
-    if (lastIsImage) {
-        bindings.push_back({buffers, VK_DESCRIPTOR_TYPE_STORAGE_IMAGE, VK_SHADER_STAGE_COMPUTE_BIT});
-    }
-    return bindings;
-}
-
-uint32_t groups(uint32_t n) { return (n + shader::kTileSize - 1) / shader::kTileSize; }
 
 } // namespace
 
@@ -86,8 +44,6 @@ RtBackend parseBackend(std::string_view name) {
     }
     throw std::invalid_argument("unknown ray tracing backend '" + std::string(name) + "' (auto, query, pipeline)");
 }
-
-std::span<const std::string_view> debugViewNames() { return kDebugViews; }
 
 bool isReflectionPass(std::string_view passName) {
     for (const std::string_view prefix : kReflectionPassPrefixes) {
@@ -114,10 +70,10 @@ ReflectionRenderer::ReflectionRenderer(gpu::Context& ctx, const scene::Scene& sc
       temporal_(ctx),
       composite_(ctx),
       particles_(ctx, ctx.caps().canTraceRays() ? options.backend : RtBackend::Auto),
-      tileView_(gpu::createComputePipeline(ctx, {"reflection_frame/tile_view.comp", storageBindings(1, true),
+      tileView_(gpu::createComputePipeline(ctx, {"reflection_frame/tile_view.comp", {},
                                                  uint32_t(sizeof(shader::TileViewConstants)),
                                                  "reflection_frame.tile_view"})),
-      classCount_(gpu::createComputePipeline(ctx, {"reflection_frame/class_count.comp", storageBindings(4, false),
+      classCount_(gpu::createComputePipeline(ctx, {"reflection_frame/class_count.comp", {},
                                                    uint32_t(sizeof(shader::ClassCountConstants)),
                                                    "reflection_frame.class_count"})) {
     if (!rt_) {
@@ -152,6 +108,13 @@ void ReflectionRenderer::bind(rg::FrameResources& resources, const ReflectionFra
 ReflectionFrame ReflectionRenderer::addFrame(rg::Graph& graph, const scene::Camera& camera,
                                              const ReflectionFrameSettings& settings) {
     // Without ray tracing every mode is ssr (the constructor said so once).
+    if (!(settings.reach > 0.0f)) {
+        throw gpu::GpuError("ReflectionFrameSettings::reach " + std::to_string(settings.reach) + ": must be positive");
+    }
+    if (!(settings.confidenceThreshold >= 0.0f && settings.confidenceThreshold <= 1.0f)) {
+        throw gpu::GpuError("ReflectionFrameSettings::confidenceThreshold " +
+                            std::to_string(settings.confidenceThreshold) + ": must be in [0, 1]");
+    }
     const ReflectionMode mode = rt_ ? settings.mode : ReflectionMode::Ssr;
     const std::string_view view = settings.debugView;
     const uint64_t frameIndex = camera.frameIndex;
@@ -170,7 +133,7 @@ ReflectionFrame ReflectionRenderer::addFrame(rg::Graph& graph, const scene::Came
 
     // 0. BVH: only when something traces; on the async compute queue.
     if (traces) {
-        scene::BvhPlan plan = planner_.plan(scene_, camera);
+        scene::BvhPlan plan = planner_.plan(scene_, camera, settings.reach);
         plan.particleTlas = plan.particleTlas && settings.reflectParticles;
         lastPlanStats_ = plan.stats;
         f.bvhComplete = plan.complete();
@@ -184,13 +147,14 @@ ReflectionFrame ReflectionRenderer::addFrame(rg::Graph& graph, const scene::Came
     }
     // 6 (of last frame). Feedback: only the hybrid band follows tile modes.
     RayGenerationInputs rayInputs{f.gbuffer, frameIndex, camera};
+    rayInputs.mode = mode;
+    rayInputs.sslrMinDistance = settings.reach;
     if (mode == ReflectionMode::Hybrid) {
         f.feedback = addFeedbackPass(graph, feedback_, {f.gbuffer, frameIndex}, settings.feedback);
         rayInputs.tileModes = f.feedback->tileModes;
     }
     // 2. Ray generation and tile classification.
     RayGenerationSettings raySettings = settings.rays;
-    raySettings.mode = mode;
     const bool sslrFallback = !f.bvhComplete && settings.sslrWhileBvhBuilds && screenSpace;
     raySettings.sslrFirst = raySettings.sslrFirst || (sslrFallback && mode == ReflectionMode::Hybrid);
     // The traces write only their rays' pixels; a debug view of their raw
@@ -204,7 +168,9 @@ ReflectionFrame ReflectionRenderer::addFrame(rg::Graph& graph, const scene::Came
     if (screenSpace) {
         SslrSettings sslrSettings = settings.sslr;
         sslrSettings.clearUntraced = sslrSettings.clearUntraced || viewsSslr;
-        f.sslr = addSslrPass(graph, sslr_, {f.gbuffer, f.rays, frameIndex, camera.view, camera.projection},
+        f.sslr = addSslrPass(graph, sslr_,
+                             {f.gbuffer, f.rays, frameIndex, camera.view, camera.projection,
+                              settings.confidenceThreshold},
                              sslrSettings);
         rtList = f.sslr->rtRayList;
         rtArgs = f.sslr->rtArgs;
@@ -220,6 +186,8 @@ ReflectionFrame ReflectionRenderer::addFrame(rg::Graph& graph, const scene::Came
         rtInputs.environment = f.environment;
         rtInputs.camera = camera;
         rtInputs.frameIndex = frameIndex;
+        rtInputs.maxDistance = settings.reach;
+        rtInputs.shadowDistance = 2.0f * settings.reach;
         RtTraceSettings rtSettings = settings.rt;
         rtSettings.clearUntraced = rtSettings.clearUntraced || viewsRt;
         f.rt = addRtTracePass(graph, *rt_, rtInputs, rtSettings);
@@ -239,8 +207,8 @@ ReflectionFrame ReflectionRenderer::addFrame(rg::Graph& graph, const scene::Came
         particleInputs.camera = camera;
         ParticleTraceSettings particleSettings;
         particleSettings.backend = rt_->backend();
-        particleSettings.confidenceThreshold = settings.sslr.confidenceThreshold;
-        particleSettings.maxDistance = settings.rt.maxDistance;
+        particleSettings.confidenceThreshold = settings.confidenceThreshold;
+        particleSettings.maxDistance = settings.reach;
         particleSettings.sslrSeesParticles = settings.sslrParticles && f.sslr.has_value();
         particleSettings.rtMissesTrusted = !sslrFallback;
         f.particles = addParticleTracePass(graph, particles_, particleInputs, particleSettings);
@@ -260,11 +228,11 @@ ReflectionFrame ReflectionRenderer::addFrame(rg::Graph& graph, const scene::Came
     integrateInputs.lighting = lighting;
     integrateInputs.environment = f.environment;
     integrateInputs.camera = camera;
+    integrateInputs.confidenceThreshold = settings.confidenceThreshold;
     if (f.particles) {
         integrateInputs.particles = f.particles->radiance;
     }
     IntegrateSettings integrateSettings = settings.integrate;
-    integrateSettings.confidenceThreshold = settings.sslr.confidenceThreshold;
     integrateSettings.rtMissesTrusted = integrateSettings.rtMissesTrusted && !sslrFallback;
     f.integrate = addIntegratePass(graph, integrate_, integrateInputs, integrateSettings);
     // 7. Reflection motion and temporal accumulation.
@@ -280,140 +248,10 @@ ReflectionFrame ReflectionRenderer::addFrame(rg::Graph& graph, const scene::Came
     f.temporal = addTemporalPass(graph, temporal_, temporalInputs, temporalSettings);
 
     if (settings.countRays) {
-        struct ClearData {
-            rg::Buffer counts;
-        };
-        const ClearData& clear = graph.addPass<ClearData>(
-            "stats.clear", rg::Queue::Graphics,
-            [&](rg::Builder& b, ClearData& d) {
-                d.counts = b.write(b.createBuffer("stats.counts", {shader::kReflectionCountWords * 4u}),
-                                   rg::Access::TransferDst);
-            },
-            [](const ClearData& d, rg::PassContext& pc) {
-                vkCmdFillBuffer(pc.cmd(), pc.buffer(d.counts).handle(), 0, VK_WHOLE_SIZE, 0);
-            });
-        struct CountData {
-            rg::Buffer classes, rays, rtArgs, counts;
-        };
-        shader::ClassCountConstants constants{};
-        constants.size = {f.width, f.height};
-        constants.rtListCounted = traces ? 1u : 0u;
-        const CountData& count = graph.addPass<CountData>(
-            "stats.count_rays", rg::Queue::Graphics,
-            [&](rg::Builder& b, CountData& d) {
-                d.classes = b.read(f.rays.classes, rg::Access::StorageRead);
-                d.rays = b.read(f.rays.rays, rg::Access::StorageRead);
-                d.rtArgs = b.read(rtArgs, rg::Access::StorageRead);
-                d.counts = b.write(clear.counts, rg::Access::StorageReadWrite);
-            },
-            [this, constants](const CountData& d, rg::PassContext& pc) {
-                classCount_.bind(pc.cmd());
-                gpu::PushDescriptors(classCount_)
-                    .storageBuffer(0, pc.buffer(d.classes))
-                    .storageBuffer(1, pc.buffer(d.rays))
-                    .storageBuffer(2, pc.buffer(d.rtArgs))
-                    .storageBuffer(3, pc.buffer(d.counts))
-                    .push(ctx_, pc.cmd());
-                classCount_.pushConstants(pc.cmd(), constants);
-                pc.dispatch(classCount_, groups(constants.size.x), groups(constants.size.y));
-            });
-        f.counts = count.counts;
+        addStatsPasses(graph, f, rtArgs);
     }
-
-    // 8. Composite and tonemap, or the debug view in its place. Without
-    // SSLR particles the particles are drawn into the lit colour only now:
-    // SSLR (and its cone pyramid) must not see them, or the trace and SSLR
-    // would both reflect them. The blended surfaces' layer, when the scene
-    // has any, goes over everything.
-    const auto transparentLayer = [&](bool declareEmpty) {
-        f.transparent = addTransparentPass(graph, gbuffer_, {f.gbuffer, f.environment, declareEmpty}).layer;
-        return f.transparent;
-    };
-    if (view.empty() || view == "final") {
-        GBufferOutputs composited = f.gbuffer;
-        if (!settings.sslrParticles) {
-            composited.lit = addParticleForwardPass(graph, particles_, {f.gbuffer, scene_.particles, camera}).lit;
-        }
-        f.output = addCompositePass(graph, composite_, {composited, f.temporal.resolved, camera, transparentLayer(false)},
-                                    settings.composite);
-        graph.markOutput(f.output.color);
-        return f;
-    }
-    const auto show = [&](rg::Texture texture, DebugViewKind kind, float minValue = 0.0f, float maxValue = 1.0f) {
-        if (!texture.valid()) {
-            throw gpu::GpuError("debug view '" + std::string(view) + "' is not produced in mode " +
-                                std::string(modeName(mode)));
-        }
-        DebugViewSettings s;
-        s.kind = kind;
-        s.minValue = minValue;
-        s.maxValue = maxValue;
-        s.exposure = settings.composite.exposure;
-        f.output = addDebugViewPass(graph, composite_, texture, f.width, f.height, s);
-        graph.markOutput(f.output.color);
-    };
-    const auto showTiles = [&](rg::Buffer tiles, uint32_t what) {
-        if (!tiles.valid()) {
-            throw gpu::GpuError("debug view '" + std::string(view) + "' is not produced in mode " +
-                                std::string(modeName(mode)));
-        }
-        struct TileData {
-            rg::Buffer tiles;
-            rg::Texture image;
-        };
-        shader::TileViewConstants constants{};
-        constants.size = {f.width, f.height};
-        constants.tilesX = f.rays.tilesX;
-        constants.what = what;
-        const TileData& data = graph.addPass<TileData>(
-            "debug_view.tiles", rg::Queue::Graphics,
-            [&](rg::Builder& b, TileData& d) {
-                d.tiles = b.read(tiles, rg::Access::StorageRead);
-                d.image = b.write(b.createTexture("debug_view.tiles", {.width = f.width,
-                                                                      .height = f.height,
-                                                                      .format = VK_FORMAT_R8G8B8A8_UNORM}),
-                                  rg::Access::StorageWrite);
-            },
-            [this, constants](const TileData& d, rg::PassContext& pc) {
-                tileView_.bind(pc.cmd());
-                gpu::PushDescriptors(tileView_)
-                    .storageBuffer(0, pc.buffer(d.tiles))
-                    .storageImage(1, pc.view(d.image))
-                    .push(ctx_, pc.cmd());
-                tileView_.pushConstants(pc.cmd(), constants);
-                pc.dispatch(tileView_, groups(constants.size.x), groups(constants.size.y));
-            });
-        show(data.image, DebugViewKind::Raw);
-    };
-    const rg::Texture none;
-    if (view == "lit") show(f.gbuffer.lit, DebugViewKind::Color);
-    else if (view == "ray_classes") show(f.rays.classDebug, DebugViewKind::Raw);
-    else if (view == "tile_modes") showTiles(f.feedback ? f.feedback->tileModes : rg::Buffer{}, shader::kTileViewModes);
-    else if (view == "feedback_counters") showTiles(f.feedback ? f.integrate.counters : rg::Buffer{}, shader::kTileViewCounters);
-    else if (view == "sslr_radiance") show(f.sslr ? f.sslr->radiance : none, DebugViewKind::Color);
-    else if (view == "sslr_confidence") show(f.sslr ? f.sslr->confidence : none, DebugViewKind::Scalar);
-    else if (view == "sslr_hits") show(f.sslr ? f.sslr->hitDebug : none, DebugViewKind::Raw);
-    else if (view == "rt_radiance") show(f.rt ? f.rt->radiance : none, DebugViewKind::Color);
-    else if (view == "rt_hit_distance") show(f.rt ? f.rt->hitDistance : none, DebugViewKind::Scalar, 0.0f, 100.0f);
-    else if (view == "particles") show(f.particles ? f.particles->radiance : none, DebugViewKind::Color);
-    else if (view == "transparent") show(transparentLayer(true), DebugViewKind::Color);
-    else if (view == "shadow_map") show(f.gbuffer.shadowMap, DebugViewKind::Scalar);
-    else if (view == "lit_pyramid") show(f.sslr ? f.sslr->litPyramid : none, DebugViewKind::Color);
-    else if (view == "reflection_source") show(f.integrate.sourceDebug, DebugViewKind::Raw);
-    else if (view == "reflections") show(f.integrate.radiance, DebugViewKind::Color);
-    else if (view == "hit_distance") show(f.integrate.hitDistance, DebugViewKind::Scalar, 0.0f, 100.0f);
-    else if (view == "resolved") show(f.temporal.resolved, DebugViewKind::Color);
-    else if (view == "reflection_motion") show(f.temporal.reflectionMotion, DebugViewKind::Scalar, -8.0f, 8.0f);
-    else if (view == "history_length") show(f.temporal.historyLength, DebugViewKind::Scalar, 0.0f, 32.0f);
-    else if (view == "motion") show(f.gbuffer.motion, DebugViewKind::Scalar, -8.0f, 8.0f);
-    else if (view == "normal") show(f.gbuffer.normal, DebugViewKind::Raw);
-    else if (view == "albedo") show(f.gbuffer.albedo, DebugViewKind::Raw);
-    else if (view == "roughness") show(f.gbuffer.roughnessMetal, DebugViewKind::Scalar);
-    else {
-        std::string names;
-        for (const std::string_view n : kDebugViews) names += (names.empty() ? "" : ", ") + std::string(n);
-        throw gpu::GpuError("unknown debug view '" + std::string(view) + "' (available: " + names + ")");
-    }
+    // 8. Composite and tonemap, or the debug view in its place.
+    addOutput(graph, f, camera, settings);
     return f;
 }
 

@@ -68,12 +68,22 @@ struct ReflectionRendererOptions {
 struct ReflectionFrameSettings {
     ReflectionMode mode = ReflectionMode::Hybrid;
     GBufferSettings gbuffer;
-    RayGenerationSettings rays;  // rays.mode is taken from `mode`
+    // How far reflections reach: the BVH's radius around the camera (Far
+    // Cry 6: 100 m). The ray tracer's ray length at roughness 0, the
+    // distance from which pixels take SSLR only, the particle trace's range,
+    // the shadow rays' length at hits (twice it: across the BVH) and the
+    // distance debug views' range all derive from it.
+    float reach = scene::kDefaultBvhRadius;
+    // SSLR confidence below which a hybrid ray goes to the ray tracer, and
+    // at which integrate and the particle trace take SSLR alone (Far Cry 6:
+    // 0.9). One value for the three: they must agree.
+    float confidenceThreshold = kDefaultConfidenceThreshold;
+    RayGenerationSettings rays;
     SslrSettings sslr;
-    RtTraceSettings rt;          // rt.backend is the renderer's
+    RtTraceSettings rt;
     FeedbackSettings feedback;
-    IntegrateSettings integrate;  // integrate.confidenceThreshold is taken from sslr
-    TemporalSettings temporal;
+    IntegrateSettings integrate;  // rtMissesTrusted is cleared while the BVH builds (sslrWhileBvhBuilds)
+    TemporalSettings temporal;    // spatialRoughnessMax is at most rays.roughnessCutoff
     CompositeSettings composite;
     // The Far Cry 6 talk's "SSLR particles": the particles are drawn into
     // the lit colour before SSLR samples it, and the particle trace covers
@@ -93,7 +103,7 @@ struct ReflectionFrameSettings {
     // Off: the incomplete BVH is traced as it is.
     bool sslrWhileBvhBuilds = true;
     // Empty or "final": the composited image; otherwise one of
-    // debugViewNames(), shown in `output` instead.
+    // debugViews(), shown in `output` instead.
     std::string debugView;
     // Discards the temporal history (first frame, camera cut).
     bool resetHistory = false;
@@ -133,8 +143,21 @@ struct ReflectionFrame {
     uint32_t height = 0;
 };
 
-// Names accepted by ReflectionFrameSettings::debugView.
-std::span<const std::string_view> debugViewNames();
+// The debug views ReflectionFrameSettings::debugView names: one table
+// (passes/reflection_frame_output.cpp) that addFrame, --list-debug-views
+// and the viewer all read.
+struct DebugViewModes {
+    bool hybrid = true, ssr = true, rt = true;
+    bool has(ReflectionMode mode) const;
+};
+struct DebugViewInfo {
+    std::string_view name;
+    std::string_view shows;  // the pass that produces it and what it shows
+    DebugViewModes modes;    // where it is produced; elsewhere addFrame throws
+};
+std::span<const DebugViewInfo> debugViews();
+// Null when no view has that name.
+const DebugViewInfo* findDebugView(std::string_view name);
 
 // The passes whose GPU time is the reflections' cost (ray generation
 // through temporal accumulation: the stats' reflection_ms).
@@ -171,6 +194,12 @@ public:
     const EnvironmentStats& environmentStats() const { return environment_.stats(); }
 
 private:
+    // addFrame's last steps (passes/reflection_frame_output.cpp): the ray
+    // counts for stats, and the composited image or a debug view.
+    void addStatsPasses(rg::Graph& graph, ReflectionFrame& f, rg::Buffer rtArgs);
+    void addOutput(rg::Graph& graph, ReflectionFrame& f, const scene::Camera& camera,
+                   const ReflectionFrameSettings& settings);
+
     gpu::Context& ctx_;
     const scene::Scene& scene_;
     // Prefiltered when the renderer is created and when addFrame sees a new

@@ -25,42 +25,6 @@ static_assert(shader::kRtTraceGroupSize == shader::kRayListGroupSize,
 constexpr VkDeviceSize kDispatchArgsBytes = shader::kRayListDispatchOffset * sizeof(uint32_t);
 constexpr VkDeviceSize kTraceArgsBytes = shader::kRayListCountOffset * sizeof(uint32_t);
 
-// Binding numbers of glint/rt_trace.glsl.
-enum Binding : uint32_t {
-    kTlas,
-    kDepth,
-    kNormal,
-    kRoughnessMetal,
-    kRayList,
-    kRayListArgs,
-    kPool,
-    kOffsets,
-    kConstants,
-    kRadiance,
-    kHitDistance,
-    kEnvironment,
-    kMaterials,       // glint/rt_geometry.glsl from here on
-    kAlphaTriangles,
-    kAlphaMasks,
-    kBindingCount
-};
-
-// `stages` read every binding; `alphaStages` also read the material rows
-// and the alpha test's data (the pipeline's any-hit shader).
-std::vector<gpu::Binding> traceBindings(VkShaderStageFlags stages, VkShaderStageFlags alphaStages = 0) {
-    std::vector<gpu::Binding> bindings;
-    for (uint32_t i = 0; i < kBindingCount; ++i) {
-        VkDescriptorType type = VK_DESCRIPTOR_TYPE_STORAGE_BUFFER;
-        if (i == kTlas) type = VK_DESCRIPTOR_TYPE_ACCELERATION_STRUCTURE_KHR;
-        if ((i >= kDepth && i <= kRoughnessMetal) || i == kEnvironment || i == kAlphaMasks) {
-            type = VK_DESCRIPTOR_TYPE_COMBINED_IMAGE_SAMPLER;
-        }
-        if (i == kRadiance || i == kHitDistance) type = VK_DESCRIPTOR_TYPE_STORAGE_IMAGE;
-        bindings.push_back({i, type, stages | (i >= kMaterials ? alphaStages : 0)});
-    }
-    return bindings;
-}
-
 // vkCmdTraceRaysIndirectKHR needs rayTracingPipelineTraceRaysIndirect; the
 // context enables it wherever the device has it, so asking the device is
 // asking what is enabled.
@@ -152,7 +116,7 @@ RtBackend RtTracePipelines::prepare(RtBackend requested) {
     }
     if (backend == RtBackend::RayQuery && !query_) {
         query_ = gpu::createComputePipeline(
-            ctx_, {"rt_trace/trace_query.comp", traceBindings(VK_SHADER_STAGE_COMPUTE_BIT), 0, "rt_trace.query"});
+            ctx_, {"rt_trace/trace_query.comp", {}, 0, "rt_trace.query"});
     }
     if (backend == RtBackend::Pipeline && !pipeline_) {
         // Depth 1: the ray generation shader traces both rays and shades;
@@ -162,7 +126,7 @@ RtBackend RtTracePipelines::prepare(RtBackend requested) {
             ctx_, {"rt_trace/trace.rgen",
                    {"rt_trace/trace.rmiss"},
                    {{"rt_trace/trace.rchit", "rt_trace/trace.rahit"}},
-                   traceBindings(VK_SHADER_STAGE_RAYGEN_BIT_KHR, VK_SHADER_STAGE_ANY_HIT_BIT_KHR),
+                   {},
                    0,
                    1,
                    "rt_trace.pipeline"});
@@ -193,8 +157,8 @@ RtTraceOutputs addRtTracePass(rg::Graph& graph, RtTracePipelines& pipelines, con
         throw gpu::GpuError("addRtTracePass: the BVH update's TLAS, primitive pool, offsets, material rows and alpha "
                             "test data are required");
     }
-    if (!(settings.maxDistance > 0.0f) || !(settings.shortRangeFraction >= 0.0f) ||
-        !(settings.shadowDistance >= 0.0f) || !(settings.originOffsetScale >= 0.0f)) {
+    if (!(inputs.maxDistance > 0.0f) || !(settings.shortRangeFraction >= 0.0f) ||
+        !(inputs.shadowDistance >= 0.0f) || !(settings.originOffsetScale >= 0.0f)) {
         throw gpu::GpuError("addRtTracePass: maxDistance must be positive; shortRangeFraction, shadowDistance and "
                             "originOffsetScale not negative");
     }
@@ -217,10 +181,10 @@ RtTraceOutputs addRtTracePass(rg::Graph& graph, RtTracePipelines& pipelines, con
                             "(passes::importEnvironment)");
     }
     constants.size = {gbuf.width, gbuf.height};
-    constants.maxDistance = settings.maxDistance;
+    constants.maxDistance = inputs.maxDistance;
     constants.shortRangeRoughness = settings.shortRangeRoughness;
     constants.shortRangeFraction = settings.shortRangeFraction;
-    constants.shadowDistance = settings.shadowDistance;
+    constants.shadowDistance = inputs.shadowDistance;
     constants.originOffsetScale = settings.originOffsetScale;
     constants.rasterErrorPerDistance =
         rtRasterErrorPerDistance(inputs.camera.projection, gbuf.width, gbuf.height, pipelines.subPixelPrecisionBits_);
@@ -297,22 +261,23 @@ RtTraceOutputs addRtTracePass(rg::Graph& graph, RtTracePipelines& pipelines, con
                 d.environment == d.normal ? sampler : pipelines.environmentSampler_.handle();
             pipeline.bind(pc.cmd());
             gpu::PushDescriptors(pipeline)
-                .accelerationStructure(kTlas, pc.accel(d.tlas).handle())
-                .sampledImage(kEnvironment, pc.view(d.environment), environmentSampler, pc.layout(d.environment))
-                .sampledImage(kDepth, pc.view(d.depth), sampler, pc.layout(d.depth))
-                .sampledImage(kNormal, pc.view(d.normal), sampler, pc.layout(d.normal))
-                .sampledImage(kRoughnessMetal, pc.view(d.roughnessMetal), sampler, pc.layout(d.roughnessMetal))
-                .storageBuffer(kRayList, pc.buffer(d.rayList))
-                .storageBuffer(kRayListArgs, pc.buffer(d.rayListArgs))
-                .storageBuffer(kPool, pc.buffer(d.pool))
-                .storageBuffer(kOffsets, pc.buffer(d.offsets))
-                .storageBuffer(kMaterials, pc.buffer(d.materials))
-                .storageBuffer(kAlphaTriangles, pc.buffer(d.alphaTriangles))
-                .sampledImage(kAlphaMasks, pc.view(d.alphaMasks), pipelines.alphaSampler_.handle(),
+                .accelerationStructure("tlas", pc.accel(d.tlas).handle())
+                .sampledImage("environmentTexture", pc.view(d.environment), environmentSampler,
+                              pc.layout(d.environment))
+                .sampledImage("depthTexture", pc.view(d.depth), sampler, pc.layout(d.depth))
+                .sampledImage("normalTexture", pc.view(d.normal), sampler, pc.layout(d.normal))
+                .sampledImage("roughnessMetalTexture", pc.view(d.roughnessMetal), sampler, pc.layout(d.roughnessMetal))
+                .storageBuffer("RayList", pc.buffer(d.rayList))
+                .storageBuffer("RayListArgs", pc.buffer(d.rayListArgs))
+                .storageBuffer("Pool", pc.buffer(d.pool))
+                .storageBuffer("Offsets", pc.buffer(d.offsets))
+                .storageBuffer("GeometryMaterials", pc.buffer(d.materials))
+                .storageBuffer("AlphaTriangles", pc.buffer(d.alphaTriangles))
+                .sampledImage("alphaMasks", pc.view(d.alphaMasks), pipelines.alphaSampler_.handle(),
                               pc.layout(d.alphaMasks))
-                .storageBuffer(kConstants, pc.buffer(d.constants))
-                .storageImage(kRadiance, pc.view(d.out.radiance))
-                .storageImage(kHitDistance, pc.view(d.out.hitDistance))
+                .storageBuffer("Constants", pc.buffer(d.constants))
+                .storageImage("radianceImage", pc.view(d.out.radiance))
+                .storageImage("hitDistanceImage", pc.view(d.out.hitDistance))
                 .push(pc.gpu(), pc.cmd());
             if (backend == RtBackend::RayQuery) {
                 pc.dispatchIndirect(pipeline, d.rayListArgs, kDispatchArgsBytes);

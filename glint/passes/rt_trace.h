@@ -75,6 +75,13 @@ struct RtTraceInputs {
     // misses and the hits' ambient light; needed when `lighting` looks up an
     // image, else left invalid.
     rg::Texture environment;
+    // Ray length at roughness 0: the BVH's radius around the camera (Far
+    // Cry 6 talk; ReflectionFrameSettings::reach); beyond it the TLAS holds
+    // nothing.
+    float maxDistance = scene::kDefaultBvhRadius;
+    // Length of shadow rays: the BVH's diameter, so that an occluder anywhere
+    // in the TLAS can shadow a hit anywhere in it.
+    float shadowDistance = 2.0f * scene::kDefaultBvhRadius;
 };
 
 struct RtTraceSettings {
@@ -85,11 +92,8 @@ struct RtTraceSettings {
     // as if that ran the same plan: wait for the device before the first
     // frame of the other backend.
     RtBackend backend = RtBackend::Auto;
-    // Ray length at roughness 0: the BVH's radius around the camera (Far
-    // Cry 6 talk); beyond it the TLAS holds nothing.
-    float maxDistance = 100.0f;
     // The length falls linearly with perceptual roughness to
-    // shortRangeFraction * maxDistance at shortRangeRoughness: rough
+    // shortRangeFraction * RtTraceInputs::maxDistance at shortRangeRoughness: rough
     // reflections blur distant detail away (the talk's range shrinking;
     // the numbers are Glint's starting values, the bench sweeps them).
     // 0.22 is ray generation's roughness cutoff, the roughest traced.
@@ -98,9 +102,6 @@ struct RtTraceSettings {
     // Sun visibility at hits from a shadow ray; off, hits are lit unshadowed
     // (as the G-buffer's lit colour is).
     bool shadows = true;
-    // Shadow rays reach across the BVH's diameter: an occluder anywhere in
-    // the TLAS can shadow a hit anywhere in it.
-    float shadowDistance = 200.0f;
     // Multiplies the robust origin offset (glint/rt_trace_shared.h); 0 turns
     // it off, which tests and the bench use to show what it prevents.
     float originOffsetScale = 1.0f;

@@ -78,10 +78,6 @@ std::vector<uint8_t> smokeImage(const std::vector<shader::SmokeHit>& hits, uint3
 }
 
 namespace {
-const std::vector<gpu::Binding> kBindings = {
-    {0, VK_DESCRIPTOR_TYPE_ACCELERATION_STRUCTURE_KHR, VK_SHADER_STAGE_COMPUTE_BIT | VK_SHADER_STAGE_RAYGEN_BIT_KHR},
-    {1, VK_DESCRIPTOR_TYPE_STORAGE_BUFFER, VK_SHADER_STAGE_COMPUTE_BIT | VK_SHADER_STAGE_RAYGEN_BIT_KHR},
-};
 constexpr VkBufferUsageFlags kBuildInput = VK_BUFFER_USAGE_ACCELERATION_STRUCTURE_BUILD_INPUT_READ_ONLY_BIT_KHR;
 } // namespace
 
@@ -133,13 +129,13 @@ const gpu::Pipeline& SmokeTracer::pipelineFor(RayBackend backend) {
         }
         if (!queryPipeline_) {
             queryPipeline_ = gpu::createComputePipeline(
-                ctx_, {"smoke/trace_query.comp", kBindings, sizeof(shader::SmokeCamera), "smoke.trace_query"});
+                ctx_, {"smoke/trace_query.comp", {}, sizeof(shader::SmokeCamera), "smoke.trace_query"});
         }
         return *queryPipeline_;
     }
     if (!rtPipeline_) {
         rtPipeline_ = gpu::createRayTracingPipeline(
-            ctx_, {"smoke/trace.rgen", {"smoke/trace.rmiss"}, {{"smoke/trace.rchit", ""}}, kBindings,
+            ctx_, {"smoke/trace.rgen", {"smoke/trace.rmiss"}, {{"smoke/trace.rchit", ""}}, {},
                    sizeof(shader::SmokeCamera), 1, "smoke.trace_pipeline"});
         sbt_.emplace(ctx_, *rtPipeline_, 1, 1);
     }
@@ -164,7 +160,10 @@ SmokeTraceResult SmokeTracer::trace(RayBackend backend, uint32_t width, uint32_t
                        [&](VkCommandBuffer cmd) {
         gpu::ScopedLabel label(ctx_, cmd, std::string("smoke.trace.") + backendName(backend));
         pipeline.bind(cmd);
-        gpu::PushDescriptors(pipeline).accelerationStructure(0, tlas_.handle()).storageBuffer(1, hits).push(ctx_, cmd);
+        gpu::PushDescriptors(pipeline)
+            .accelerationStructure("tlas", tlas_.handle())
+            .storageBuffer("Hits", hits)
+            .push(ctx_, cmd);
         pipeline.pushConstants(cmd, camera);
         timer.begin(cmd, 0);
         if (backend == RayBackend::RayQuery) {

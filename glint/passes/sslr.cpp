@@ -18,29 +18,6 @@ namespace glint::passes {
 
 namespace {
 
-constexpr uint32_t kBindingCount = 15;
-
-std::vector<gpu::Binding> traceBindings() {
-    std::vector<gpu::Binding> bindings;
-    for (uint32_t i = 0; i < kBindingCount; ++i) {
-        VkDescriptorType type = VK_DESCRIPTOR_TYPE_STORAGE_BUFFER;
-        if (i < 3 || i == 11 || i == 12) type = VK_DESCRIPTOR_TYPE_COMBINED_IMAGE_SAMPLER;
-        if (i >= 6 && i <= 8) type = VK_DESCRIPTOR_TYPE_STORAGE_IMAGE;
-        bindings.push_back({i, type, VK_SHADER_STAGE_COMPUTE_BIT});
-    }
-    return bindings;
-}
-
-// pyramid.glsl: the source (the lit colour through a sampler, whose reads
-// are texelFetch, or level 5 as a storage image), then the levels written.
-std::vector<gpu::Binding> pyramidBindings(VkDescriptorType source) {
-    std::vector<gpu::Binding> bindings = {{0, source, VK_SHADER_STAGE_COMPUTE_BIT}};
-    for (uint32_t o = 0; o < shader::kSslrPyramidOutputs; ++o) {
-        bindings.push_back({1 + o, VK_DESCRIPTOR_TYPE_STORAGE_IMAGE, VK_SHADER_STAGE_COMPUTE_BIT});
-    }
-    return bindings;
-}
-
 // The trace inverts the projection from P00, P11, P22 and P32 alone
 // (glint/sslr_shared.h); anything else (an off-centre or orthographic
 // projection) would be reconstructed wrongly, so it is refused.
@@ -57,12 +34,12 @@ void checkProjection(const glm::mat4& p) {
 SslrPipelines::SslrPipelines(gpu::Context& ctx)
     : ctx_(ctx),
       trace_(gpu::createComputePipeline(
-          ctx, {"sslr/trace.comp", traceBindings(), uint32_t(sizeof(shader::SslrConstants)), "sslr.trace"})),
+          ctx, {"sslr/trace.comp", {}, uint32_t(sizeof(shader::SslrConstants)), "sslr.trace"})),
       pyramidBase_(gpu::createComputePipeline(
-          ctx, {"sslr/pyramid_base.comp", pyramidBindings(VK_DESCRIPTOR_TYPE_COMBINED_IMAGE_SAMPLER),
+          ctx, {"sslr/pyramid_base.comp", {},
                 uint32_t(sizeof(shader::SslrPyramidConstants)), "sslr.pyramid_base"})),
       pyramidDown_(gpu::createComputePipeline(
-          ctx, {"sslr/pyramid_down.comp", pyramidBindings(VK_DESCRIPTOR_TYPE_STORAGE_IMAGE),
+          ctx, {"sslr/pyramid_down.comp", {},
                 uint32_t(sizeof(shader::SslrPyramidConstants)), "sslr.pyramid_down"})),
       nearest_(ctx, {VK_FILTER_NEAREST, VK_SAMPLER_MIPMAP_MODE_NEAREST, VK_SAMPLER_ADDRESS_MODE_CLAMP_TO_EDGE, 0.0f,
                      "sslr.nearest"}),
@@ -180,13 +157,15 @@ SslrOutputs addSslrPass(rg::Graph& graph, SslrPipelines& pipelines, const SslrIn
                     pipeline.bind(pc.cmd());
                     gpu::PushDescriptors push(pipeline);
                     if (d.fromLit) {
-                        push.sampledImage(0, pc.view(d.source), pipelines.nearest_.handle(), pc.layout(d.source));
+                        push.sampledImage("source", pc.view(d.source), pipelines.nearest_.handle(),
+                                          pc.layout(d.source));
                     } else {
-                        push.storageImage(0, image.mipView(shader::kSslrPyramidLevelsPerPass));
+                        push.storageImage("source", image.mipView(shader::kSslrPyramidLevelsPerPass));
                     }
-                    // Bindings past the levels written repeat the last one (never stored to).
+                    // Outputs past the levels written repeat the last one (never stored to).
                     for (uint32_t o = 0; o < shader::kSslrPyramidOutputs; ++o) {
-                        push.storageImage(1 + o, image.mipView(d.first + std::min(o, d.outputs - 1)));
+                        push.storageImage("output" + std::to_string(o),
+                                          image.mipView(d.first + std::min(o, d.outputs - 1)));
                     }
                     push.push(pipelines.ctx_, pc.cmd());
                     pipeline.pushConstants(pc.cmd(), constants);
@@ -210,7 +189,7 @@ SslrOutputs addSslrPass(rg::Graph& graph, SslrPipelines& pipelines, const SslrIn
     constants.thickness = settings.thickness;
     constants.maxDistance = settings.maxDistance;
     constants.edgeFade = settings.edgeFade;
-    constants.confidenceThreshold = sslrStoredThreshold(settings.confidenceThreshold);
+    constants.confidenceThreshold = sslrStoredThreshold(inputs.confidenceThreshold);
     constants.pyramidMips = pyramidMips;
     constants.blueNoise = rays.blueNoise ? 1u : 0u;
 
@@ -247,24 +226,24 @@ SslrOutputs addSslrPass(rg::Graph& graph, SslrPipelines& pipelines, const SslrIn
             const VkSampler sampler = pipelines.nearest_.handle();
             pipeline.bind(pc.cmd());
             gpu::PushDescriptors(pipeline)
-                .sampledImage(0, pc.view(d.depth), sampler, pc.layout(d.depth))
-                .sampledImage(1, pc.view(d.normal), sampler, pc.layout(d.normal))
-                .sampledImage(2, pc.view(d.lit), sampler, pc.layout(d.lit))
-                .storageBuffer(3, pc.buffer(d.rays))
-                .storageBuffer(4, pc.buffer(d.classes))
-                .storageBuffer(5, pc.buffer(d.sslrRays))
-                .storageImage(6, pc.view(d.out.radiance))
-                .storageImage(7, pc.view(d.out.confidence))
-                .storageImage(8, pc.view(d.out.hitDebug))
-                .storageBuffer(9, pc.buffer(d.out.rtRayList))
-                .storageBuffer(10, pc.buffer(d.out.rtArgs))
-                .sampledImage(11, pc.view(d.roughnessMetal), sampler, pc.layout(d.roughnessMetal))
-                // Without the cone trace (pyramidMips 0) binding 12 is never
+                .sampledImage("depthTexture", pc.view(d.depth), sampler, pc.layout(d.depth))
+                .sampledImage("normalTexture", pc.view(d.normal), sampler, pc.layout(d.normal))
+                .sampledImage("litTexture", pc.view(d.lit), sampler, pc.layout(d.lit))
+                .storageBuffer("Rays", pc.buffer(d.rays))
+                .storageBuffer("Classes", pc.buffer(d.classes))
+                .storageBuffer("SslrRays", pc.buffer(d.sslrRays))
+                .storageImage("radianceImage", pc.view(d.out.radiance))
+                .storageImage("confidenceImage", pc.view(d.out.confidence))
+                .storageImage("hitDebugImage", pc.view(d.out.hitDebug))
+                .storageBuffer("RtRays", pc.buffer(d.out.rtRayList))
+                .storageBuffer("RtArgs", pc.buffer(d.out.rtArgs))
+                .sampledImage("roughnessMetalTexture", pc.view(d.roughnessMetal), sampler, pc.layout(d.roughnessMetal))
+                // Without the cone trace (pyramidMips 0) the pyramid is never
                 // read; the lit colour completes the descriptor set.
-                .sampledImage(12, pc.view(d.pyramid.valid() ? d.pyramid : d.lit), pipelines.trilinear_.handle(),
-                              pc.layout(d.pyramid.valid() ? d.pyramid : d.lit))
-                .storageBuffer(13, pc.buffer(d.sslrArgs))
-                .storageBuffer(14, *blueNoise)
+                .sampledImage("pyramidTexture", pc.view(d.pyramid.valid() ? d.pyramid : d.lit),
+                              pipelines.trilinear_.handle(), pc.layout(d.pyramid.valid() ? d.pyramid : d.lit))
+                .storageBuffer("SslrArgs", pc.buffer(d.sslrArgs))
+                .storageBuffer("BlueNoise", *blueNoise)
                 .push(pipelines.ctx_, pc.cmd());
             pipeline.pushConstants(pc.cmd(), constants);
             pc.dispatchIndirect(pipeline, d.sslrArgs, kRayListDispatchArgsBytes);

@@ -36,6 +36,10 @@ inline constexpr VkFormat kSslrRadianceFormat = VK_FORMAT_R16G16B16A16_SFLOAT;
 inline constexpr VkFormat kSslrConfidenceFormat = VK_FORMAT_R16_SFLOAT;
 inline constexpr VkFormat kSslrHitDebugFormat = VK_FORMAT_R16G16B16A16_SFLOAT;
 
+// The Far Cry 6 talk's SSLR confidence threshold; ReflectionFrameSettings
+// hands one value to SSLR, integrate and the particle trace.
+inline constexpr float kDefaultConfidenceThreshold = 0.9f;
+
 struct SslrInputs {
     GBufferOutputs gbuffer;
     RayGenerationOutputs rays;
@@ -46,6 +50,10 @@ struct SslrInputs {
     // from four entries; glint/sslr_shared.h).
     glm::mat4 view{1.0f};
     glm::mat4 projection{1.0f};
+    // Hybrid rays below this confidence go to the ray tracer. Compared as
+    // the confidence image stores it (sslrStoredThreshold); integrate and
+    // the particle trace must compare with the same value.
+    float confidenceThreshold = kDefaultConfidenceThreshold;
 };
 
 struct SslrSettings {
@@ -71,11 +79,6 @@ struct SslrSettings {
     // border, where neighbouring rays start to leave the screen (FidelityFX
     // SSSR's hit validation fades the same way). Glint's starting value.
     float edgeFade = 0.05f;
-    // Hybrid rays below this confidence go to the ray tracer: the Far Cry 6
-    // talk's 0.9. Compared as the confidence image
-    // stores it (sslrStoredThreshold); integrate and the particle trace
-    // compare with the same value.
-    float confidenceThreshold = 0.9f;
     // The rays ray generation marks (RayGenerationSettings::coneRoughness)
     // cone-trace over a pyramid of the lit colour; off, every ray marches
     // its own GGX direction and no pyramid is declared.

@@ -15,18 +15,6 @@ namespace glint::passes {
 
 namespace {
 
-std::vector<gpu::Binding> bindings(uint32_t sampled, uint32_t storage) {
-    std::vector<gpu::Binding> out;
-    out.push_back({0, VK_DESCRIPTOR_TYPE_UNIFORM_BUFFER, VK_SHADER_STAGE_COMPUTE_BIT});
-    for (uint32_t i = 0; i < sampled; ++i) {
-        out.push_back({1 + i, VK_DESCRIPTOR_TYPE_COMBINED_IMAGE_SAMPLER, VK_SHADER_STAGE_COMPUTE_BIT});
-    }
-    for (uint32_t i = 0; i < storage; ++i) {
-        out.push_back({1 + sampled + i, VK_DESCRIPTOR_TYPE_STORAGE_IMAGE, VK_SHADER_STAGE_COMPUTE_BIT});
-    }
-    return out;
-}
-
 uint32_t groups(uint32_t pixels) { return (pixels + shader::kTemporalGroupSize - 1) / shader::kTemporalGroupSize; }
 
 void checkSettings(const TemporalSettings& s) {
@@ -81,8 +69,8 @@ shader::TemporalFrame frameConstants(const TemporalInputs& in, const TemporalSet
 TemporalPipelines::TemporalPipelines(gpu::Context& ctx)
     : ctx_(ctx),
       accumulate_(
-          gpu::createComputePipeline(ctx, {"temporal/accumulate.comp", bindings(8, 4), 0, "temporal.accumulate"})),
-      spatial_(gpu::createComputePipeline(ctx, {"temporal/spatial.comp", bindings(4, 1), 0, "temporal.spatial"})),
+          gpu::createComputePipeline(ctx, {"temporal/accumulate.comp", {}, 0, "temporal.accumulate"})),
+      spatial_(gpu::createComputePipeline(ctx, {"temporal/spatial.comp", {}, 0, "temporal.spatial"})),
       // Every read is a texelFetch; the sampler only completes the combined
       // descriptor.
       nearest_(ctx, {VK_FILTER_NEAREST, VK_SAMPLER_MIPMAP_MODE_NEAREST, VK_SAMPLER_ADDRESS_MODE_CLAMP_TO_EDGE, 0.0f,
@@ -157,19 +145,21 @@ TemporalOutputs addTemporalPass(rg::Graph& graph, TemporalPipelines& pipelines, 
             const VkSampler sampler = pipelines.nearest_.handle();
             pipeline.bind(pc.cmd());
             gpu::PushDescriptors(pipeline)
-                .uniformBuffer(0, pc.buffer(d.frame))
-                .sampledImage(1, pc.view(d.depth), sampler, pc.layout(d.depth))
-                .sampledImage(2, pc.view(d.normal), sampler, pc.layout(d.normal))
-                .sampledImage(3, pc.view(d.roughnessMetal), sampler, pc.layout(d.roughnessMetal))
-                .sampledImage(4, pc.view(d.motion), sampler, pc.layout(d.motion))
-                .sampledImage(5, pc.view(d.radiance), sampler, pc.layout(d.radiance))
-                .sampledImage(6, pc.view(d.hitDistance), sampler, pc.layout(d.hitDistance))
-                .sampledImage(7, pc.view(d.previousRadiance), sampler, pc.layout(d.previousRadiance))
-                .sampledImage(8, pc.view(d.previousSurface), sampler, pc.layout(d.previousSurface))
-                .storageImage(9, pc.view(d.radianceOut))
-                .storageImage(10, pc.view(d.surfaceOut))
-                .storageImage(11, pc.view(d.motionOut))
-                .storageImage(12, pc.view(d.lengthOut))
+                .uniformBuffer("Frame", pc.buffer(d.frame))
+                .sampledImage("depthTexture", pc.view(d.depth), sampler, pc.layout(d.depth))
+                .sampledImage("normalTexture", pc.view(d.normal), sampler, pc.layout(d.normal))
+                .sampledImage("roughnessMetalTexture", pc.view(d.roughnessMetal), sampler, pc.layout(d.roughnessMetal))
+                .sampledImage("motionTexture", pc.view(d.motion), sampler, pc.layout(d.motion))
+                .sampledImage("radianceTexture", pc.view(d.radiance), sampler, pc.layout(d.radiance))
+                .sampledImage("hitDistanceTexture", pc.view(d.hitDistance), sampler, pc.layout(d.hitDistance))
+                .sampledImage("previousRadianceTexture", pc.view(d.previousRadiance), sampler,
+                              pc.layout(d.previousRadiance))
+                .sampledImage("previousSurfaceTexture", pc.view(d.previousSurface), sampler,
+                              pc.layout(d.previousSurface))
+                .storageImage("radianceHistory", pc.view(d.radianceOut))
+                .storageImage("surfaceHistory", pc.view(d.surfaceOut))
+                .storageImage("motionImage", pc.view(d.motionOut))
+                .storageImage("lengthImage", pc.view(d.lengthOut))
                 .push(pipelines.ctx_, pc.cmd());
             pc.dispatch(pipeline, groups(width), groups(height));
         });
@@ -195,12 +185,12 @@ TemporalOutputs addTemporalPass(rg::Graph& graph, TemporalPipelines& pipelines, 
             const VkSampler sampler = pipelines.nearest_.handle();
             pipeline.bind(pc.cmd());
             gpu::PushDescriptors(pipeline)
-                .uniformBuffer(0, pc.buffer(d.frame))
-                .sampledImage(1, pc.view(d.depth), sampler, pc.layout(d.depth))
-                .sampledImage(2, pc.view(d.normal), sampler, pc.layout(d.normal))
-                .sampledImage(3, pc.view(d.roughnessMetal), sampler, pc.layout(d.roughnessMetal))
-                .sampledImage(4, pc.view(d.accumulated), sampler, pc.layout(d.accumulated))
-                .storageImage(5, pc.view(d.resolved))
+                .uniformBuffer("Frame", pc.buffer(d.frame))
+                .sampledImage("depthTexture", pc.view(d.depth), sampler, pc.layout(d.depth))
+                .sampledImage("normalTexture", pc.view(d.normal), sampler, pc.layout(d.normal))
+                .sampledImage("roughnessMetalTexture", pc.view(d.roughnessMetal), sampler, pc.layout(d.roughnessMetal))
+                .sampledImage("accumulatedTexture", pc.view(d.accumulated), sampler, pc.layout(d.accumulated))
+                .storageImage("resolvedImage", pc.view(d.resolved))
                 .push(pipelines.ctx_, pc.cmd());
             pc.dispatch(pipeline, groups(width), groups(height));
         });

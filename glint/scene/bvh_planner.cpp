@@ -195,7 +195,10 @@ void BvhPlanner::reset() {
     assets_ = {};
 }
 
-BvhPlan BvhPlanner::plan(const Scene& scene, const glm::vec3& cameraPosition, uint64_t frame) {
+BvhPlan BvhPlanner::plan(const Scene& scene, const glm::vec3& cameraPosition, uint64_t frame, float radius) {
+    if (!(radius > 0.0f)) {
+        throw SceneError(scene.name, "BVH planner", "radius " + std::to_string(radius) + ": must be positive");
+    }
     if (havePlanned_ && frame <= lastFrame_) {
         throw SceneError(scene.name, "BVH planner",
                          "frame " + std::to_string(frame) + " after frame " + std::to_string(lastFrame_) +
@@ -269,8 +272,8 @@ BvhPlan BvhPlanner::plan(const Scene& scene, const glm::vec3& cameraPosition, ui
                              "mesh " + std::to_string(inst.mesh) + " out of range");
         }
         const bool deformable = inst.motion != Motion::Static;
-        const float radius = inst.longRange ? settings_.longRangeRadius : settings_.radius;
-        views[i].inRange = distanceToBounds(instanceBounds(scene, inst), cameraPosition) <= radius;
+        const float reach = inst.longRange ? std::max(settings_.longRangeRadius, radius) : radius;
+        views[i].inRange = distanceToBounds(instanceBounds(scene, inst), cameraPosition) <= reach;
         for (uint32_t p = 0; p < partsOf[inst.mesh].size(); ++p) {
             const Key key{deformable, deformable ? uint32_t(i) : inst.mesh, inst.mesh, lodOf[inst.mesh], p};
             views[i].keys.push_back(key);

@@ -30,8 +30,8 @@
 //    built; until then the frame reflects it through SSLR or the
 //    environment (BvhPlan::complete, passes::ReflectionRenderer: "SSLR is
 //    the fallback while the BVH builds", the talk);
-//  - the TLAS holds the instances within 100 m of the camera (the long-range
-//    group: a larger radius); an object never within the radius gets no
+//  - the TLAS holds the instances within the frame's radius of the camera
+//    (Far Cry 6: 100 m; the long-range group: a larger radius); an object never within the radius gets no
 //    BLAS; the particle TLAS exists only when there are particles.
 //
 // The primitive pool: every BLAS owns a contiguous range of triangles
@@ -49,9 +49,14 @@
 
 namespace glint::scene {
 
+// Far Cry 6's BVH radius around the camera; BvhPlanner::plan takes the
+// radius per frame (passes::ReflectionFrameSettings::reach).
+inline constexpr float kDefaultBvhRadius = 100.0f;
+
 struct BvhSettings {
-    float radius = 100.0f;                     // FC6: BVH radius around the camera
-    float longRangeRadius = 500.0f;            // Glint's choice for the terrain group; the talk gives no number
+    // The long-range group's radius (at least the frame's): Glint's choice
+    // for the terrain group; the talk gives no number.
+    float longRangeRadius = 500.0f;
     uint32_t maxRebuildsPerFrame = 16;         // FC6
     uint32_t maxSkinnedRebuildsPerFrame = 12;  // FC6
     uint32_t maxGeometriesPerBlas = 32;        // FC6
@@ -211,9 +216,14 @@ class BvhPlanner {
 public:
     explicit BvhPlanner(const BvhSettings& settings = {});
 
-    // The plan for `frame` (strictly increasing) seen from `cameraPosition`.
-    BvhPlan plan(const Scene& scene, const glm::vec3& cameraPosition, uint64_t frame);
-    BvhPlan plan(const Scene& scene, const Camera& camera) { return plan(scene, camera.position, camera.frameIndex); }
+    // The plan for `frame` (strictly increasing) seen from `cameraPosition`:
+    // the TLAS holds the instances within `radius` of it (> 0; the
+    // long-range group within max(radius, BvhSettings::longRangeRadius)).
+    BvhPlan plan(const Scene& scene, const glm::vec3& cameraPosition, uint64_t frame,
+                 float radius = kDefaultBvhRadius);
+    BvhPlan plan(const Scene& scene, const Camera& camera, float radius = kDefaultBvhRadius) {
+        return plan(scene, camera.position, camera.frameIndex, radius);
+    }
 
     const BvhSettings& settings() const { return settings_; }
     // Forgets every BLAS (device loss, scene switch): the next plan builds afresh.

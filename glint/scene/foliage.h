@@ -3,7 +3,7 @@
 // what a tropical reflection mostly shows, and what tests the alpha test in
 // raster, SSLR and both ray backends. Each cut-out is a texture whose alpha
 // draws the shape (glTF alphaMode MASK, double-sided) on a few quads.
-// Internal to engine/scene.
+// Internal to glint/scene.
 
 #include "glint/scene/scene.h"
 #include "glint/scene/scene_builder.h"

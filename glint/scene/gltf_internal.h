@@ -1,7 +1,7 @@
 #pragma once
 // Shared by gltf_loader.cpp (files, GLB container, JSON preflight, tinygltf)
 // and gltf_convert.cpp (tinygltf model -> scene, with every accessor
-// checked). Not installed; nothing outside engine/scene includes it.
+// checked). Internal: nothing outside glint/scene includes it.
 
 #include "glint/scene/gltf_loader.h"
 

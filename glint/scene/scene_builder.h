@@ -3,7 +3,7 @@
 // with: deterministic noise for generated textures, material makers and
 // SceneBuilder, which keeps the index bookkeeping of nodes, meshes,
 // instances, skins and sampled animation tracks in one place. Internal to
-// engine/scene.
+// glint/scene.
 
 #include "glint/scene/animation.h"
 #include "glint/scene/scene.h"

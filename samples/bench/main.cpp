@@ -41,23 +41,31 @@ using namespace glint;
 namespace {
 
 constexpr const char* kUsage =
-    "usage: glint-bench [--scene plaza|hard-cases|city[:OPTIONS]|FILE.gltf|FILE.glb] [--frames N] [--size WxH|N]\n"
-    "                   [--modes hybrid,ssr,rt] [--sweep-modes hybrid[,ssr,rt]|\"\"] [--quick]\n"
-    "                   [--out-dir DIR] [--csv FILE] [--json FILE] [--plot FILE.png]\n"
-    "                   [--time SECONDS] [--ppd N] [--backend auto|query|pipeline]\n"
-    "                   [--reference-max-frames N] [--warmup-frames N] [--jitter] [--validate]\n"
-    "                   [--scale N1,N2,...]\n"
-    "  Renders the converged reference at the pose of the runs' last frame, then each of --modes with\n"
-    "  defaults and the parameter sweeps (in the --sweep-modes where the parameter means something),\n"
-    "  N frames (default 16) each, and compares each run's last frame with the reference.\n"
-    "  --size defaults to 256x256 on a CPU device and 1920x1080 on a GPU. --warmup-frames (default 60 on\n"
-    "  a GPU, 0 on a CPU device): untimed frames of each configuration before its measured run.\n"
-    "  --csv/--json/--plot default to DIR/<scene>_bench.{csv,json,png}; DIR (default build/bench) also\n"
-    "  gets the reference, each mode's default image, its FLIP map, and both reflection terms\n"
-    "  (*_reflections.png, tonemapped as the \"resolved\" debug view).\n"
-    "  --scale: cost against scene size instead: the city (--scene city:triangles=T,seed=S sets its other\n"
-    "  options) at each number of buildings, each with its own reference, every mode with its defaults;\n"
-    "  writes DIR/city_scale.{csv,json,png} (reflection_ms against instanced triangles, log axis).";
+    "glint-bench: speed against error. Renders the converged reference at the pose of the runs' last frame,\n"
+    "then each of --modes with defaults and the parameter sweeps (in the --sweep-modes where the parameter\n"
+    "means something), N frames each, and compares each run's last frame with the reference. DIR (default\n"
+    "build/bench) gets the CSV, JSON and plot, the reference, each mode's default image, its FLIP map and\n"
+    "both reflection terms (*_reflections.png, tonemapped as the \"resolved\" debug view).";
+
+const std::vector<app::Flag> kFlags = {
+    {"scene", "plaza (default), hard-cases, city[:OPTIONS], FILE.gltf or FILE.glb"},
+    {"frames", "frames per run (default 16)"},
+    {"size", "WxH or N; default 256x256 on a CPU device, 1920x1080 on a GPU"},
+    {"modes", "the modes run with defaults (default hybrid,ssr,rt)"},
+    {"sweep-modes", "the modes the parameter sweeps run in (default hybrid; \"\": no sweeps)"},
+    {"out-dir", "DIR for everything written (default build/bench)"},
+    {"csv", "the CSV (default DIR/<scene>_bench.csv)"},
+    {"json", "the JSON (default DIR/<scene>_bench.json)"},
+    {"plot", "the time-against-error plot (default DIR/<scene>_bench.png)"},
+    {"time", "SECONDS along the camera path of the measured pose"},
+    {"ppd", "FLIP's pixels per degree"},
+    {"backend", "auto (default), query or pipeline"},
+    {"reference-max-frames", "at most this many reference frames"},
+    {"warmup-frames", "untimed frames of each configuration before its run (default 60 on a GPU, 0 on a CPU)"},
+    {"scale", "N1,N2,...: cost against scene size instead: the city (--scene city:triangles=T,seed=S sets its "
+              "other options) at each number of buildings, each with its own reference, every mode with its "
+              "defaults; writes DIR/city_scale.{csv,json,png}"},
+};
 
 double parsePositive(const std::string& flag, const std::string& text, bool allowZero) {
     try {
@@ -108,10 +116,9 @@ struct Configuration {
 
 int main(int argc, char** argv) {
     return app::runMain("glint-bench", [&] {
-        const app::Args args(argc, argv, kUsage,
-                             {"scene", "frames", "size", "modes", "sweep-modes", "out-dir", "csv", "json", "plot",
-                              "time", "ppd", "backend", "reference-max-frames", "warmup-frames", "scale"},
-                             {"quick", "jitter"});
+        const app::Args args(argc, argv, kUsage, kFlags,
+                             {{"quick", "a short run: fewer frames and sweep values (what CI runs)"},
+                              {"jitter", "jitter the camera as the measured runs would (default off)"}});
         const std::string sceneName = args.get("scene", "plaza");
         const uint32_t frames = args.getUint("frames", 16);
         if (frames == 0) throw std::runtime_error("--frames 0: must be at least 1");

@@ -1,8 +1,8 @@
 #pragma once
 // glint-bench's report: the rows it measures, the table, CSV and
-// JSON it writes, the Pareto front of time against error, and the plot.
-// Pure CPU code with no Vulkan, so the tests check the schema and the plot
-// without a device.
+// JSON it writes, the Pareto front of time against error, and the plot
+// (drawn by matplotlib). Pure CPU code with no Vulkan, so the tests check
+// the schema and the plot without a device.
 
 #include <cstdint>
 #include <filesystem>
@@ -23,7 +23,7 @@ inline constexpr std::string_view kCsvHeader =
 // The baseline row of each mode has this as its param (and no value).
 inline constexpr std::string_view kDefaultParam = "default";
 
-// One image against the reference (engine/metrics).
+// One image against the reference (glint/metrics).
 struct ErrorMetrics {
     double flipMean = 0.0;  // LDR-FLIP mean at the run's pixels per degree
     double relMse = 0.0;    // epsilon metrics::kRelMseEpsilon
@@ -133,13 +133,18 @@ struct PlotOptions {
 // are left out.
 std::vector<PlotPoint> plotPoints(std::span<const Row> rows, bool wallTime);
 
-// Time against error: points coloured by series, the Pareto front as a line
-// through the non-dominated points, axes with tick labels and a legend
-// (stb_easy_font). RGBA8, options.width x options.height, top row first.
-std::vector<uint8_t> renderPlot(std::span<const PlotPoint> points, const PlotOptions& options);
+// What the plot script reads: the options and the points with finite
+// coordinates (positive x on a log axis), each marked whether it is on the
+// Pareto front (paretoFront) when options.paretoFront.
+std::string plotJson(std::span<const PlotPoint> points, const PlotOptions& options);
 
-// renderPlot written as a PNG; creates the folder, throws
-// std::runtime_error naming the file on failure.
+// The plot drawn by matplotlib: points coloured by series (defaults as
+// diamonds), the Pareto front as a dashed line with its points labelled,
+// axes, grid and legend; a PNG of options.width x options.height pixels at
+// `path` and an SVG beside it. The points (<stem>.plot.json) and the script
+// (<stem>.plot.py, samples/bench/plot.py) are left beside them, so the plot
+// can be redrawn with python3 alone. Throws std::runtime_error naming the
+// file when python3 or matplotlib is missing or fails.
 void writePlot(const std::filesystem::path& path, std::span<const PlotPoint> points, const PlotOptions& options);
 
 // ---- Cost against scene size (glint-bench --scale) --------------------------
@@ -177,10 +182,6 @@ std::string toScaleJson(const RunInfo& info, std::span<const ScaleRow> rows);
 
 // x = instanced triangles, y = reflection_ms, one series per mode.
 std::vector<PlotPoint> scalePlotPoints(std::span<const ScaleRow> rows);
-
-// Tick positions for an axis over [lo, hi]: multiples of 1, 2 or 5 x 10^k,
-// about `target` of them, all inside [lo, hi].
-std::vector<double> niceTicks(double lo, double hi, int target = 5);
 
 // Writes `text` to `path`, creating the folder; throws naming the file.
 void writeText(const std::filesystem::path& path, std::string_view text);

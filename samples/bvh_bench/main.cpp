@@ -520,11 +520,17 @@ int runOverlap(gpu::Context& ctx, const app::Args& args) {
 int main(int argc, char** argv) {
     return app::runMain("glint-bvh-bench", [&] {
         app::Args args(argc, argv,
-                       "usage: glint-bvh-bench [--scenes a,b,...] [--frames N]\n"
-                       "       glint-bvh-bench --overlap [--scenes NAME] [--frames N] [--warmup N] [--rays SIDE]\n"
-                       "                       [--busy-mib MIB] [--busy-passes N] [--busy-iterations N]",
-                       {"scenes", "frames", "warmup", "rays", "busy-mib", "busy-passes", "busy-iterations"},
-                       {"overlap"});
+                       "glint-bvh-bench: the BVH update pass per scene (first frame, steady frames, TLAS-only "
+                       "frames, memory), or with --overlap the frame time with the builds on async compute "
+                       "against the graphics queue",
+                       {{"scenes", "a,b,...: built-in names or glTF files (default: the plaza and the shared scenes)"},
+                        {"frames", "frames measured"},
+                        {"warmup", "--overlap: untimed frames first"},
+                        {"rays", "--overlap: SIDE of the square traced beside the builds"},
+                        {"busy-mib", "--overlap: MiB the graphics stand-in workload touches"},
+                        {"busy-passes", "--overlap: passes of the stand-in workload"},
+                        {"busy-iterations", "--overlap: iterations per stand-in pass"}},
+                       {{"overlap", "measure builds on async compute against builds on the graphics queue"}});
         // Builds and traces BVHs: a device without ray tracing is refused.
         gpu::ContextOptions contextOptions = args.contextOptions();
         contextOptions.requireRayTracing = true;

@@ -2,9 +2,11 @@
 
 #include "glint/gpu/error.h"
 
+#include "glint/scene/image_io.h"
+
+#include <CLI/CLI.hpp>
 #include <spdlog/cfg/helpers.h>
 #include <spdlog/spdlog.h>
-#include "glint/scene/image_io.h"
 
 #include <cstdio>
 #include <filesystem>
@@ -43,46 +45,44 @@ std::optional<scene::ReflectionLodSettings> parseReflectionLods(const std::strin
 }
 } // namespace
 
-Args::Args(int argc, char** argv, const std::string& usage, const std::vector<std::string>& knownFlags,
-           const std::vector<std::string>& knownSwitches) {
-    auto known = [](const std::vector<std::string>& list, const std::string& s) {
-        return std::find(list.begin(), list.end(), s) != list.end();
-    };
-    for (int i = 1; i < argc; ++i) {
-        const std::string a = argv[i];
-        auto value = [&]() -> std::string {
-            if (i + 1 >= argc) {
-                throw UsageError(a + " needs a value\n" + usage);
-            }
-            return argv[++i];
-        };
-        if (a == "--help" || a == "-h") {
-            std::cout << usage << "\n"
-                      << "common: --validate  --device NAME  --log LEVEL (trace|debug|info|warn|error)  --no-ray-query\n"
-                      << "        --no-ray-tracing  (as on a device without ray tracing: hybrid and rt render as ssr;\n"
-                      << "                           GLINT_NO_RAY_TRACING=1 does the same)\n"
-                      << "        --reflection-lods RATIO[:ERROR]|off  (glTF meshes' reflection LODs; default 0.25:0.01)\n";
-            std::exit(0);
-        } else if (a == "--validate") {
-            common_.validate = true;
-        } else if (a == "--device") {
-            common_.device = value();
-        } else if (a == "--log") {
-            common_.logLevel = value();
-        } else if (a == "--no-ray-query") {
-            common_.pipelineOnly = true;
-        } else if (a == "--no-ray-tracing") {
-            common_.noRayTracing = true;
-        } else if (a == "--reflection-lods") {
-            common_.reflectionLods = parseReflectionLods(value());
-        } else if (a.rfind("--", 0) == 0 && known(knownFlags, a.substr(2))) {
-            values_[a.substr(2)] = value();
-        } else if (a.rfind("--", 0) == 0 && known(knownSwitches, a.substr(2))) {
-            values_[a.substr(2)] = "1";
-        } else {
-            throw UsageError("unknown argument '" + a + "'\n" + usage);
-        }
+Args::Args(int argc, char** argv, const std::string& usage, const std::vector<Flag>& knownFlags,
+           const std::vector<Flag>& knownSwitches) {
+    CLI::App cli(usage);
+    cli.set_help_flag("-h,--help", "print this help and exit");
+    cli.add_flag("--validate", common_.validate,
+                 "Khronos validation with synchronization validation; exit 2 on any message");
+    cli.add_option("--device", common_.device, "a substring of the device name (GLINT_DEVICE does the same)");
+    cli.add_option("--log", common_.logLevel, "trace, debug, info, warn, error or off")->capture_default_str();
+    cli.add_flag("--no-ray-query", common_.pipelineOnly,
+                 "use the ray tracing pipeline even where ray query exists (as on NVIDIA)");
+    cli.add_flag("--no-ray-tracing", common_.noRayTracing,
+                 "as on a device without ray tracing: hybrid and rt render as ssr (GLINT_NO_RAY_TRACING=1)");
+    std::string lods;
+    cli.add_option("--reflection-lods", lods,
+                   "RATIO[:ERROR]|off: glTF meshes' reflection LODs, a share of the triangles and the largest "
+                   "relative error (default 0.25:0.01); off: BVHs from full detail");
+    std::map<std::string, std::string> given;
+    std::vector<std::pair<std::string, CLI::Option*>> options;
+    for (const Flag& f : knownFlags) {
+        options.emplace_back(f.name, cli.add_option("--" + f.name, given[f.name], f.help)->type_name("VALUE"));
     }
+    std::vector<std::pair<std::string, CLI::Option*>> switches;
+    for (const Flag& f : knownSwitches) switches.emplace_back(f.name, cli.add_flag("--" + f.name, f.help));
+    try {
+        cli.parse(argc, argv);
+    } catch (const CLI::CallForHelp&) {
+        std::cout << cli.help();
+        std::exit(0);
+    } catch (const CLI::ParseError& e) {
+        throw UsageError(std::string(e.what()) + " (--help lists the flags)");
+    }
+    for (const auto& [name, option] : options) {
+        if (option->count() > 0) values_[name] = given[name];
+    }
+    for (const auto& [name, option] : switches) {
+        if (option->count() > 0) values_[name] = "1";
+    }
+    if (!lods.empty()) common_.reflectionLods = parseReflectionLods(lods);
     const auto level = spdlog::level::from_str(common_.logLevel);
     if (level == spdlog::level::off && common_.logLevel != "off") {
         throw UsageError("--log " + common_.logLevel + ": not a log level (trace, debug, info, warn, error, off)");

@@ -29,11 +29,22 @@ struct CommonOptions {
     std::optional<scene::ReflectionLodSettings> reflectionLods = scene::ReflectionLodSettings{};
 };
 
-// Flags after the common ones: "--name value" or "--name" (value "1").
+// One command-line option of an executable: "--name VALUE" (or a switch,
+// "--name", value "1") and its line in --help.
+struct Flag {
+    Flag(const char* flagName, std::string flagHelp = {}) : name(flagName), help(std::move(flagHelp)) {}
+    std::string name;
+    std::string help;
+};
+
+// The command line, parsed by CLI11: the common flags (CommonOptions) and
+// the executable's own; --help prints `usage` and every flag's help.
+// Unknown flags, a missing value or a bad common value throw one line
+// naming it.
 class Args {
 public:
-    Args(int argc, char** argv, const std::string& usage, const std::vector<std::string>& knownFlags,
-         const std::vector<std::string>& knownSwitches);
+    Args(int argc, char** argv, const std::string& usage, const std::vector<Flag>& knownFlags,
+         const std::vector<Flag>& knownSwitches);
     const CommonOptions& common() const { return common_; }
     bool has(const std::string& name) const { return values_.count(name) != 0; }
     std::string get(const std::string& name, const std::string& fallback) const;

@@ -50,12 +50,12 @@ constexpr std::array<bool, 3> kEveryMode{true, true, true};
 
 // The one table of parameters: name, field, the viewer's range, the
 // bench's sweep, and where the value lives.
-const std::array<ParameterSlot, 18> kParameters = {{
+const std::array<ParameterSlot, 16> kParameters = {{
     // A confidence; the talk's 0.9 (default) bracketed from "trust SSLR
     // often" to "almost never".
-    {{"sslr_threshold", "SslrSettings::confidenceThreshold", 0.0f, 1.0f, false, {0.5, 0.7, 0.8, 0.95, 0.99}, {0.7},
-      kHybrid},
-     [](ReflectionRunOptions& o) { return &o.frame.sslr.confidenceThreshold; }, nullptr},
+    {{"sslr_threshold", "ReflectionFrameSettings::confidenceThreshold", 0.0f, 1.0f, false, {0.5, 0.7, 0.8, 0.95, 0.99},
+      {0.7}, kHybrid},
+     [](ReflectionRunOptions& o) { return &o.frame.confidenceThreshold; }, nullptr},
     // 64 linear steps (default, the talk) against fewer and more.
     {{"sslr_steps", "SslrSettings::linearSteps", 1.0f, 256.0f, true, {16, 32, 96, 128}, {16, 32}, kScreenSpace},
      nullptr, [](ReflectionRunOptions& o) { return &o.frame.sslr.linearSteps; }},
@@ -81,16 +81,11 @@ const std::array<ParameterSlot, 18> kParameters = {{
     // tries SSLR first everywhere.
     {{"rt_near_distance", "RayGenerationSettings::rtMaxDistance", 0.0f, 50.0f, false, {0, 1, 6, 10}, {0}, kHybrid},
      [](ReflectionRunOptions& o) { return &o.frame.rays.rtMaxDistance; }, nullptr},
-    // Default 100.
-    {{"sslr_far_distance", "RayGenerationSettings::sslrMinDistance", 0.0f, 500.0f, false, {}, {}, {}},
-     [](ReflectionRunOptions& o) { return &o.frame.rays.sslrMinDistance; }, nullptr},
-    // The talk's 100 (default) around the camera; smaller radii drop
-    // distant BLASes.
-    {{"bvh_radius", "BvhSettings::radius", 1.0f, 500.0f, false, {10, 25, 50, 200}, {25}, kTraced},
-     [](ReflectionRunOptions& o) { return &o.renderer.bvh.radius; }, nullptr},
-    // Default 100 (the talk).
-    {{"rt_max_distance", "RtTraceSettings::maxDistance", 1.0f, 500.0f, false, {}, {}, {}},
-     [](ReflectionRunOptions& o) { return &o.frame.rt.maxDistance; }, nullptr},
+    // The BVH radius, the talk's 100 (default) around the camera: smaller
+    // drops distant BLASes and shortens the rays; the SSLR-only distance
+    // and the particle trace's range follow it.
+    {{"reach", "ReflectionFrameSettings::reach", 1.0f, 500.0f, false, {10, 25, 50, 200}, {25}, kTraced},
+     [](ReflectionRunOptions& o) { return &o.frame.reach; }, nullptr},
     {{"frustum_culling", "GBufferSettings::frustumCulling (0 or 1)", 0.0f, 1.0f, true, {}, {}, {}}, nullptr, nullptr,
      [](ReflectionRunOptions& o) { return &o.frame.gbuffer.frustumCulling; }},
     // Half-rate RT on a checkerboard (default off).
@@ -215,14 +210,14 @@ ReflectionRunOptions referenceSettings(const ReflectionRunOptions& in) {
     // noise the measured runs use.
     o.frame.rays.blueNoise = false;
     o.frame.rays.roughnessCutoff = 1.0f;  // rough pixels are traced too: the environment is an approximation
-    o.renderer.bvh.radius = std::numeric_limits<float>::max();
-    o.renderer.bvh.longRangeRadius = std::numeric_limits<float>::max();
+    // Every object in the BVH, rays without end (the long-range group
+    // reaches at least as far).
+    o.frame.reach = 1e30f;
     // Full detail: the reference is the scene itself, not its reflection LODs.
     o.renderer.bvh.reflectionLods = false;
     // Every BLAS on the first frame: the reference accumulates from there.
     o.renderer.bvh.maxFirstBuildsPerFrame = std::numeric_limits<uint32_t>::max();
     o.renderer.bvh.maxFirstBuildTrianglesPerFrame = std::numeric_limits<uint64_t>::max();
-    o.frame.rt.maxDistance = 1e30f;
     o.frame.temporal.maxHistoryFrames = float(r.maxFrames);
     o.frame.temporal.neighbourhoodClamp = false;
     o.frame.temporal.spatialRadius = 0;

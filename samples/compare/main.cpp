@@ -18,7 +18,7 @@ using namespace glint;
 namespace {
 
 constexpr const char* kUsage =
-    "usage: glint-compare REF.png TEST.png [--ppd N] [--map FLIP.png]\n"
+    "glint-compare REF.png TEST.png: one line of image metrics\n"
     "  prints: flip_mean=... flip_weighted_median=... flip_q1=... flip_q3=... flip_min=... flip_max=...\n"
     "          relmse=... psnr=... ssim=...\n"
     "  PNG values are sRGB, linearised as the official FLIP tool does.\n"
@@ -26,8 +26,7 @@ constexpr const char* kUsage =
     "          a 0.7 m wide 3840-pixel display at 0.7 m); median and quartiles are weighted by error\n"
     "  relmse  mean over pixels and channels of (test - ref)^2 / (ref^2 + 0.01), linear RGB (epsilon 0.01)\n"
     "  psnr    10 log10(1 / MSE) on sRGB values in [0,1] (inf for identical images)\n"
-    "  ssim    mean SSIM, 11x11 Gaussian window (sigma 1.5), K1 0.01, K2 0.03, per R/G/B channel, averaged\n"
-    "  --map   writes the FLIP error map as a PNG through the magma colour ramp";
+    "  ssim    mean SSIM, 11x11 Gaussian window (sigma 1.5), K1 0.01, K2 0.03, per R/G/B channel, averaged";
 
 double parsePpd(const std::string& text) {
     try {
@@ -58,7 +57,10 @@ int main(int argc, char** argv) {
             const bool takesValue = a == "--ppd" || a == "--map" || a == "--device" || a == "--log";
             if (takesValue && i + 1 < argc) flagArgv.push_back(argv[++i]);
         }
-        const app::Args args(int(flagArgv.size()), flagArgv.data(), kUsage, {"ppd", "map"}, {});
+        const app::Args args(int(flagArgv.size()), flagArgv.data(), kUsage,
+                             {{"ppd", "FLIP's pixels per degree (default 67.020645)"},
+                              {"map", "FLIP.png: the FLIP error map through the magma colour ramp"}},
+                             {});
         if (files.size() != 2) {
             throw std::runtime_error("expected two images, REF.png and TEST.png, got " + std::to_string(files.size()) +
                                      "\n" + kUsage);

@@ -1,7 +1,7 @@
 // glint-graph-bench: how long declaring and compiling a frame takes, per
 // pass, for reflection-like and random graphs of 16, 128 and 1024 passes;
 // and how much transient memory aliasing saves on the synthetic reflection
-// frame (engine/graph/synthetic.h; the real frame's saving is measured by
+// frame (glint/graph/synthetic.h; the real frame's saving is measured by
 // tests/gpu/reflection_frame_plan_test.cpp) at 1920x1080. The last line is machine-readable:
 //   compile_us_per_pass_1024=<number> alias_saving_1080p=<percent>
 // where the first number is the worse of the two 1024-pass shapes
@@ -19,6 +19,8 @@
 #include <exception>
 #include <string>
 #include <vector>
+
+#include <CLI/CLI.hpp>
 
 #include "glint/graph/compile.h"
 #include "glint/graph/graph.h"
@@ -108,28 +110,23 @@ int run(int runsOverride, uint32_t onlyPasses) {
 } // namespace
 
 int main(int argc, char** argv) {
+    // No GPU here: this links Glint::graph alone, so it parses its two
+    // flags with CLI11 itself rather than through the samples' app::Args.
     int runs = 0;
     uint32_t passes = 0;
-    for (int i = 1; i < argc; ++i) {
-        const std::string arg = argv[i];
-        if (arg == "--runs" && i + 1 < argc) {
-            runs = std::atoi(argv[++i]);
-            if (runs <= 0) {
-                std::fprintf(stderr, "glint-graph-bench: --runs takes a positive count, not '%s'\n", argv[i]);
-                return 2;
-            }
-        } else if (arg == "--passes" && i + 1 < argc) {
-            passes = static_cast<uint32_t>(std::atoi(argv[++i]));
-            if (passes != 16 && passes != 128 && passes != 1024) {
-                std::fprintf(stderr, "glint-graph-bench: --passes takes 16, 128 or 1024, not '%s'\n", argv[i]);
-                return 2;
-            }
-        } else {
-            std::fprintf(stderr,
-                         "glint-graph-bench: unknown argument '%s' (usage: glint-graph-bench [--runs N] [--passes P])\n",
-                         arg.c_str());
-            return 2;
-        }
+    CLI::App cli("glint-graph-bench: declare + compile cost of the render graph per pass, and what aliasing saves");
+    cli.set_help_flag("-h,--help", "print this help and exit");
+    cli.add_option("--runs", runs, "time each shape N times (default 41 at 1024 passes, 201 below)")
+        ->check(CLI::PositiveNumber);
+    cli.add_option("--passes", passes, "time only the graphs of P passes")->check(CLI::IsMember({16, 128, 1024}));
+    try {
+        cli.parse(argc, argv);
+    } catch (const CLI::CallForHelp&) {
+        std::printf("%s", cli.help().c_str());
+        return 0;
+    } catch (const CLI::ParseError& e) {
+        std::fprintf(stderr, "glint-graph-bench: error: %s (--help lists the flags)\n", e.what());
+        return 2;
     }
     try {
         return run(runs, passes);

@@ -68,7 +68,9 @@ bool smokeCheck(gpu::Context& ctx, uint32_t size) {
 
 int main(int argc, char** argv) {
     return app::runMain("glint-info", [&] {
-        app::Args args(argc, argv, "usage: glint-info [--smoke] [--size N]", {"size"}, {"smoke"});
+        app::Args args(argc, argv, "glint-info: the device, its driver, queue families and ray tracing support",
+                       {{"size", "N: the smoke trace's image size (default 64)"}},
+                       {{"smoke", "trace the smoke scene with every ray backend and compare them"}});
         // Reports on devices without ray tracing too (contextOptions does
         // not require it).
         gpu::Context ctx(args.contextOptions());

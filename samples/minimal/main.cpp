@@ -12,6 +12,7 @@
 #include "glint/scene/builtin_scenes.h"
 #include "glint/scene/image_io.h"
 
+#include <CLI/CLI.hpp>
 #include <spdlog/spdlog.h>
 
 #include <exception>
@@ -20,9 +21,12 @@
 using namespace glint;
 
 int main(int argc, char** argv) {
+    std::string sceneName = "plaza", out = "build/out/minimal.png";
+    CLI::App cli("glint-minimal: the reflection frame in one sitting");
+    cli.add_option("scene", sceneName, "a built-in scene or a glTF file (default plaza)");
+    cli.add_option("out", out, "the PNG written (default build/out/minimal.png)");
+    CLI11_PARSE(cli, argc, argv);
     try {
-        const std::string sceneName = argc > 1 ? argv[1] : "plaza";
-        const std::string out = argc > 2 ? argv[2] : "build/out/minimal.png";
         constexpr uint32_t kWidth = 640, kHeight = 360, kFrames = 16;
 
         // The device (GLINT_DEVICE picks one), the scene, and the three

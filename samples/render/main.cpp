@@ -23,20 +23,31 @@ using namespace glint;
 namespace {
 
 constexpr const char* kUsage =
-    "usage: glint-render [--scene plaza|hard-cases|city[:OPTIONS]|smoke|FILE.gltf|FILE.glb] [--mode hybrid|ssr|rt|reference]\n"
-    "                    [--size WxH|N] [--frames N] [--out IMAGE.png] [--debug-view NAME] [--stats FILE.json]\n"
-    "                    [--backend auto|query|pipeline] [--bvh-queue async|graphics] [--time SECONDS]\n"
-    "                    [--camera NAME|INDEX] [--environment FILE.hdr] [--pass-timer auto|gpu|host]\n"
-    "                    [--set NAME=VALUE[,NAME=VALUE...]]\n"
-    "                    [--tolerance REL] [--seed N] [--max-frames N] (reference mode)\n"
-    "                    [--list-debug-views] [--list-parameters] [--validate]\n"
-    "--pass-timer: GPU timestamps, or each pass submitted alone and timed on the host (auto: host on a CPU\n"
-    "                    device such as lavapipe, whose timestamps do not cover compute dispatches)\n"
-    "--scene city:instances=N,triangles=T,seed=S: the built-in city at a size (16..4096 buildings, about T\n"
-    "                    triangles each; default city:instances=64,triangles=40000,seed=1)\n"
-    "--environment FILE.hdr: light and reflect the scene with an equirectangular HDR image (Radiance .hdr, twice\n"
-    "                    as wide as high; -Z at its centre, +Y at its top) in place of the scene's sky, prefiltered\n"
-    "                    by roughness on the GPU once (its sun, intensity and rotation stay the scene's)";
+    "glint-render: renders a scene with the hybrid reflections (or hybrid, ssr, rt, or the converged\n"
+    "reference) over its camera path and writes the last frame as a PNG.";
+
+const std::vector<app::Flag> kFlags = {
+    {"scene", "plaza (default), hard-cases, city[:instances=N,triangles=T,seed=S] (16..4096 buildings of about T "
+              "triangles; default 64, 40000, 1), smoke (first light of each ray backend), FILE.gltf or FILE.glb"},
+    {"mode", "hybrid (default), ssr, rt, or reference (every ray traced, accumulated from a still camera)"},
+    {"size", "WxH or N (square); default 256"},
+    {"frames", "frames along the camera path; the last is written (default 1)"},
+    {"out", "the PNG (default build/out/<scene>_<mode>.png)"},
+    {"debug-view", "write a debug view instead of the final image (--list-debug-views)"},
+    {"stats", "FILE.json: per-pass times, rays, pixel classes, BVH and raster work"},
+    {"backend", "auto (default), query or pipeline: the ray backend"},
+    {"bvh-queue", "async (default) or graphics: where the BVH builds run"},
+    {"time", "SECONDS along the camera path to start at (plaza: 3)"},
+    {"set", "NAME=VALUE[,NAME=VALUE...]: tunable parameters (--list-parameters)"},
+    {"tolerance", "reference mode: stop when the mean changes by less than this (default 2e-4)"},
+    {"seed", "reference mode: the noise seed (default 0)"},
+    {"max-frames", "reference mode: at most this many frames"},
+    {"camera", "NAME or INDEX: a glTF camera or a built-in preset, held still"},
+    {"environment", "FILE.hdr: an equirectangular Radiance HDR (2:1; -Z at its centre, +Y at its top) lights and is "
+                    "reflected in place of the scene's sky, prefiltered by roughness on the GPU once"},
+    {"pass-timer", "auto (default), gpu or host: GPU timestamps, or each pass submitted alone and timed on the host "
+                   "(auto: host on a CPU device such as lavapipe, whose timestamps miss compute dispatches)"},
+};
 
 float parseSeconds(const std::string& text) {
     try {
@@ -67,10 +78,9 @@ int renderSmoke(gpu::Context& ctx, const std::filesystem::path& outDir, uint32_t
 
 int main(int argc, char** argv) {
     return app::runMain("glint-render", [&] {
-        app::Args args(argc, argv, kUsage,
-                       {"scene", "mode", "size", "frames", "out", "debug-view", "stats", "backend", "time", "set",
-                        "tolerance", "seed", "max-frames", "camera", "bvh-queue", "environment", "pass-timer"},
-                       {"list-debug-views", "list-parameters"});
+        app::Args args(argc, argv, kUsage, kFlags,
+                       {{"list-debug-views", "print the debug views (name, modes, what each shows) and exit"},
+                        {"list-parameters", "print the tunable parameters (--set) and exit"}});
         if (args.has("list-parameters")) {
             for (const app::Parameter& p : app::parameters()) {
                 std::printf("%-18.*s %.*s\n", int(p.name.size()), p.name.data(), int(p.field.size()), p.field.data());
@@ -78,7 +88,12 @@ int main(int argc, char** argv) {
             return 0;
         }
         if (args.has("list-debug-views")) {
-            for (const std::string_view name : passes::debugViewNames()) std::printf("%.*s\n", int(name.size()), name.data());
+            for (const passes::DebugViewInfo& v : passes::debugViews()) {
+                const std::string modes = std::string(v.modes.hybrid ? "hybrid " : "") + (v.modes.ssr ? "ssr " : "") +
+                                          (v.modes.rt ? "rt" : "");
+                std::printf("%-18.*s %-15s %.*s\n", int(v.name.size()), v.name.data(), modes.c_str(),
+                            int(v.shows.size()), v.shows.data());
+            }
             return 0;
         }
         const std::string sceneName = args.get("scene", "plaza");
@@ -146,9 +161,7 @@ int main(int argc, char** argv) {
         }
         options.frame.debugView = args.get("debug-view", "");
         if (!options.frame.debugView.empty()) {
-            bool known = false;
-            for (const std::string_view name : passes::debugViewNames()) known |= name == options.frame.debugView;
-            if (!known) {
+            if (passes::findDebugView(options.frame.debugView) == nullptr) {
                 throw std::runtime_error("--debug-view " + options.frame.debugView +
                                          ": unknown (--list-debug-views prints the names)");
             }

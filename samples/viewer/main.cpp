@@ -291,8 +291,8 @@ private:
             renderer_ = std::make_unique<passes::ReflectionRenderer>(ctx_, scene_, options_.renderer);
             builtWith_ = options_.renderer;
             message_.clear();
-            spdlog::info("renderer rebuilt: backend {}, BVH radius {}", passes::backendName(renderer_->backend()),
-                         options_.renderer.bvh.radius);
+            spdlog::info("renderer rebuilt: backend {}, reflection LODs {}", passes::backendName(renderer_->backend()),
+                         options_.renderer.bvh.reflectionLods ? "on" : "off");
         } catch (const std::exception& e) {
             message_ = std::string("renderer: ") + e.what();
             options_.renderer = builtWith_;
@@ -379,9 +379,12 @@ private:
         }
         const std::string view = options_.frame.debugView.empty() ? "final" : options_.frame.debugView;
         if (ImGui::BeginCombo("debug view", view.c_str())) {
-            for (const std::string_view name : passes::debugViewNames()) {
-                ImGui::BeginDisabled(!viewer::debugViewAvailable(name, options_.frame.mode));
-                if (ImGui::Selectable(std::string(name).c_str(), name == view)) options_.frame.debugView = name;
+            for (const passes::DebugViewInfo& info : passes::debugViews()) {
+                ImGui::BeginDisabled(!info.modes.has(options_.frame.mode));
+                if (ImGui::Selectable(std::string(info.name).c_str(), info.name == view)) {
+                    options_.frame.debugView = info.name;
+                }
+                if (ImGui::IsItemHovered()) ImGui::SetTooltip("%.*s", int(info.shows.size()), info.shows.data());
                 ImGui::EndDisabled();
             }
             ImGui::EndCombo();

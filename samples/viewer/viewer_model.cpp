@@ -34,7 +34,14 @@ glm::uvec2 parseWindowSize(std::string_view text) {
     return {number(text.substr(0, x)), number(text.substr(x + 1))};
 }
 
-std::vector<std::string> viewerFlags() { return {"scene", "size", "frames", "mode", "backend", "debug-view"}; }
+std::vector<app::Flag> viewerFlags() {
+    return {{"scene", "plaza (default), hard-cases, city[:OPTIONS], FILE.gltf or FILE.glb"},
+            {"size", "WxH: the window's size"},
+            {"frames", "close after N frames (smoke tests on a virtual display)"},
+            {"mode", "hybrid, ssr or rt: what the panel starts with"},
+            {"backend", "auto, query or pipeline: the ray backend the panel starts with"},
+            {"debug-view", "the debug view the panel starts with (glint-render --list-debug-views)"}};
+}
 
 ViewerOptions viewerOptions(const app::Args& args) {
     ViewerOptions o;
@@ -52,8 +59,7 @@ ViewerOptions viewerOptions(const app::Args& args) {
         throw std::runtime_error(std::string("--mode/--backend: ") + e.what());
     }
     o.debugView = args.get("debug-view", o.debugView);
-    const auto names = passes::debugViewNames();
-    if (std::find(names.begin(), names.end(), o.debugView) == names.end()) {
+    if (passes::findDebugView(o.debugView) == nullptr) {
         throw std::runtime_error("--debug-view " + o.debugView + ": unknown (glint-render --list-debug-views)");
     }
     if (!debugViewAvailable(o.debugView, o.mode)) {
@@ -64,11 +70,8 @@ ViewerOptions viewerOptions(const app::Args& args) {
 }
 
 bool debugViewAvailable(std::string_view view, passes::ReflectionMode mode) {
-    using passes::ReflectionMode;
-    if (view == "tile_modes" || view == "feedback_counters") return mode == ReflectionMode::Hybrid;
-    if (startsWith(view, "sslr_")) return mode != ReflectionMode::Rt;
-    if (startsWith(view, "rt_")) return mode != ReflectionMode::Ssr;
-    return true;
+    const passes::DebugViewInfo* info = passes::findDebugView(view);
+    return info != nullptr && info->modes.has(mode);
 }
 
 std::vector<ParameterSlider> parameterSliders() {
@@ -100,7 +103,7 @@ void applySlider(app::ReflectionRunOptions& options, const ParameterSlider& slid
 }
 
 bool rendererOptionsDiffer(const passes::ReflectionRendererOptions& a, const passes::ReflectionRendererOptions& b) {
-    return a.backend != b.backend || a.bvh.radius != b.bvh.radius || a.bvh.reflectionLods != b.bvh.reflectionLods;
+    return a.backend != b.backend || a.bvh.reflectionLods != b.bvh.reflectionLods;
 }
 
 // ---- fly camera

@@ -19,10 +19,7 @@
 namespace glint::viewer {
 
 inline constexpr const char* kUsage =
-    "usage: glint-viewer [--scene plaza|hard-cases|city[:OPTIONS]|FILE.gltf|FILE.glb] [--size WxH] [--mode hybrid|ssr|rt]\n"
-    "                    [--backend auto|query|pipeline] [--debug-view NAME] [--frames N] [--validate]\n"
-    "  --mode, --backend, --debug-view: what the panel starts with (it changes them later)\n"
-    "  --frames N: close after N frames (smoke tests on a virtual display)\n"
+    "glint-viewer: the interactive viewer (GLFW + Dear ImGui).\n"
     "  WASD move, Q/E down/up, Shift faster, left-drag to look, Esc quits;\n"
     "  the panel sets mode, backend, debug view and parameters";
 
@@ -43,7 +40,7 @@ ViewerOptions viewerOptions(const app::Args& args);
 // Throws std::runtime_error naming the flag for a bad value, and for a
 // debug view the mode does not produce.
 // The flags app::Args must accept for the viewer.
-std::vector<std::string> viewerFlags();
+std::vector<app::Flag> viewerFlags();
 
 // Whether ReflectionRenderer::addFrame produces debug view `view` in
 // `mode`: the SSLR views need screen space (not rt), the ray-traced ones a

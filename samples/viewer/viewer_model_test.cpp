@@ -57,9 +57,10 @@ TEST_CASE("a window size outside 64..8192 or not WxH is refused, naming the flag
 
 TEST_CASE("debug views a mode does not produce are unavailable, every other one is") {
     using passes::ReflectionMode;
-    for (const std::string_view name : passes::debugViewNames()) {
-        CHECK(viewer::debugViewAvailable(name, ReflectionMode::Hybrid));
+    for (const passes::DebugViewInfo& info : passes::debugViews()) {
+        CHECK(viewer::debugViewAvailable(info.name, ReflectionMode::Hybrid));
     }
+    CHECK_FALSE(viewer::debugViewAvailable("no_such_view", ReflectionMode::Hybrid));
     CHECK_FALSE(viewer::debugViewAvailable("sslr_confidence", ReflectionMode::Rt));
     CHECK_FALSE(viewer::debugViewAvailable("rt_hit_distance", ReflectionMode::Ssr));
     CHECK_FALSE(viewer::debugViewAvailable("tile_modes", ReflectionMode::Ssr));
@@ -114,19 +115,19 @@ TEST_CASE("a slider sets its parameter through setParameter, clamped and rounded
     };
     app::ReflectionRunOptions o;
     viewer::applySlider(o, find("sslr_threshold"), 0.5f);
-    CHECK(o.frame.sslr.confidenceThreshold == doctest::Approx(0.5f));
+    CHECK(o.frame.confidenceThreshold == doctest::Approx(0.5f));
     viewer::applySlider(o, find("sslr_threshold"), 7.0f);
-    CHECK(o.frame.sslr.confidenceThreshold == doctest::Approx(1.0f));
+    CHECK(o.frame.confidenceThreshold == doctest::Approx(1.0f));
     viewer::applySlider(o, find("sslr_steps"), 31.6f);
     CHECK(o.frame.sslr.linearSteps == 32u);
     viewer::applySlider(o, find("sslr_steps"), NAN);
     CHECK(o.frame.sslr.linearSteps == 1u);
 }
 
-TEST_CASE("only the BVH's parameters (radius, reflection LODs) need a new renderer") {
+TEST_CASE("only the BVH's reflection LODs need a new renderer (the reach is the frame's)") {
     for (const viewer::ParameterSlider& s : viewer::parameterSliders()) {
         INFO(s.parameter.name);
-        CHECK(s.rendererOption == (s.parameter.name == "bvh_radius" || s.parameter.name == "reflection_lods"));
+        CHECK(s.rendererOption == (s.parameter.name == "reflection_lods"));
         // One end of the range or the other moves the field off its default.
         bool differs = false;
         for (const float value : {s.min, s.max}) {

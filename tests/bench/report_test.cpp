@@ -4,9 +4,12 @@
 #include "bench/report.h"
 
 #include <doctest/doctest.h>
-#include <stb_image.h>
+#include <nlohmann/json.hpp>
 
 #include <cmath>
+#include <filesystem>
+#include <fstream>
+#include <iterator>
 #include <limits>
 #include <sstream>
 #include <string>
@@ -136,63 +139,76 @@ TEST_CASE("the Pareto front of a single point, of equal points and of none") {
     CHECK(paretoFront(std::vector<Point>{{2.0, 0.5}, {0.5, 0.1}, {1.0, 0.2}}) == std::vector<size_t>{1});
 }
 
-TEST_CASE("axis ticks are round numbers inside the range") {
-    const std::vector<double> t = niceTicks(0.0, 1.0, 5);
-    REQUIRE(t.size() == 6);
-    CHECK(t.front() == 0.0);
-    CHECK(t[1] == doctest::Approx(0.2));
-    CHECK(t.back() == doctest::Approx(1.0));
-    for (const double v : niceTicks(0.013, 0.087, 4)) {
-        CHECK(v >= 0.013);
-        CHECK(v <= 0.087);
-    }
+namespace {
+
+// The PNG's size from its IHDR chunk.
+std::pair<uint32_t, uint32_t> pngSize(const std::string& path) {
+    std::ifstream file(path, std::ios::binary);
+    unsigned char header[24] = {};
+    file.read(reinterpret_cast<char*>(header), sizeof header);
+    REQUIRE(file);
+    const auto word = [&](int at) {
+        return uint32_t(header[at]) << 24 | uint32_t(header[at + 1]) << 16 | uint32_t(header[at + 2]) << 8 |
+               uint32_t(header[at + 3]);
+    };
+    return {word(16), word(20)};
 }
 
-TEST_CASE("the plot is written at the requested size with something drawn on it") {
+std::string readAll(const std::string& path) {
+    std::ifstream file(path);
+    return {std::istreambuf_iterator<char>(file), std::istreambuf_iterator<char>()};
+}
+
+} // namespace
+
+TEST_CASE("the plot's points carry the Pareto front; matplotlib draws them as PNG and SVG at the requested size") {
     const std::vector<Row> rows = {makeRow("hybrid", "default", std::nullopt, 1.0, 0.05),
                                    makeRow("ssr", "default", std::nullopt, 0.5, 0.09),
                                    makeRow("rt", "default", std::nullopt, 1.2, 0.04),
-                                   makeRow("hybrid", "sslr_steps", 32.0, 0.9, 0.055)};
+                                   makeRow("hybrid", "sslr_steps", 32.0, 0.9, 0.055),
+                                   makeRow("hybrid", "sslr_steps", 16.0, 1.1, 0.06)};
     const std::vector<PlotPoint> points = plotPoints(rows, false);
-    REQUIRE(points.size() == 4);
+    REQUIRE(points.size() == 5);
     CHECK(points[0].at.x == 1.0);
     CHECK(points[3].label == "sslr_steps=32");
     CHECK(plotPoints(rows, true)[0].at.x == 10.0);
 
-    for (const auto& [w, h] : {std::pair<uint32_t, uint32_t>{800, 500}, {123, 77}}) {
-        PlotOptions options;
+    PlotOptions options;
+    options.title = "plaza 64x48";
+    options.xLabel = "reflection_ms";
+    options.yLabel = "FLIP mean";
+    const auto json = nlohmann::json::parse(plotJson(points, options));
+    REQUIRE(json["points"].size() == 5);
+    // ssr (fastest), sslr_steps=32, hybrid, rt (least error) are on the
+    // front; sslr_steps=16 is dominated by the hybrid default.
+    const std::vector<bool> front = {true, true, true, true, false};
+    for (size_t i = 0; i < front.size(); ++i) CHECK(json["points"][i]["front"] == front[i]);
+    CHECK(json["title"] == "plaza 64x48");
+
+    for (const auto& [w, h] : {std::pair<uint32_t, uint32_t>{800, 500}, {300, 200}}) {
         options.width = w;
         options.height = h;
-        options.title = "plaza 64x48";
-        options.xLabel = "reflection_ms";
-        options.yLabel = "FLIP mean";
         // Relative: ctest runs the suite in its build folder.
-        const std::string path = "test-out/bench/plot_" + std::to_string(w) + ".png";
-        writePlot(path, points, options);
-        int rw = 0, rh = 0, channels = 0;
-        unsigned char* data = stbi_load(path.c_str(), &rw, &rh, &channels, 4);
-        REQUIRE(data != nullptr);
-        CHECK(rw == int(w));
-        CHECK(rh == int(h));
-        // Points in their mode's colour (hybrid purple) and dark text both made it.
-        bool purple = false, dark = false;
-        for (int i = 0; i < rw * rh; ++i) {
-            const unsigned char* p = data + i * 4;
-            purple |= p[0] == 150 && p[1] == 50 && p[2] == 200;
-            dark |= p[0] == 0 && p[1] == 0 && p[2] == 0;
-        }
-        stbi_image_free(data);
-        CHECK(purple);
-        CHECK(dark);
+        const std::string stem = "test-out/bench/plot_" + std::to_string(w);
+        writePlot(stem + ".png", points, options);
+        CHECK(pngSize(stem + ".png") == std::pair<uint32_t, uint32_t>{w, h});
+        const std::string svg = readAll(stem + ".svg");
+        CHECK(svg.find("<svg") != std::string::npos);
+        // The script and its input stay beside the plot.
+        CHECK(std::filesystem::exists(stem + ".plot.py"));
+        CHECK(std::filesystem::exists(stem + ".plot.json"));
     }
 }
 
-TEST_CASE("an empty plot still has axes") {
+TEST_CASE("an empty plot is still drawn; a tiny one is refused") {
     PlotOptions options;
-    options.width = 64;
-    options.height = 32;
-    const std::vector<uint8_t> rgba = renderPlot({}, options);
-    CHECK(rgba.size() == 64u * 32u * 4u);
+    options.width = 200;
+    options.height = 120;
+    writePlot("test-out/bench/plot_empty.png", {}, options);
+    CHECK(pngSize("test-out/bench/plot_empty.png") == std::pair<uint32_t, uint32_t>{200, 120});
+    options.width = 32;
+    CHECK_THROWS_WITH_AS(writePlot("test-out/bench/plot_tiny.png", {}, options), doctest::Contains("plot_tiny.png"),
+                         std::runtime_error);
 }
 
 TEST_CASE("the scale CSV has its header and a row per size and mode; the plot puts sizes on a log axis") {
@@ -232,10 +248,10 @@ TEST_CASE("the scale CSV has its header and a row per size and mode; the plot pu
     options.logX = true;
     options.seriesLines = true;
     options.paretoFront = false;
-    const std::vector<uint8_t> rgba = renderPlot(points, options);
-    REQUIRE(rgba.size() == size_t(options.width) * options.height * 4);
-    // The hybrid line (purple) is drawn between its points.
-    size_t purple = 0;
-    for (size_t i = 0; i < rgba.size(); i += 4) purple += rgba[i] == 150 && rgba[i + 1] == 50 && rgba[i + 2] == 200;
-    CHECK(purple > 500u);
+    const auto json = nlohmann::json::parse(plotJson(points, options));
+    CHECK(json["logX"] == true);
+    CHECK(json["points"].size() == rows.size());
+    for (const auto& p : json["points"]) CHECK(p["front"] == false);
+    writePlot("test-out/bench/scale.png", points, options);
+    CHECK(pngSize("test-out/bench/scale.png") == std::pair<uint32_t, uint32_t>{options.width, options.height});
 }

@@ -13,10 +13,10 @@
 // nothing in the frame with the BVH still building (its ray passed where an
 // unbuilt box stands).
 #include "support/gpu_test.h"
-#include "glint/graph/transfer.h"
 
 #include "glint/graph/executor.h"
 #include "glint/graph/graph.h"
+#include "glint/graph/transfer.h"
 #include "glint/passes/reflection_frame.h"
 #include "glint/scene/animation.h"
 #include "glint/scene/procedural_meshes.h"
@@ -89,7 +89,7 @@ class Sequence {
 public:
     Sequence(gpu::Context& ctx, const scene::Scene& s, uint32_t firstBuildBudget)
         : ctx_(ctx), scene_(s), executor_(ctx), renderer_(ctx, scene_, options(firstBuildBudget)) {
-                camera_.resolution = {kWidth, kHeight};
+        camera_.resolution = {kWidth, kHeight};
         camera_.lens = {glm::radians(60.0f), 0.1f, scene::kInfiniteFar};
         camera_.jitter = false;
     }

@@ -200,7 +200,7 @@ TEST_CASE("a plane facing the camera gives the reversed-Z depth, its normal and 
         singleObjectScene(square({0, 0, -kDistance}, {1, 0, 0}, {0, 1, 0}, 20.0f), material);
     const GBufferImage img = render(gpu, scene, {testCamera()});
 
-    // Infinite far plane: depth = near / distance (engine/scene/camera.cpp).
+    // Infinite far plane: depth = near / distance (glint/scene/camera.cpp).
     const float expectedDepth = kNear / kDistance;
     for (uint32_t y = 0; y < kSize; ++y) {
         for (uint32_t x = 0; x < kSize; ++x) {

@@ -244,10 +244,11 @@ scene::Scene floorScene() {
 
 passes::RayGenerationSettings floorRaySettings() {
     passes::RayGenerationSettings s;
-    s.rtMaxDistance = 2.5f;    // rows below ~47
-    s.sslrMinDistance = 8.0f;  // rows above ~36
+    s.rtMaxDistance = 2.5f;  // rows below ~47
     return s;
 }
+// The SSLR-only distance of the floor scene's runs: rows above ~36.
+constexpr float kFloorSslrMinDistance = 8.0f;
 
 // A wall at z = -kWallDistance facing the camera and filling the image.
 constexpr float kWallDistance = 4.0f;
@@ -528,7 +529,10 @@ glm::u8vec4 sourceColour(uint32_t source) {
 
 struct RunOptions {
     passes::IntegrateSettings integrate;
+    // SSLR's, integrate's (and so the counters') confidence threshold.
+    float confidenceThreshold = passes::kDefaultConfidenceThreshold;
     passes::RayGenerationSettings rays = floorRaySettings();
+    float sslrMinDistance = kFloorSslrMinDistance;
     // Ray generation follows the feedback's tile modes.
     bool followTileModes = false;
     // Runs the real SSLR pass instead of uploading traces.sslr*.
@@ -564,6 +568,7 @@ public:
             feedback = passes::addFeedbackPass(graph, feedbackPipelines_, {gbuf, frameIndex});
         }
         passes::RayGenerationInputs rayInputs{gbuf, frameIndex, camera};
+        rayInputs.sslrMinDistance = options.sslrMinDistance;
         if (options.followTileModes && feedback) rayInputs.tileModes = feedback->tileModes;
         const passes::RayGenerationOutputs rays =
             passes::addRayGenerationPass(graph, rayPipelines_, rayInputs, options.rays);
@@ -573,8 +578,8 @@ public:
         in.rays = rays;
         if (present.sslr && options.realSslr) {
             in.sslr = passes::addSslrPass(graph, *options.realSslr,
-                                          {gbuf, rays, frameIndex, camera.view, camera.projection},
-                                          {.confidenceThreshold = options.integrate.confidenceThreshold});
+                                          {gbuf, rays, frameIndex, camera.view, camera.projection,
+                                           options.confidenceThreshold});
         } else if (present.sslr) {
             passes::SslrOutputs sslr;
             sslr.width = kSize;
@@ -598,6 +603,7 @@ public:
         if (feedback) in.feedback = *feedback;
         in.lighting = lighting_;
         in.camera = camera;
+        in.confidenceThreshold = options.confidenceThreshold;
         const passes::IntegrateOutputs out =
             passes::addIntegratePass(graph, integratePipelines_, in, options.integrate);
         REQUIRE(out.counters.valid() == present.feedback);
@@ -921,10 +927,8 @@ TEST_CASE("a lower confidence threshold trusts SSLR alone more often") {
     // The same frame index twice: the same classes and rays.
     const Frame strict = harness.run(testCamera(), 0, traces, noFeedback);
     const Coverage strictCov = checkFrame(strict, traces, noFeedback, harness.lighting());
-    passes::IntegrateSettings settings;
-    settings.confidenceThreshold = 0.4f;
     const Presence all;
-    const Frame lax = harness.run(testCamera(), 0, traces, all, {.integrate = settings});
+    const Frame lax = harness.run(testCamera(), 0, traces, all, {.confidenceThreshold = 0.4f});
     REQUIRE(lax.classes == strict.classes);
     const Coverage laxCov = checkFrame(lax, traces, all, harness.lighting(), 0.4f);
     // The counters count a hit at the same threshold (the first feedback
@@ -944,7 +948,7 @@ TEST_CASE("behind the real SSLR pass, confident wall hits are SSLR with the wall
     RunOptions options;
     options.realSslr = &sslrPipelines;
     options.rays.rtMaxDistance = 0.0f;  // every floor pixel hybrid
-    options.rays.sslrMinDistance = 1e9f;
+    options.sslrMinDistance = 1e9f;
     const Traces none = makeTraces(0, false);  // RT absent: only the SSLR fields matter, and those are replaced
     const Presence ssr{true, false, true};
     const Frame f = harness.run(testCamera(), 4, none, ssr, options);

@@ -242,10 +242,8 @@ public:
         if (sslrParticles) {
             gbuf.lit = passes::addParticleForwardPass(graph, particles_, {gbuf, scene_.particles, camera_}).lit;
         }
-        passes::RayGenerationSettings raySettings;
-        raySettings.mode = mode;
         const passes::RayGenerationOutputs rays =
-            passes::addRayGenerationPass(graph, rays_, {gbuf, noise, camera_, {}}, raySettings);
+            passes::addRayGenerationPass(graph, rays_, {gbuf, noise, camera_, {}, mode}, {});
         std::optional<passes::SslrOutputs> sslr;
         if (mode != passes::ReflectionMode::Rt) {
             sslr = passes::addSslrPass(graph, sslr_, {gbuf, rays, noise, camera_.view, camera_.projection});

@@ -10,6 +10,7 @@
 
 #include "glint/graph/executor.h"
 #include "glint/graph/graph.h"
+#include "glint/graph/transfer.h"
 #include "glint/graph/verify.h"
 #include "glint/passes/gbuffer.h"
 #include "glint/passes/ray_generation.h"
@@ -38,8 +39,6 @@ constexpr float kNear = test::kPassTestNear;
 using test::square;
 using test::testCamera;
 
-constexpr rg::BoundaryState kHostRead =
-    rg::BoundaryState::raw(VK_PIPELINE_STAGE_2_HOST_BIT, VK_ACCESS_2_HOST_READ_BIT, VK_IMAGE_LAYOUT_UNDEFINED);
 constexpr rg::BoundaryState kHostWrite =
     rg::BoundaryState::raw(VK_PIPELINE_STAGE_2_HOST_BIT, VK_ACCESS_2_HOST_WRITE_BIT, VK_IMAGE_LAYOUT_UNDEFINED);
 constexpr size_t kReadbacks = 6;
@@ -67,63 +66,34 @@ public:
                                                         kSize * kSize * sizeof(shader::PackedRay),
                                                         shader::kRayListArgsWords * 4,
                                                         shader::kRayListArgsWords * 4};
-        for (size_t i = 0; i < buffers_.size(); ++i) {
-            buffers_[i] = gpu::Buffer(ctx, {bytes[i], VK_BUFFER_USAGE_TRANSFER_DST_BIT, gpu::MemoryUsage::Readback,
-                                            "ray_generation_test.readback" + std::to_string(i)});
+        for (size_t i = 0; i < bytes.size(); ++i) {
+            buffers_.emplace_back(ctx, bytes[i], "ray_generation_test.readback" + std::to_string(i));
         }
     }
 
-    void add(rg::Graph& graph, const passes::RayGenerationOutputs& out, rg::FrameResources& frame) {
-        struct Data {
-            std::array<rg::Buffer, kReadbacks> sources;
-            std::array<rg::Buffer, kReadbacks> targets;
-        };
+    void add(rg::Graph& graph, const passes::RayGenerationOutputs& out, rg::FrameResources& frame) const {
         const std::array<rg::Buffer, kReadbacks> sources = {out.rays,   out.classes,  out.sslrRays,
                                                             out.rtRays, out.sslrArgs, out.rtArgs};
-        std::array<rg::Buffer, kReadbacks> imports;
-        const rg::BoundaryState lastCopy = rg::BoundaryState::of(rg::Access::TransferDst);
-        for (size_t i = 0; i < imports.size(); ++i) {
-            imports[i] =
-                graph.importBuffer("readback" + std::to_string(i), {{buffers_[i].size()}, lastCopy, kHostRead});
-            frame.bind(imports[i], buffers_[i]);
-        }
-        const Data& data = graph.addPass<Data>(
-            "readback", rg::Queue::Graphics,
-            [&](rg::Builder& b, Data& d) {
-                for (size_t i = 0; i < sources.size(); ++i) {
-                    d.sources[i] = b.read(sources[i], rg::Access::TransferSrc);
-                    d.targets[i] = b.write(imports[i], rg::Access::TransferDst);
-                }
-            },
-            [](const Data& d, rg::PassContext& pc) {
-                for (size_t i = 0; i < d.sources.size(); ++i) {
-                    const gpu::Buffer& target = pc.buffer(d.targets[i]);
-                    const VkBufferCopy region{0, 0, target.size()};
-                    vkCmdCopyBuffer(pc.cmd(), pc.buffer(d.sources[i]).handle(), target.handle(), 1, &region);
-                }
-            });
-        for (const rg::Buffer& written : data.targets) {
-            graph.markOutput(written);
-        }
+        for (size_t i = 0; i < sources.size(); ++i) buffers_[i].copy(graph, frame, sources[i]);
     }
 
     RayFrame decode() const {
         RayFrame f;
-        const auto copy = [](auto& vec, const gpu::Buffer& b) {
-            vec.resize(b.size() / sizeof(vec[0]));
-            std::memcpy(vec.data(), b.mapped(), b.size());
+        const auto copy = [](auto& vec, const rg::HostReadback& b) {
+            vec.resize(b.bytes().size() / sizeof(vec[0]));
+            std::memcpy(vec.data(), b.bytes().data(), b.bytes().size());
         };
         copy(f.rays, buffers_[0]);
         copy(f.classes, buffers_[1]);
         copy(f.sslrRays, buffers_[2]);
         copy(f.rtRays, buffers_[3]);
-        std::memcpy(f.sslrArgs.data(), buffers_[4].mapped(), sizeof(f.sslrArgs));
-        std::memcpy(f.rtArgs.data(), buffers_[5].mapped(), sizeof(f.rtArgs));
+        std::memcpy(f.sslrArgs.data(), buffers_[4].bytes().data(), sizeof(f.sslrArgs));
+        std::memcpy(f.rtArgs.data(), buffers_[5].bytes().data(), sizeof(f.rtArgs));
         return f;
     }
 
 private:
-    std::array<gpu::Buffer, kReadbacks> buffers_;
+    std::vector<rg::HostReadback> buffers_;
 };
 
 // A floor at y = -1 under a camera at the origin looking down -Z: the lower
@@ -153,10 +123,17 @@ glm::vec3 viewRay(uint32_t x, uint32_t y) {
     return glm::normalize(glm::vec3(ndc.x, -ndc.y, -1.0f));
 }
 
+// What the frame hands ray generation besides the G-buffer: its mode and
+// the distance from which pixels take SSLR only (the frame's reach).
+struct Band {
+    passes::ReflectionMode mode = passes::ReflectionMode::Hybrid;
+    float sslrMinDistance = scene::kDefaultBvhRadius;
+};
+
 // Renders the G-buffer and the ray generation for each frame index, with
 // the given tile modes (u32 per tile, glint/feedback_shared.h) when not empty.
 std::vector<RayFrame> generate(test::GpuTest& gpu, const scene::Scene& scene, const std::vector<uint64_t>& frames,
-                               const passes::RayGenerationSettings& settings = {},
+                               const passes::RayGenerationSettings& settings = {}, const Band& band = {},
                                const std::vector<uint32_t>& tileModes = {}) {
     auto& ctx = gpu.ctx();
     rg::Executor executor(ctx);
@@ -176,6 +153,8 @@ std::vector<RayFrame> generate(test::GpuTest& gpu, const scene::Scene& scene, co
         rg::FrameResources resources;
         const passes::GBufferOutputs gbuf = passes::addGBufferPass(graph, renderer, {camera});
         passes::RayGenerationInputs inputs{gbuf, frame, camera};
+        inputs.mode = band.mode;
+        inputs.sslrMinDistance = band.sslrMinDistance;
         if (!tileModes.empty()) {
             inputs.tileModes = graph.importBuffer(
                 "tile_modes", {{modes.size()}, kHostWrite, rg::BoundaryState::of(rg::Access::StorageRead)});
@@ -393,9 +372,10 @@ TEST_CASE("the same frame index gives the same rays") {
 TEST_CASE("the distance split classes pixels, and ray lists and indirect args agree with a CPU count") {
     test::GpuTest gpu;
     passes::RayGenerationSettings settings;
+    Band band;
     settings.rtMaxDistance = 3.0f;
-    settings.sslrMinDistance = 8.0f;
-    const RayFrame f = generate(gpu, floorScene(0.05f), {0}, settings).front();
+    band.sslrMinDistance = 8.0f;
+    const RayFrame f = generate(gpu, floorScene(0.05f), {0}, settings, band).front();
     constexpr uint32_t kTiles = kSize / shader::kTileSize;
     std::set<uint32_t> sslrLeaders, rtLeaders;
     std::array<uint32_t, shader::kPixelClassCount> counts{};
@@ -453,8 +433,9 @@ TEST_CASE("the distance split classes pixels, and ray lists and indirect args ag
 TEST_CASE("rough 2x2 quads share their leader's ray, and the leader rotates with the frame") {
     test::GpuTest gpu;
     passes::RayGenerationSettings settings;
-    settings.sslrMinDistance = 1e9f;  // RT and hybrid only
-    const std::vector<RayFrame> frames = generate(gpu, floorScene(0.15f), {0, 1, 2, 3}, settings);
+    Band band;
+    band.sslrMinDistance = 1e9f;  // RT and hybrid only
+    const std::vector<RayFrame> frames = generate(gpu, floorScene(0.15f), {0, 1, 2, 3}, settings, band);
     for (uint32_t frame = 0; frame < frames.size(); ++frame) {
         const RayFrame& f = frames[frame];
         const uint32_t lx = frame & 1u, ly = frame >> 1u;
@@ -495,9 +476,10 @@ TEST_CASE("below the reuse roughness every pixel keeps its own ray") {
 TEST_CASE("the checkerboard halves the smooth hybrid and RT rays: off squares share their row neighbour's ray") {
     test::GpuTest gpu;
     passes::RayGenerationSettings settings;
+    Band band;
     settings.checkerboard = true;
-    settings.sslrMinDistance = 1e9f;  // RT and hybrid only
-    const std::vector<RayFrame> frames = generate(gpu, floorScene(0.05f), {4, 5}, settings);
+    band.sslrMinDistance = 1e9f;  // RT and hybrid only
+    const std::vector<RayFrame> frames = generate(gpu, floorScene(0.05f), {4, 5}, settings, band);
     const std::vector<RayFrame> plainFrames = generate(gpu, floorScene(0.05f), {4, 5});
     for (uint32_t k = 0; k < frames.size(); ++k) {
         const RayFrame& f = frames[k];
@@ -535,12 +517,13 @@ TEST_CASE("the checkerboard halves the smooth hybrid and RT rays: off squares sh
 TEST_CASE("the ssr and rt modes send every traced pixel one way, and the RT list holds exactly the RT leaders") {
     test::GpuTest gpu;
     passes::RayGenerationSettings settings;
+    Band band;
     settings.rtMaxDistance = 3.0f;
-    settings.sslrMinDistance = 8.0f;
+    band.sslrMinDistance = 8.0f;
     for (const passes::ReflectionMode mode : {passes::ReflectionMode::Ssr, passes::ReflectionMode::Rt}) {
-        settings.mode = mode;
+        band.mode = mode;
         const uint32_t expected = mode == passes::ReflectionMode::Ssr ? shader::kPixelSslr : shader::kPixelRt;
-        const RayFrame f = generate(gpu, floorScene(0.05f), {0}, settings).front();
+        const RayFrame f = generate(gpu, floorScene(0.05f), {0}, settings, band).front();
         uint32_t traced = 0, leaders = 0;
         for (uint32_t y = 0; y < kSize; ++y) {
             for (uint32_t x = 0; x < kSize; ++x) {
@@ -572,8 +555,9 @@ TEST_CASE("the ssr and rt modes send every traced pixel one way, and the RT list
 TEST_CASE("hybrid pixels follow their tile's mode, and an RT tile keeps the configured share hybrid") {
     test::GpuTest gpu;
     passes::RayGenerationSettings settings;
+    Band band;
     settings.rtMaxDistance = 0.0f;    // no RT band
-    settings.sslrMinDistance = 1e9f;  // no SSLR band: every floor pixel is hybrid before the feedback
+    band.sslrMinDistance = 1e9f;  // no SSLR band: every floor pixel is hybrid before the feedback
     settings.rtToHybridShare = 0.25f;
     constexpr uint32_t kTiles = kSize / shader::kTileSize;
     // Columns of tiles: SSLR, hybrid, RT, repeating.
@@ -583,7 +567,8 @@ TEST_CASE("hybrid pixels follow their tile's mode, and an RT tile keeps the conf
         modes[t] = tx % 3 == 0 ? shader::kTileModeSslr : tx % 3 == 1 ? shader::kTileModeHybrid : shader::kTileModeRt;
     }
     uint64_t rtTilePixels = 0, keptHybrid = 0;
-    const std::vector<RayFrame> frames = generate(gpu, floorScene(0.05f), {0, 1, 2, 3, 4, 5, 6, 7}, settings, modes);
+    const std::vector<RayFrame> frames =
+        generate(gpu, floorScene(0.05f), {0, 1, 2, 3, 4, 5, 6, 7}, settings, band, modes);
     for (const RayFrame& f : frames) {
         for (uint32_t y = kSize / 2; y < kSize; ++y) {
             for (uint32_t x = 0; x < kSize; ++x) {

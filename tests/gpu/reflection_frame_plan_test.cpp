@@ -204,3 +204,34 @@ TEST_CASE("the real frame at 1920x1080: transient memory aliasing saves a quarte
         CHECK(saving > 0.25);
     }
 }
+
+TEST_CASE("every debug view is declared in the modes its table row names, and refused in the others") {
+    test::GpuTest gpu;
+    RealFrame frame(gpu.ctx(), {96, 64});
+    const rg::QueueCaps caps = capsFor(gpu.ctx(), {});
+    for (const passes::ReflectionMode mode :
+         {passes::ReflectionMode::Hybrid, passes::ReflectionMode::Ssr, passes::ReflectionMode::Rt}) {
+        for (const passes::DebugViewInfo& view : passes::debugViews()) {
+            INFO(view.name << " in " << passes::modeName(mode));
+            frame.camera.advance(frame.plaza.cameraPath.evaluate(3.0f), ++frame.frameIndex);
+            rg::Graph graph(caps);
+            passes::ReflectionFrameSettings settings;
+            settings.mode = mode;
+            settings.debugView = std::string(view.name);
+            if (view.modes.has(mode)) {
+                const passes::ReflectionFrame f = frame.renderer.addFrame(graph, frame.camera, settings);
+                CHECK(f.output.color.valid());
+                const rg::VerifyReport report = rg::verify(graph.compile());
+                CHECK_MESSAGE(report.ok(), report.text());
+            } else {
+                CHECK_THROWS_WITH(frame.renderer.addFrame(graph, frame.camera, settings),
+                                  doctest::Contains("not produced in mode"));
+            }
+        }
+    }
+    frame.camera.advance(frame.plaza.cameraPath.evaluate(3.0f), ++frame.frameIndex);
+    passes::ReflectionFrameSettings unknown;
+    unknown.debugView = "no_such_view";
+    rg::Graph graph(caps);
+    CHECK_THROWS_WITH(frame.renderer.addFrame(graph, frame.camera, unknown), doctest::Contains("unknown debug view"));
+}

@@ -319,7 +319,7 @@ public:
     }
 
     RtFrame trace(passes::RtTracePipelines& pipelines, const RayList& list, const shader::SceneLighting& lighting,
-                  const passes::RtTraceSettings& settings) {
+                  const passes::RtTraceSettings& settings, float maxDistance = scene::kDefaultBvhRadius) {
         REQUIRE(list.entries.size() <= size_t(kSize) * kSize);
         REQUIRE(list.count <= list.entries.size());
         std::memcpy(rays_.mapped(), list.entries.data(), list.entries.size() * sizeof(shader::PackedRay));
@@ -328,7 +328,7 @@ public:
         std::memcpy(args_.mapped(), argWords.data(), sizeof(argWords));
 
         // The graph orders each frame after the previous one as if it ran
-        // the same plan (engine/graph/barriers.cpp); a backend switch
+        // the same plan (glint/graph/barriers.cpp); a backend switch
         // changes the trace's shader stages, so a switch first waits for
         // the device (a wait the validation layer sees, unlike a timeline's).
         const passes::RtBackend backend =
@@ -349,8 +349,9 @@ public:
             graph.importBuffer("rt_test.ray_list_args", {{args_.size()}, kHostWritten, kHostWritten});
         resources.bind(rays, rays_);
         resources.bind(args, args_);
-        const passes::RtTraceOutputs out =
-            passes::addRtTracePass(graph, pipelines, {gbuf, rays, args, bvh, lighting, camera_, frame_}, settings);
+        passes::RtTraceInputs inputs{gbuf, rays, args, bvh, lighting, camera_, frame_};
+        inputs.maxDistance = maxDistance;
+        const passes::RtTraceOutputs out = passes::addRtTracePass(graph, pipelines, inputs, settings);
         REQUIRE(out.width == kSize);
         REQUIRE(out.height == kSize);
         addReadback(graph, out, gbuf.depth, resources);
@@ -592,11 +593,11 @@ RayList toList(const std::vector<ListedRay>& rays) {
     return list;
 }
 
-// The length of a ray leaving the floor (passes/rt_trace.h's defaults).
-float floorRayLength(const passes::RtTraceSettings& s) {
+// The length of a ray leaving the floor (passes/rt_trace.h's rule).
+float floorRayLength(const passes::RtTraceSettings& s, float maxDistance = scene::kDefaultBvhRadius) {
     const float roughness = 51.0f / 255.0f;
     const float k = std::clamp(roughness / s.shortRangeRoughness, 0.0f, 1.0f);
-    return s.maxDistance * glm::mix(1.0f, s.shortRangeFraction, k);
+    return maxDistance * glm::mix(1.0f, s.shortRangeFraction, k);
 }
 
 bool near(glm::vec3 got, glm::vec3 expected, float relative, float absolute) {
@@ -744,12 +745,11 @@ TEST_CASE("without shadows the roof's shadow is gone; rougher surfaces trace sho
     // Rays from the floor (roughness 0.2) with maxDistance 12 shrinking to a
     // quarter by roughness 0.1: 3 units long. The target lies 1-5 units
     // away: nearer hits stay, farther ones become misses.
-    settings.maxDistance = 12.0f;
     settings.shortRangeFraction = 0.25f;
     settings.shortRangeRoughness = 0.1f;
-    const float length = floorRayLength(settings);
+    const float length = floorRayLength(settings, 12.0f);
     REQUIRE(length == doctest::Approx(3.0f));
-    const RtFrame shortRays = rig.trace(pipelines, list, lit, settings);
+    const RtFrame shortRays = rig.trace(pipelines, list, lit, settings, 12.0f);
     uint32_t nearHits = 0, cutOff = 0;
     for (const ListedRay& r : rays) {
         if (!r.aimedAtTarget) continue;

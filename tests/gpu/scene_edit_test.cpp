@@ -6,10 +6,10 @@
 // primitive offsets, hit materials or G-buffer vertices), with validation
 // on.
 #include "support/gpu_test.h"
-#include "glint/graph/transfer.h"
 
 #include "glint/graph/executor.h"
 #include "glint/graph/graph.h"
+#include "glint/graph/transfer.h"
 #include "glint/passes/reflection_frame.h"
 #include "glint/scene/builtin_scenes.h"
 #include "glint/scene/mesh_tools.h"

@@ -10,6 +10,7 @@
 
 #include "glint/graph/executor.h"
 #include "glint/graph/graph.h"
+#include "glint/graph/transfer.h"
 #include "glint/graph/verify.h"
 #include "glint/passes/gbuffer.h"
 #include "glint/passes/ray_generation.h"
@@ -71,53 +72,17 @@ public:
         const std::array<uint64_t, kBuffers + kTextures> bytes = {
             pixels * sizeof(shader::PackedRay), pixels * 4, pixels * sizeof(shader::PackedRay),
             shader::kRayListArgsWords * 4, pixels * 8, pixels * 2, pixels * 8, pixels * 8};
-        for (size_t i = 0; i < buffers_.size(); ++i) {
-            buffers_[i] = gpu::Buffer(ctx, {bytes[i], VK_BUFFER_USAGE_TRANSFER_DST_BIT, gpu::MemoryUsage::Readback,
-                                            "sslr_test.readback" + std::to_string(i)});
+        for (size_t i = 0; i < bytes.size(); ++i) {
+            buffers_.emplace_back(ctx, bytes[i], "sslr_test.readback" + std::to_string(i));
         }
     }
 
     void add(rg::Graph& graph, const passes::RayGenerationOutputs& rays, const passes::SslrOutputs& sslr,
-             const passes::GBufferOutputs& gbuf, rg::FrameResources& frame) {
-        struct Data {
-            std::array<rg::Buffer, kBuffers> buffers;
-            std::array<rg::Texture, kTextures> textures;
-            std::array<rg::Buffer, kBuffers + kTextures> targets;
-        };
+             const passes::GBufferOutputs& gbuf, rg::FrameResources& frame) const {
         const std::array<rg::Buffer, kBuffers> buffers = {rays.rays, rays.classes, sslr.rtRayList, sslr.rtArgs};
         const std::array<rg::Texture, kTextures> textures = {sslr.radiance, sslr.confidence, sslr.hitDebug, gbuf.lit};
-        std::array<rg::Buffer, kBuffers + kTextures> imports;
-        const rg::BoundaryState lastCopy = rg::BoundaryState::of(rg::Access::TransferDst);
-        for (size_t i = 0; i < imports.size(); ++i) {
-            imports[i] =
-                graph.importBuffer("readback" + std::to_string(i), {{buffers_[i].size()}, lastCopy, kHostRead});
-            frame.bind(imports[i], buffers_[i]);
-        }
-        const Data& data = graph.addPass<Data>(
-            "readback", rg::Queue::Graphics,
-            [&](rg::Builder& b, Data& d) {
-                for (size_t i = 0; i < kBuffers; ++i) d.buffers[i] = b.read(buffers[i], rg::Access::TransferSrc);
-                for (size_t i = 0; i < kTextures; ++i) d.textures[i] = b.read(textures[i], rg::Access::TransferSrc);
-                for (size_t i = 0; i < imports.size(); ++i) d.targets[i] = b.write(imports[i], rg::Access::TransferDst);
-            },
-            [](const Data& d, rg::PassContext& pc) {
-                for (size_t i = 0; i < kBuffers; ++i) {
-                    const gpu::Buffer& target = pc.buffer(d.targets[i]);
-                    const VkBufferCopy region{0, 0, target.size()};
-                    vkCmdCopyBuffer(pc.cmd(), pc.buffer(d.buffers[i]).handle(), target.handle(), 1, &region);
-                }
-                for (size_t i = 0; i < kTextures; ++i) {
-                    const gpu::Image& image = pc.image(d.textures[i]);
-                    VkBufferImageCopy region{};
-                    region.imageSubresource = {image.aspect(), 0, 0, 1};
-                    region.imageExtent = {kSize, kSize, 1};
-                    vkCmdCopyImageToBuffer(pc.cmd(), image.handle(), VK_IMAGE_LAYOUT_TRANSFER_SRC_OPTIMAL,
-                                           pc.buffer(d.targets[kBuffers + i]).handle(), 1, &region);
-                }
-            });
-        for (const rg::Buffer& written : data.targets) {
-            graph.markOutput(written);
-        }
+        for (size_t i = 0; i < kBuffers; ++i) buffers_[i].copy(graph, frame, buffers[i]);
+        for (size_t i = 0; i < kTextures; ++i) buffers_[kBuffers + i].copy(graph, frame, textures[i]);
     }
 
     SslrFrame decode() const {
@@ -126,12 +91,12 @@ public:
         f.rays.resize(n);
         f.classes.resize(n);
         f.rtRays.resize(n);
-        std::memcpy(f.rays.data(), buffers_[0].mapped(), n * sizeof(shader::PackedRay));
-        std::memcpy(f.classes.data(), buffers_[1].mapped(), n * 4);
-        std::memcpy(f.rtRays.data(), buffers_[2].mapped(), n * sizeof(shader::PackedRay));
-        std::memcpy(f.rtArgs.data(), buffers_[3].mapped(), sizeof(f.rtArgs));
-        const auto halves = [](const gpu::Buffer& b, size_t i, int components) {
-            const uint16_t* h = reinterpret_cast<const uint16_t*>(b.mapped()) + i * components;
+        std::memcpy(f.rays.data(), buffers_[0].bytes().data(), n * sizeof(shader::PackedRay));
+        std::memcpy(f.classes.data(), buffers_[1].bytes().data(), n * 4);
+        std::memcpy(f.rtRays.data(), buffers_[2].bytes().data(), n * sizeof(shader::PackedRay));
+        std::memcpy(f.rtArgs.data(), buffers_[3].bytes().data(), sizeof(f.rtArgs));
+        const auto halves = [](const rg::HostReadback& b, size_t i, int components) {
+            const uint16_t* h = b.as<uint16_t>().data() + i * components;
             glm::vec4 v(0.0f);
             for (int c = 0; c < components; ++c) v[c] = glm::unpackHalf1x16(h[c]);
             return v;
@@ -157,7 +122,7 @@ public:
     }
 
 private:
-    std::array<gpu::Buffer, kBuffers + kTextures> buffers_;
+    std::vector<rg::HostReadback> buffers_;
 };
 
 // A mirror floor at y = -1 and a rough red wall at z = -6 from the floor
@@ -256,13 +221,13 @@ SslrFrame traceScene(test::GpuTest& gpu, const scene::Scene& scene, uint64_t fra
     // Every floor pixel is hybrid: SSLR first, RT for what it misses.
     passes::RayGenerationSettings raySettings;
     raySettings.rtMaxDistance = 0.0f;
-    raySettings.sslrMinDistance = 1e9f;
     raySettings.roughnessCutoff = roughnessCutoff;
     rg::Graph graph(executor.queueCaps());
     rg::FrameResources resources;
     const passes::GBufferOutputs gbuf = passes::addGBufferPass(graph, renderer, {camera});
     const passes::RayGenerationOutputs rays =
-        passes::addRayGenerationPass(graph, rayPipelines, {gbuf, frame, camera}, raySettings);
+        passes::addRayGenerationPass(graph, rayPipelines,
+                                     {gbuf, frame, camera, {}, passes::ReflectionMode::Hybrid, 1e9f}, raySettings);
     const passes::SslrOutputs sslr =
         passes::addSslrPass(graph, sslrPipelines, {gbuf, rays, frame, camera.view, camera.projection}, settings);
     readback.add(graph, rays, sslr, gbuf, resources);
@@ -323,7 +288,7 @@ TEST_CASE("SSLR finds the wall in a mirror floor within one texel, with its lit 
                     // Within one texel of the analytic hit.
                     REQUIRE(std::abs(got.x - expected.x) <= 1.0f);
                     REQUIRE(std::abs(got.y - expected.y) <= 1.0f);
-                    REQUIRE(f.confidence[i] > settings.confidenceThreshold);
+                    REQUIRE(f.confidence[i] > passes::kDefaultConfidenceThreshold);
                     const glm::vec3 rgb = f.radiance[i];
                     REQUIRE(glm::length(rgb - glm::vec3(wallLit)) <= 0.01f * glm::length(glm::vec3(wallLit)));
                 } else if (hit.y > kWallTop + 0.5f) {
@@ -351,8 +316,8 @@ TEST_CASE("SSLR lists exactly the hybrid rays below the confidence threshold for
             const bool leader = ray.pixelFlags != shader::kNoRay && (ray.pixelFlags & shader::kRayReused) == 0u;
             // Ray generation lists the RT pixels' leaders; SSLR appends its
             // unresolved hybrid ones.
-            if (leader && (f.classes[i] == shader::kPixelRt ||
-                           (f.classes[i] == shader::kPixelHybrid && f.confidence[i] < settings.confidenceThreshold))) {
+            const bool unresolved = f.confidence[i] < passes::kDefaultConfidenceThreshold;
+            if (leader && (f.classes[i] == shader::kPixelRt || (f.classes[i] == shader::kPixelHybrid && unresolved))) {
                 expected.insert(ray.pixelFlags);
             }
         }
@@ -471,13 +436,13 @@ PyramidFrame buildPyramid(test::GpuTest& gpu, const scene::Scene& scene, glm::uv
     camera.reset({glm::vec3(0.0f), glm::vec3(0, 0, -1), {0, 1, 0}}, 0);
     passes::RayGenerationSettings raySettings;
     raySettings.rtMaxDistance = 0.0f;
-    raySettings.sslrMinDistance = 1e9f;
     raySettings.roughnessCutoff = 0.5f;
     rg::Graph graph(executor.queueCaps());
     rg::FrameResources resources;
     const passes::GBufferOutputs gbuf = passes::addGBufferPass(graph, renderer, {camera});
     const passes::RayGenerationOutputs rays =
-        passes::addRayGenerationPass(graph, rayPipelines, {gbuf, 1, camera}, raySettings);
+        passes::addRayGenerationPass(graph, rayPipelines,
+                                     {gbuf, 1, camera, {}, passes::ReflectionMode::Hybrid, 1e9f}, raySettings);
     const passes::SslrOutputs sslr =
         passes::addSslrPass(graph, sslrPipelines, {gbuf, rays, 1, camera.view, camera.projection}, {});
     REQUIRE(sslr.litPyramid.valid());

@@ -1,4 +1,4 @@
-// The synthetic reflection frame (engine/graph/synthetic.h, shaped after
+// The synthetic reflection frame (glint/graph/synthetic.h, shaped after
 // DESIGN §3, its SSLR reading the TLAS as Far Cry 6's does) must compile to
 // the shape the technique asks for: BVH update on async compute overlapping
 // G-buffer and ray generation, graphics waiting for it exactly before SSLR;

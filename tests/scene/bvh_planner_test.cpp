@@ -283,10 +283,15 @@ TEST_CASE("the TLAS holds only instances within the radius; the long-range group
                                                          : glint::shader::kInstanceMaskWorld));
         CHECK(ti.sbtOffset == glint::shader::kSbtOffsetPackedPrimitives);
     }
-    BvhSettings wide;
-    wide.radius = 1000.0f;
-    BvhPlanner widePlanner(wide);
-    CHECK(widePlanner.plan(t.scene, {0, 0, 0}, 0).tlas.size() == 5);
+    BvhPlanner widePlanner;
+    CHECK(widePlanner.plan(t.scene, {0, 0, 0}, 0, 400.0f).tlas.size() == 5);
+    // The long-range group reaches at least as far as the frame's radius.
+    CHECK(widePlanner.plan(t.scene, {0, 0, 0}, 1, 1000.0f).tlas.size() == 6);
+    BvhSettings shortLongRange;
+    shortLongRange.longRangeRadius = 10.0f;
+    BvhPlanner shortPlanner(shortLongRange);
+    CHECK(shortPlanner.plan(t.scene, {0, 0, 0}, 0, 400.0f).tlas.size() == 5);
+    CHECK_THROWS_WITH_AS(BvhPlanner().plan(t.scene, {0, 0, 0}, 0, 0.0f), doctest::Contains("radius"), SceneError);
 }
 
 TEST_CASE("an object never within the radius gets no BLAS; one that arrives is built when it does") {

@@ -3,10 +3,9 @@
 // few frames from the start of a scene's camera path, for the GPU tests
 // that judge the composited image: the last frame's output read back.
 
-#include "glint/graph/transfer.h"
-
 #include "glint/graph/executor.h"
 #include "glint/graph/graph.h"
+#include "glint/graph/transfer.h"
 #include "glint/passes/reflection_frame.h"
 #include "glint/scene/camera.h"
 #include "glint/scene/scene.h"

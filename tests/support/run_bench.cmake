@@ -4,7 +4,7 @@
 # a row per configuration (three mode defaults and the quick sweeps), and
 # the JSON's provenance keys.
 cmake_policy(SET CMP0054 NEW)
-file(REMOVE ${OUT}/bench.csv ${OUT}/bench.json ${OUT}/bench.png)
+file(REMOVE ${OUT}/bench.csv ${OUT}/bench.json ${OUT}/bench.png ${OUT}/bench.svg)
 execute_process(COMMAND ${BENCH} --validate --scene plaza --quick --size 64x48 --frames 3
                         --reference-max-frames 64 --out-dir ${OUT}
                         --csv ${OUT}/bench.csv --json ${OUT}/bench.json --plot ${OUT}/bench.png
@@ -12,7 +12,7 @@ execute_process(COMMAND ${BENCH} --validate --scene plaza --quick --size 64x48 -
 if(NOT rc EQUAL 0)
   message(FATAL_ERROR "glint-bench exited with ${rc}")
 endif()
-foreach(f bench.csv bench.json bench.png)
+foreach(f bench.csv bench.json bench.png bench.svg bench.plot.json bench.plot.py)
   if(NOT EXISTS ${OUT}/${f})
     message(FATAL_ERROR "glint-bench did not write ${OUT}/${f}")
   endif()

@@ -84,7 +84,7 @@ struct SurfaceVertex {
 // geometry: offsets[customIndex + geometryIndex] is that geometry's first
 // triangle in the pool, so
 //     pool[offsets[gl_InstanceCustomIndexEXT + gl_GeometryIndexEXT] + gl_PrimitiveID]
-// is the hit triangle. The BVH planner fills both (engine/scene/bvh_planner.h).
+// is the hit triangle. The BVH planner fills both (glint/scene/bvh_planner.h).
 GLINT_FUNC uint primitiveOffsetSlot(uint instanceCustomIndex, uint geometryIndex) {
     return instanceCustomIndex + geometryIndex;
 }

@@ -93,7 +93,7 @@ GLINT_FUNC float scalarNoise(uvec2 pixel, uint frame, uint dimension) {
     return unitFromBits(seed + frame * step);
 }
 
-// Spatiotemporal blue noise (engine/sampling/blue_noise.h, generated at
+// Spatiotemporal blue noise (glint/sampling/blue_noise.h, generated at
 // build time): the same four uses from a 64 x 64 x 32 volume, one channel
 // each, the volume tiling the screen and frame t reading slice t mod 32.
 // Each pass through the 32 slices shifts the volume by an R2 step, so the
