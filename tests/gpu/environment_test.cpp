@@ -13,6 +13,7 @@
 #include "glint/gpu/pipeline.h"
 #include "glint/graph/executor.h"
 #include "glint/graph/graph.h"
+#include "glint/graph/transfer.h"
 #include "glint/passes/environment.h"
 #include "glint/passes/gbuffer.h"
 #include "glint/scene/image_io.h"
@@ -410,40 +411,17 @@ TEST_CASE("the G-buffer's sky pixels show an environment loaded from an .hdr fil
     passes::GBufferRenderer renderer(ctx, scene);
     const scene::Camera camera = test::testCamera();
     const uint32_t size = camera.resolution.x;
-    gpu::Buffer readback(ctx, {VkDeviceSize(size) * size * 8, VK_BUFFER_USAGE_TRANSFER_DST_BIT,
-                               gpu::MemoryUsage::Readback, "environment_test.lit"});
+    const rg::HostReadback readback(ctx, VkDeviceSize(size) * size * 8, "environment_test.lit");
     rg::Graph graph(executor.queueCaps());
     rg::FrameResources resources;
     const rg::Texture env = passes::importEnvironment(graph, map);
     REQUIRE(env.valid());
     map.bind(resources, env);
     const passes::GBufferOutputs gbuf = passes::addGBufferPass(graph, renderer, {camera, map.lighting({}), env}, {});
-    const rg::BoundaryState hostRead =
-        rg::BoundaryState::raw(VK_PIPELINE_STAGE_2_HOST_BIT, VK_ACCESS_2_HOST_READ_BIT, VK_IMAGE_LAYOUT_UNDEFINED);
-    const rg::Buffer target =
-        graph.importBuffer("lit", {{readback.size()}, rg::BoundaryState::of(rg::Access::None), hostRead});
-    resources.bind(target, readback);
-    struct Data {
-        rg::Texture lit;
-        rg::Buffer target;
-    };
-    const Data& copy = graph.addPass<Data>(
-        "readback", rg::Queue::Graphics,
-        [&](rg::Builder& b, Data& d) {
-            d.lit = b.read(gbuf.lit, rg::Access::TransferSrc);
-            d.target = b.write(target, rg::Access::TransferDst);
-        },
-        [size](const Data& d, rg::PassContext& pc) {
-            VkBufferImageCopy region{};
-            region.imageSubresource = {VK_IMAGE_ASPECT_COLOR_BIT, 0, 0, 1};
-            region.imageExtent = {size, size, 1};
-            vkCmdCopyImageToBuffer(pc.cmd(), pc.image(d.lit).handle(), VK_IMAGE_LAYOUT_TRANSFER_SRC_OPTIMAL,
-                                   pc.buffer(d.target).handle(), 1, &region);
-        });
-    graph.markOutput(copy.target);
+    readback.copy(graph, resources, gbuf.lit);
     executor.run(graph.compile(executor.compileOptions()), resources);
     executor.waitIdle();
-    const uint16_t* halves = reinterpret_cast<const uint16_t*>(readback.mapped());
+    const uint16_t* halves = readback.as<uint16_t>().data();
     const auto lit = [&](uint32_t x, uint32_t y) {
         const uint16_t* h = halves + (size_t(y) * size + x) * 4;
         return glm::vec3(glm::unpackHalf1x16(h[0]), glm::unpackHalf1x16(h[1]), glm::unpackHalf1x16(h[2]));

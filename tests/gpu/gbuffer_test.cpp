@@ -12,6 +12,7 @@
 #include "glint/gpu/error.h"
 #include "glint/graph/executor.h"
 #include "glint/graph/graph.h"
+#include "glint/graph/transfer.h"
 #include "glint/graph/verify.h"
 #include "glint/passes/gbuffer.h"
 #include "glint/scene/animation.h"
@@ -41,8 +42,6 @@ constexpr float kNear = test::kPassTestNear;
 using test::square;
 using test::testCamera;
 
-constexpr rg::BoundaryState kHostRead =
-    rg::BoundaryState::raw(VK_PIPELINE_STAGE_2_HOST_BIT, VK_ACCESS_2_HOST_READ_BIT, VK_IMAGE_LAYOUT_UNDEFINED);
 
 // Every G-buffer target of one frame, decoded on the host.
 struct GBufferImage {
@@ -64,49 +63,16 @@ class Readback {
 public:
     Readback(gpu::Context& ctx, uint32_t width, uint32_t height) : width_(width), height_(height) {
         const uint32_t bytes[6] = {4, 8, 4, 4, 4, 8};
-        for (size_t i = 0; i < buffers_.size(); ++i) {
-            buffers_[i] = gpu::Buffer(ctx, {VkDeviceSize(width) * height * bytes[i], VK_BUFFER_USAGE_TRANSFER_DST_BIT,
-                                            gpu::MemoryUsage::Readback, "gbuffer_test.readback" + std::to_string(i)});
+        for (size_t i = 0; i < 6; ++i) {
+            buffers_.emplace_back(ctx, VkDeviceSize(width) * height * bytes[i],
+                                  "gbuffer_test.readback" + std::to_string(i));
         }
     }
 
-    void add(rg::Graph& graph, const passes::GBufferOutputs& gbuf, rg::FrameResources& frame) {
-        struct Data {
-            std::array<rg::Texture, 6> sources;
-            std::array<rg::Buffer, 6> targets;
-        };
+    void add(rg::Graph& graph, const passes::GBufferOutputs& gbuf, rg::FrameResources& frame) const {
         const std::array<rg::Texture, 6> sources = {gbuf.depth, gbuf.normal, gbuf.albedo,
                                                     gbuf.roughnessMetal, gbuf.motion, gbuf.lit};
-        std::array<rg::Buffer, 6> imports;
-        // Frames reuse the buffers: each frame's copy follows the last one's.
-        const rg::BoundaryState lastCopy = rg::BoundaryState::of(rg::Access::TransferDst);
-        for (size_t i = 0; i < imports.size(); ++i) {
-            imports[i] =
-                graph.importBuffer("readback" + std::to_string(i), {{buffers_[i].size()}, lastCopy, kHostRead});
-            frame.bind(imports[i], buffers_[i]);
-        }
-        const uint32_t width = width_, height = height_;
-        const Data& data = graph.addPass<Data>(
-            "readback", rg::Queue::Graphics,
-            [&](rg::Builder& b, Data& d) {
-                for (size_t i = 0; i < sources.size(); ++i) {
-                    d.sources[i] = b.read(sources[i], rg::Access::TransferSrc);
-                    d.targets[i] = b.write(imports[i], rg::Access::TransferDst);
-                }
-            },
-            [width, height](const Data& d, rg::PassContext& pc) {
-                for (size_t i = 0; i < d.sources.size(); ++i) {
-                    const gpu::Image& image = pc.image(d.sources[i]);
-                    VkBufferImageCopy region{};
-                    region.imageSubresource = {image.aspect(), 0, 0, 1};
-                    region.imageExtent = {width, height, 1};
-                    vkCmdCopyImageToBuffer(pc.cmd(), image.handle(), VK_IMAGE_LAYOUT_TRANSFER_SRC_OPTIMAL,
-                                           pc.buffer(d.targets[i]).handle(), 1, &region);
-                }
-            });
-        for (const rg::Buffer& written : data.targets) {
-            graph.markOutput(written);
-        }
+        for (size_t i = 0; i < sources.size(); ++i) buffers_[i].copy(graph, frame, sources[i]);
     }
 
     GBufferImage decode() const {
@@ -115,9 +81,9 @@ public:
         out.height = height_;
         const size_t n = size_t(width_) * height_;
         out.depth.resize(n);
-        std::memcpy(out.depth.data(), buffers_[0].mapped(), n * sizeof(float));
-        const auto halves = [](const gpu::Buffer& b, size_t i, int components) {
-            const uint16_t* h = reinterpret_cast<const uint16_t*>(b.mapped()) + i * components;
+        std::memcpy(out.depth.data(), buffers_[0].bytes().data(), n * sizeof(float));
+        const auto halves = [](const rg::HostReadback& b, size_t i, int components) {
+            const uint16_t* h = b.as<uint16_t>().data() + i * components;
             glm::vec4 v(0.0f);
             for (int c = 0; c < components; ++c) v[c] = glm::unpackHalf1x16(h[c]);
             return v;
@@ -127,8 +93,8 @@ public:
         out.roughnessMetal.resize(n);
         out.motion.resize(n);
         out.lit.resize(n);
-        std::memcpy(out.albedo.data(), buffers_[2].mapped(), n * 4);
-        std::memcpy(out.roughnessMetal.data(), buffers_[3].mapped(), n * 4);
+        std::memcpy(out.albedo.data(), buffers_[2].bytes().data(), n * 4);
+        std::memcpy(out.roughnessMetal.data(), buffers_[3].bytes().data(), n * 4);
         for (size_t i = 0; i < n; ++i) {
             out.normal[i] = halves(buffers_[1], i, 4);
             out.motion[i] = glm::vec2(halves(buffers_[4], i, 2));
@@ -139,7 +105,7 @@ public:
 
 private:
     uint32_t width_, height_;
-    std::array<gpu::Buffer, 6> buffers_;
+    std::vector<rg::HostReadback> buffers_;
 };
 
 // One material, one mesh of the given geometry, one static instance.

@@ -17,6 +17,7 @@
 #include "glint/gpu/error.h"
 #include "glint/graph/executor.h"
 #include "glint/graph/graph.h"
+#include "glint/graph/transfer.h"
 #include "glint/graph/verify.h"
 #include "glint/passes/feedback.h"
 #include "glint/passes/gbuffer.h"
@@ -40,6 +41,7 @@
 #include <memory>
 #include <optional>
 #include <string>
+#include <span>
 #include <vector>
 
 using namespace glint;
@@ -52,8 +54,6 @@ constexpr size_t kPixels = size_t(kSize) * kSize;
 using test::square;
 using test::testCamera;
 
-constexpr rg::BoundaryState kHostRead =
-    rg::BoundaryState::raw(VK_PIPELINE_STAGE_2_HOST_BIT, VK_ACCESS_2_HOST_READ_BIT, VK_IMAGE_LAYOUT_UNDEFINED);
 constexpr rg::BoundaryState kHostWrite =
     rg::BoundaryState::raw(VK_PIPELINE_STAGE_2_HOST_BIT, VK_ACCESS_2_HOST_WRITE_BIT, VK_IMAGE_LAYOUT_UNDEFINED);
 
@@ -132,10 +132,8 @@ public:
     }
 
     template <class T> std::vector<T> get(size_t index) const {
-        const gpu::Buffer& b = *readbacks_.at(index);
-        std::vector<T> out(b.size() / sizeof(T));
-        std::memcpy(out.data(), b.mapped(), out.size() * sizeof(T));
-        return out;
+        const std::span<const T> values = readbacks_.at(index)->template as<T>();
+        return {values.begin(), values.end()};
     }
 
 private:
@@ -154,37 +152,10 @@ private:
     size_t read(rg::Graph& graph, rg::FrameResources& resources, rg::Texture texture, rg::Buffer buffer,
                 uint64_t bytes) {
         const size_t index = readbacks_.size();
-        readbacks_.push_back(std::make_unique<gpu::Buffer>(
-            ctx_, gpu::BufferDesc{bytes, VK_BUFFER_USAGE_TRANSFER_DST_BIT, gpu::MemoryUsage::Readback,
-                                  "integrate_test.readback" + std::to_string(index)}));
-        const rg::Buffer target = graph.importBuffer(
-            "readback" + std::to_string(index), {{bytes}, rg::BoundaryState::of(rg::Access::TransferDst), kHostRead});
-        resources.bind(target, *readbacks_.back());
-        struct Data {
-            rg::Texture texture;
-            rg::Buffer buffer, target;
-        };
-        const Data& data = graph.addPass<Data>(
-            "readback" + std::to_string(index), rg::Queue::Graphics,
-            [&](rg::Builder& b, Data& d) {
-                if (texture.valid()) d.texture = b.read(texture, rg::Access::TransferSrc);
-                if (buffer.valid()) d.buffer = b.read(buffer, rg::Access::TransferSrc);
-                d.target = b.write(target, rg::Access::TransferDst);
-            },
-            [](const Data& d, rg::PassContext& pc) {
-                const gpu::Buffer& dst = pc.buffer(d.target);
-                if (d.texture.valid()) {
-                    VkBufferImageCopy region{};
-                    region.imageSubresource = {VK_IMAGE_ASPECT_COLOR_BIT, 0, 0, 1};
-                    region.imageExtent = {kSize, kSize, 1};
-                    vkCmdCopyImageToBuffer(pc.cmd(), pc.image(d.texture).handle(), VK_IMAGE_LAYOUT_TRANSFER_SRC_OPTIMAL,
-                                           dst.handle(), 1, &region);
-                } else {
-                    const VkBufferCopy region{0, 0, dst.size()};
-                    vkCmdCopyBuffer(pc.cmd(), pc.buffer(d.buffer).handle(), dst.handle(), 1, &region);
-                }
-            });
-        graph.markOutput(data.target);
+        readbacks_.push_back(
+            std::make_unique<rg::HostReadback>(ctx_, bytes, "integrate_test.readback" + std::to_string(index)));
+        if (texture.valid()) readbacks_.back()->copy(graph, resources, texture);
+        if (buffer.valid()) readbacks_.back()->copy(graph, resources, buffer);
         return index;
     }
 
@@ -193,7 +164,7 @@ private:
     // the next frame's buffers reads to synchronization validation as a
     // hazard against the finished frame's copies.
     std::vector<std::unique_ptr<gpu::Buffer>> staging_;
-    std::vector<std::unique_ptr<gpu::Buffer>> readbacks_;
+    std::vector<std::unique_ptr<rg::HostReadback>> readbacks_;
 };
 
 // ---------------------------------------------------------------------------

@@ -18,6 +18,7 @@
 #include "glint/gpu/error.h"
 #include "glint/graph/executor.h"
 #include "glint/graph/graph.h"
+#include "glint/graph/transfer.h"
 #include "glint/graph/verify.h"
 #include "glint/passes/bvh_update.h"
 #include "glint/passes/gbuffer.h"
@@ -51,8 +52,6 @@ using test::square;
 
 constexpr rg::BoundaryState kHostWritten =
     rg::BoundaryState::raw(VK_PIPELINE_STAGE_2_HOST_BIT, VK_ACCESS_2_HOST_WRITE_BIT, VK_IMAGE_LAYOUT_UNDEFINED);
-constexpr rg::BoundaryState kHostRead =
-    rg::BoundaryState::raw(VK_PIPELINE_STAGE_2_HOST_BIT, VK_ACCESS_2_HOST_READ_BIT, VK_IMAGE_LAYOUT_UNDEFINED);
 
 size_t pixelIndex(glm::uvec2 p) { return size_t(p.y) * kSize + p.x; }
 
@@ -295,13 +294,6 @@ public:
         args_ = gpu::Buffer(ctx, {shader::kRayListArgsWords * sizeof(uint32_t),
                                   VK_BUFFER_USAGE_STORAGE_BUFFER_BIT | VK_BUFFER_USAGE_INDIRECT_BUFFER_BIT,
                                   gpu::MemoryUsage::Upload, "rt_test.ray_list_args"});
-        const VkDeviceSize pixels = VkDeviceSize(kSize) * kSize;
-        radianceReadback_ = gpu::Buffer(ctx, {pixels * 8, VK_BUFFER_USAGE_TRANSFER_DST_BIT, gpu::MemoryUsage::Readback,
-                                              "rt_test.readback.radiance"});
-        distanceReadback_ = gpu::Buffer(ctx, {pixels * 4, VK_BUFFER_USAGE_TRANSFER_DST_BIT, gpu::MemoryUsage::Readback,
-                                              "rt_test.readback.hit_distance"});
-        depthReadback_ = gpu::Buffer(ctx, {pixels * 4, VK_BUFFER_USAGE_TRANSFER_DST_BIT, gpu::MemoryUsage::Readback,
-                                              "rt_test.readback.depth"});
     }
 
     const scene::Scene& scene() const { return scene_; }
@@ -366,10 +358,10 @@ public:
         f.radianceBits.resize(n);
         f.radiance.resize(n);
         f.hitDistance.resize(n);
-        std::memcpy(f.radianceBits.data(), radianceReadback_.mapped(), n * 8);
-        std::memcpy(f.hitDistance.data(), distanceReadback_.mapped(), n * 4);
+        std::memcpy(f.radianceBits.data(), radianceReadback_.bytes().data(), n * 8);
+        std::memcpy(f.hitDistance.data(), distanceReadback_.bytes().data(), n * 4);
         f.depth.resize(n);
-        std::memcpy(f.depth.data(), depthReadback_.mapped(), n * 4);
+        std::memcpy(f.depth.data(), depthReadback_.bytes().data(), n * 4);
         for (size_t i = 0; i < n; ++i) {
             for (int c = 0; c < 4; ++c) f.radiance[i][c] = glm::unpackHalf1x16(f.radianceBits[i][c]);
         }
@@ -380,42 +372,10 @@ private:
     // Copies both outputs and the G-buffer's depth into host-visible
     // buffers inside the graph, under the graph's own barriers.
     void addReadback(rg::Graph& graph, const passes::RtTraceOutputs& out, rg::Texture depth,
-                     rg::FrameResources& resources) {
-        const rg::BoundaryState lastCopy = rg::BoundaryState::of(rg::Access::TransferDst);
-        const rg::Buffer radiance =
-            graph.importBuffer("rt_test.readback.radiance", {{radianceReadback_.size()}, lastCopy, kHostRead});
-        const rg::Buffer distance =
-            graph.importBuffer("rt_test.readback.hit_distance", {{distanceReadback_.size()}, lastCopy, kHostRead});
-        const rg::Buffer depthBuffer =
-            graph.importBuffer("rt_test.readback.depth", {{depthReadback_.size()}, lastCopy, kHostRead});
-        resources.bind(radiance, radianceReadback_);
-        resources.bind(distance, distanceReadback_);
-        resources.bind(depthBuffer, depthReadback_);
-        struct Data {
-            std::array<rg::Texture, 3> sources;
-            std::array<rg::Buffer, 3> targets;
-        };
-        const Data& data = graph.addPass<Data>(
-            "rt_test.readback", rg::Queue::Graphics,
-            [&](rg::Builder& b, Data& d) {
-                const std::array<rg::Texture, 3> sources = {out.radiance, out.hitDistance, depth};
-                const std::array<rg::Buffer, 3> targets = {radiance, distance, depthBuffer};
-                for (size_t i = 0; i < 3; ++i) {
-                    d.sources[i] = b.read(sources[i], rg::Access::TransferSrc);
-                    d.targets[i] = b.write(targets[i], rg::Access::TransferDst);
-                }
-            },
-            [](const Data& d, rg::PassContext& pc) {
-                for (size_t i = 0; i < 3; ++i) {
-                    const gpu::Image& image = pc.image(d.sources[i]);
-                    VkBufferImageCopy region{};
-                    region.imageSubresource = {image.aspect(), 0, 0, 1};
-                    region.imageExtent = {kSize, kSize, 1};
-                    vkCmdCopyImageToBuffer(pc.cmd(), image.handle(), VK_IMAGE_LAYOUT_TRANSFER_SRC_OPTIMAL,
-                                           pc.buffer(d.targets[i]).handle(), 1, &region);
-                }
-            });
-        for (const rg::Buffer& written : data.targets) graph.markOutput(written);
+                     rg::FrameResources& resources) const {
+        radianceReadback_.copy(graph, resources, out.radiance);
+        distanceReadback_.copy(graph, resources, out.hitDistance);
+        depthReadback_.copy(graph, resources, depth);
     }
 
     gpu::Context& ctx_;
@@ -427,7 +387,11 @@ private:
     passes::BvhManager bvh_;
     scene::BvhPlanner planner_;
     uint64_t frame_ = 0;
-    gpu::Buffer rays_, args_, radianceReadback_, distanceReadback_, depthReadback_;
+    gpu::Buffer rays_, args_;
+    static constexpr VkDeviceSize kPixels = VkDeviceSize(kSize) * kSize;
+    rg::HostReadback radianceReadback_{ctx_, kPixels * 8, "rt_test.readback.radiance"};
+    rg::HostReadback distanceReadback_{ctx_, kPixels * 4, "rt_test.readback.hit_distance"};
+    rg::HostReadback depthReadback_{ctx_, kPixels * 4, "rt_test.readback.depth"};
 };
 
 std::vector<passes::RtBackend> availableBackends(const gpu::Context& ctx) {

@@ -15,6 +15,7 @@
 #include "glint/gpu/error.h"
 #include "glint/graph/executor.h"
 #include "glint/graph/graph.h"
+#include "glint/graph/transfer.h"
 #include "glint/graph/verify.h"
 #include "glint/passes/composite.h"
 #include "glint/passes/gbuffer.h"
@@ -47,8 +48,6 @@ constexpr size_t kPixels = size_t(kSize) * kSize;
 using test::square;
 using test::testCamera;
 
-constexpr rg::BoundaryState kHostRead =
-    rg::BoundaryState::raw(VK_PIPELINE_STAGE_2_HOST_BIT, VK_ACCESS_2_HOST_READ_BIT, VK_IMAGE_LAYOUT_UNDEFINED);
 constexpr rg::BoundaryState kHostWrite =
     rg::BoundaryState::raw(VK_PIPELINE_STAGE_2_HOST_BIT, VK_ACCESS_2_HOST_WRITE_BIT, VK_IMAGE_LAYOUT_UNDEFINED);
 
@@ -70,15 +69,14 @@ public:
         std::memcpy(buffers_.back().mapped(), data, bytes);
         return buffers_.back();
     }
-    const gpu::Buffer& readback(size_t bytes) {
-        buffers_.emplace_back(ctx_, gpu::BufferDesc{bytes, VK_BUFFER_USAGE_TRANSFER_DST_BIT,
-                                                    gpu::MemoryUsage::Readback, "temporal_test.readback"});
-        return buffers_.back();
+    const rg::HostReadback& readback(size_t bytes, const std::string& name) {
+        return readbacks_.emplace_back(ctx_, bytes, "readback." + name);
     }
 
 private:
     gpu::Context& ctx_;
     std::deque<gpu::Buffer> buffers_;
+    std::deque<rg::HostReadback> readbacks_;
 };
 
 // A kSize x kSize texture of `format` filled from `data` by a copy inside
@@ -113,30 +111,9 @@ rg::Texture uploadTexture(rg::Graph& graph, rg::FrameResources& resources, Stagi
 // Copies a kSize x kSize texture into a new host buffer inside the graph.
 const gpu::Buffer& readTexture(rg::Graph& graph, rg::FrameResources& resources, Staging& staging, rg::Texture texture,
                                VkFormat format, const std::string& name) {
-    const gpu::Buffer& target = staging.readback(kPixels * gpu::bytesPerTexel(format));
-    const rg::Buffer imported =
-        graph.importBuffer(name, {{target.size()}, rg::BoundaryState::of(rg::Access::None), kHostRead});
-    resources.bind(imported, target);
-    struct Data {
-        rg::Texture source;
-        rg::Buffer target;
-    };
-    const Data& d = graph.addPass<Data>(
-        "readback." + name, rg::Queue::Graphics,
-        [&](rg::Builder& b, Data& data) {
-            data.source = b.read(texture, rg::Access::TransferSrc);
-            data.target = b.write(imported, rg::Access::TransferDst);
-        },
-        [](const Data& data, rg::PassContext& pc) {
-            const gpu::Image& image = pc.image(data.source);
-            VkBufferImageCopy region{};
-            region.imageSubresource = {image.aspect(), 0, 0, 1};
-            region.imageExtent = {kSize, kSize, 1};
-            vkCmdCopyImageToBuffer(pc.cmd(), image.handle(), VK_IMAGE_LAYOUT_TRANSFER_SRC_OPTIMAL,
-                                   pc.buffer(data.target).handle(), 1, &region);
-        });
-    graph.markOutput(d.target);
-    return target;
+    const rg::HostReadback& target = staging.readback(kPixels * gpu::bytesPerTexel(format), name);
+    target.copy(graph, resources, texture);
+    return target.buffer();
 }
 
 std::vector<glm::vec4> halves(const gpu::Buffer& b, int components) {
