@@ -1,6 +1,7 @@
 #include "glint/graph/transfer.h"
 
 #include "glint/graph/error.h"
+#include "glint/graph/ir.h"
 
 #include <algorithm>
 #include <memory>
@@ -15,6 +16,16 @@ constexpr size_t kUpdateLimit = 65536;
 
 constexpr BoundaryState kHostRead =
     BoundaryState::raw(VK_PIPELINE_STAGE_2_HOST_BIT, VK_ACCESS_2_HOST_READ_BIT, VK_IMAGE_LAYOUT_UNDEFINED);
+
+// The declared resource a handle names, or a GraphError naming the readback.
+template <class H>
+const ir::Resource& declared(const Graph& graph, H handle, const std::string& readback) {
+    if (!handle.valid() || handle.graph != graph.id() || handle.index >= graph.declaration().resources.size()) {
+        throw GraphError(ErrorKind::ForeignHandle, readback, "",
+                         "the readback's source is not a resource of this graph");
+    }
+    return graph.declaration().resources[handle.index];
+}
 
 } // namespace
 
@@ -45,11 +56,13 @@ HostReadback::HostReadback(gpu::Context& ctx, VkDeviceSize bytes, std::string na
       name_(std::move(name)) {}
 
 void HostReadback::copy(Graph& graph, FrameResources& resources, Texture texture) const {
-    const ir::Resource& source = graph.declaration().resources.at(texture.index);
-    const TextureDesc& desc = source.texture;
+    // Copied: declaring the import below may move the declaration's
+    // resources.
+    const TextureDesc desc = declared(graph, texture, name_).texture;
+    const std::string sourceName(declared(graph, texture, name_).name);
     const VkDeviceSize needed = VkDeviceSize(desc.width) * desc.height * desc.depth * gpu::bytesPerTexel(desc.format);
     if (needed > buffer_.size()) {
-        throw GraphError(ErrorKind::InvalidDescription, name_, source.name,
+        throw GraphError(ErrorKind::InvalidDescription, name_, sourceName,
                          "the readback holds " + std::to_string(buffer_.size()) + " bytes, the texture's mip 0 " +
                              std::to_string(needed));
     }
@@ -77,8 +90,7 @@ void HostReadback::copy(Graph& graph, FrameResources& resources, Texture texture
 }
 
 void HostReadback::copy(Graph& graph, FrameResources& resources, Buffer buffer) const {
-    const ir::Resource& source = graph.declaration().resources.at(buffer.index);
-    const VkDeviceSize size = std::min<VkDeviceSize>(source.buffer.size, buffer_.size());
+    const VkDeviceSize size = std::min<VkDeviceSize>(declared(graph, buffer, name_).buffer.size, buffer_.size());
     const Buffer target = graph.importBuffer(name_, {{buffer_.size()}, BoundaryState::of(Access::TransferDst), kHostRead});
     resources.bind(target, buffer_);
     struct Data {
