@@ -69,8 +69,8 @@ std::string bindingText(const Binding& b) {
 
 // The layout of a pipeline of `modules`: their reflected bindings, checked
 // against and completed by the description's (see ComputePipelineDesc).
-std::vector<Binding> resolveBindings(const std::vector<Binding>& declared, uint32_t& pushConstantBytes,
-                                     const std::vector<const ShaderModule*>& modules, const std::string& pipeline) {
+PipelineLayout layoutFor(Context& ctx, const std::vector<Binding>& declared, uint32_t pushConstantBytes,
+                         const std::vector<const ShaderModule*>& modules, const std::string& pipeline) {
     std::vector<ShaderInterface> stages;
     for (const ShaderModule* m : modules) stages.push_back(m->interface());
     const ShaderInterface merged = mergeInterfaces(stages, pipeline);
@@ -113,7 +113,7 @@ std::vector<Binding> resolveBindings(const std::vector<Binding>& declared, uint3
                        " bytes of push constants declared, the shaders' block has " +
                        std::to_string(merged.pushConstantBytes));
     }
-    return out;
+    return PipelineLayout(ctx, std::move(out), pushConstantBytes, pipeline);
 }
 
 } // namespace
@@ -233,8 +233,7 @@ Pipeline createComputePipeline(Context& ctx, const ComputePipelineDesc& desc) {
     p.name_ = desc.name.empty() ? desc.shader : desc.name;
     p.bindPoint_ = VK_PIPELINE_BIND_POINT_COMPUTE;
     ShaderModule module(ctx, desc.shader, VK_SHADER_STAGE_COMPUTE_BIT);
-    uint32_t pushBytes = desc.pushConstantBytes;
-    p.layout_ = PipelineLayout(ctx, resolveBindings(desc.bindings, pushBytes, {&module}, p.name_), pushBytes, p.name_);
+    p.layout_ = layoutFor(ctx, desc.bindings, desc.pushConstantBytes, {&module}, p.name_);
     VkComputePipelineCreateInfo info{VK_STRUCTURE_TYPE_COMPUTE_PIPELINE_CREATE_INFO};
     info.stage = {VK_STRUCTURE_TYPE_PIPELINE_SHADER_STAGE_CREATE_INFO};
     info.stage.stage = VK_SHADER_STAGE_COMPUTE_BIT;
@@ -255,8 +254,7 @@ Pipeline createGraphicsPipeline(Context& ctx, const GraphicsPipelineDesc& desc) 
     p.bindPoint_ = VK_PIPELINE_BIND_POINT_GRAPHICS;
     ShaderModule vs(ctx, desc.vertexShader, VK_SHADER_STAGE_VERTEX_BIT);
     ShaderModule fs(ctx, desc.fragmentShader, VK_SHADER_STAGE_FRAGMENT_BIT);
-    uint32_t pushBytes = desc.pushConstantBytes;
-    p.layout_ = PipelineLayout(ctx, resolveBindings(desc.bindings, pushBytes, {&vs, &fs}, p.name_), pushBytes, p.name_);
+    p.layout_ = layoutFor(ctx, desc.bindings, desc.pushConstantBytes, {&vs, &fs}, p.name_);
     VkPipelineShaderStageCreateInfo stages[2] = {{VK_STRUCTURE_TYPE_PIPELINE_SHADER_STAGE_CREATE_INFO},
                                                  {VK_STRUCTURE_TYPE_PIPELINE_SHADER_STAGE_CREATE_INFO}};
     stages[0].stage = VK_SHADER_STAGE_VERTEX_BIT;
@@ -381,8 +379,7 @@ Pipeline createRayTracingPipeline(Context& ctx, const RayTracingPipelineDesc& de
 
     std::vector<const ShaderModule*> reflected;
     for (const ShaderModule& m : modules) reflected.push_back(&m);
-    uint32_t pushBytes = desc.pushConstantBytes;
-    p.layout_ = PipelineLayout(ctx, resolveBindings(desc.bindings, pushBytes, reflected, p.name_), pushBytes, p.name_);
+    p.layout_ = layoutFor(ctx, desc.bindings, desc.pushConstantBytes, reflected, p.name_);
 
     VkRayTracingPipelineCreateInfoKHR info{VK_STRUCTURE_TYPE_RAY_TRACING_PIPELINE_CREATE_INFO_KHR};
     info.stageCount = static_cast<uint32_t>(stages.size());

@@ -55,19 +55,27 @@ HostReadback::HostReadback(gpu::Context& ctx, VkDeviceSize bytes, std::string na
     : buffer_(ctx, {bytes, VK_BUFFER_USAGE_TRANSFER_DST_BIT, gpu::MemoryUsage::Readback, name}),
       name_(std::move(name)) {}
 
+Buffer HostReadback::importTarget(Graph& graph, FrameResources& resources) const {
+    // Left by the last frame's copy, read by the host after this one's.
+    const Buffer target =
+        graph.importBuffer(name_, {{buffer_.size()}, BoundaryState::of(Access::TransferDst), kHostRead});
+    resources.bind(target, buffer_);
+    return target;
+}
+
 void HostReadback::copy(Graph& graph, FrameResources& resources, Texture texture) const {
     // Copied: declaring the import below may move the declaration's
     // resources.
-    const TextureDesc desc = declared(graph, texture, name_).texture;
-    const std::string sourceName(declared(graph, texture, name_).name);
+    const ir::Resource& source = declared(graph, texture, name_);
+    const TextureDesc desc = source.texture;
+    const std::string sourceName(source.name);
     const VkDeviceSize needed = VkDeviceSize(desc.width) * desc.height * desc.depth * gpu::bytesPerTexel(desc.format);
     if (needed > buffer_.size()) {
         throw GraphError(ErrorKind::InvalidDescription, name_, sourceName,
                          "the readback holds " + std::to_string(buffer_.size()) + " bytes, the texture's mip 0 " +
                              std::to_string(needed));
     }
-    const Buffer target = graph.importBuffer(name_, {{buffer_.size()}, BoundaryState::of(Access::TransferDst), kHostRead});
-    resources.bind(target, buffer_);
+    const Buffer target = importTarget(graph, resources);
     struct Data {
         Texture source;
         Buffer target;
@@ -91,8 +99,7 @@ void HostReadback::copy(Graph& graph, FrameResources& resources, Texture texture
 
 void HostReadback::copy(Graph& graph, FrameResources& resources, Buffer buffer) const {
     const VkDeviceSize size = std::min<VkDeviceSize>(declared(graph, buffer, name_).buffer.size, buffer_.size());
-    const Buffer target = graph.importBuffer(name_, {{buffer_.size()}, BoundaryState::of(Access::TransferDst), kHostRead});
-    resources.bind(target, buffer_);
+    const Buffer target = importTarget(graph, resources);
     struct Data {
         Buffer source;
         Buffer target;

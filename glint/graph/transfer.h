@@ -68,6 +68,9 @@ public:
     const std::string& name() const { return name_; }
 
 private:
+    // This buffer as the frame's import, bound in `resources`.
+    Buffer importTarget(Graph& graph, FrameResources& resources) const;
+
     gpu::Buffer buffer_;
     std::string name_;
 };
