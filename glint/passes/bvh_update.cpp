@@ -57,6 +57,20 @@ std::vector<shader::BvhSourceVertex> sourceVertices(const scene::Scene& scene, c
     return vertices;
 }
 
+// Where a world point on `instance` this frame was last frame: its last
+// transform after the inverse of this one (in double: a far instance's
+// float inverse would move still points). Identity for a still instance.
+glm::mat4 instanceMotion(const scene::Instance& instance) {
+    if (instance.previousTransform == instance.transform) return glm::mat4(1.0f);
+    return glm::mat4(glm::dmat4(instance.previousTransform) * glm::inverse(glm::dmat4(instance.transform)));
+}
+
+void setPreviousFromCurrent(shader::RtGeometryMaterial& row, const glm::mat4& m) {
+    for (int r = 0; r < 3; ++r) {
+        row.previousFromCurrent[r] = glm::vec4(m[0][r], m[1][r], m[2][r], m[3][r]);  // glm is column-major
+    }
+}
+
 VkPipelineStageFlags2 traceStages(const gpu::Capabilities& caps) {
     VkPipelineStageFlags2 stages = VK_PIPELINE_STAGE_2_COMPUTE_SHADER_BIT;
     if (caps.rayTracingPipeline) {
@@ -618,6 +632,7 @@ std::shared_ptr<BvhManager::FrameWork> BvhManager::prepare(const scene::BvhPlan&
     shader::RtGeometryMaterial unused{};
     unused.alphaTriangles = shader::kAlphaOpaque;
     unused.alphaMask = shader::kAlphaNoMask;
+    setPreviousFromCurrent(unused, glm::mat4(1.0f));
     work->materials.assign(plan.primitiveOffsets.size(), unused);
     work->instances.reserve(plan.tlas.size());
     for (const scene::TlasInstance& ti : plan.tlas) {
@@ -626,11 +641,15 @@ std::shared_ptr<BvhManager::FrameWork> BvhManager::prepare(const scene::BvhPlan&
             throw gpu::GpuError("BVH update: TLAS instance of scene instance " + std::to_string(ti.sceneInstance) +
                                 " uses BLAS " + std::to_string(ti.blas) + ", which was never built");
         }
-        // The material rows beside the offset rows the planner wrote.
+        // The material rows beside the offset rows the planner wrote, each
+        // with its instance's motion since last frame.
         const std::vector<shader::RtGeometryMaterial>& rows = it->second->materialRows;
+        const glm::mat4 previousFromCurrent = instanceMotion(scene_.instances.at(ti.sceneInstance));
         for (size_t g = 0; g < rows.size(); ++g) {
             const size_t row = shader::primitiveOffsetSlot(ti.customIndex, uint32_t(g));
-            if (row < work->materials.size()) work->materials[row] = rows[g];
+            if (row >= work->materials.size()) continue;
+            work->materials[row] = rows[g];
+            setPreviousFromCurrent(work->materials[row], previousFromCurrent);
         }
         const auto transform = scene::rowMajor3x4(ti.transform);
         // glTF's front faces wind counter-clockwise in its right-handed

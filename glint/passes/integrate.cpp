@@ -60,8 +60,10 @@ IntegrateOutputs addIntegratePass(rg::Graph& graph, IntegratePipelines& pipeline
     if (inputs.sslr && (inputs.sslr->width != gbuf.width || inputs.sslr->height != gbuf.height)) {
         throw gpu::GpuError("addIntegratePass: the SSLR outputs must have the G-buffer's size");
     }
-    if (inputs.rtRadiance.valid() != inputs.rtHitDistance.valid()) {
-        throw gpu::GpuError("addIntegratePass: give the ray tracer's radiance and hit distance together, or neither");
+    if (inputs.rtRadiance.valid() != inputs.rtHitDistance.valid() ||
+        (inputs.rtHitMotion.valid() && !inputs.rtRadiance.valid())) {
+        throw gpu::GpuError("addIntegratePass: give the ray tracer's radiance and hit distance together, or neither "
+                            "(its hit motion only with them)");
     }
     const bool hasFeedback = feedback.counters.current.valid();
     if (hasFeedback && (!feedback.reprojected.valid() || feedback.tilesX != rays.tilesX ||
@@ -85,22 +87,27 @@ IntegrateOutputs addIntegratePass(rg::Graph& graph, IntegratePipelines& pipeline
 
     shader::IntegrateConstants constants{};
     constants.inverseViewProjection = glm::inverse(inputs.camera.viewProjection());
+    constants.previousViewProjection = inputs.camera.previousViewProjection();
+    constants.previousInverseViewProjection = glm::inverse(constants.previousViewProjection);
     constants.cameraPosition = glm::vec4(inputs.camera.position, 1.0f);
+    constants.previousCameraPosition = glm::vec4(inputs.camera.previousPosition, 1.0f);
     constants.lighting = inputs.lighting;
     constants.size = {gbuf.width, gbuf.height};
     constants.tiles = {tilesX, tilesY};
     constants.confidenceThreshold = sslrStoredThreshold(inputs.confidenceThreshold);
     constants.particlesBound = hasParticles ? 1u : 0u;
     constants.rtMissesTrusted = settings.rtMissesTrusted ? 1u : 0u;
+    constants.rtHitMotionBound = inputs.rtHitMotion.valid() ? 1u : 0u;
 
     // The constants outgrow push constants (glint/integrate_shared.h); a
     // transfer inside the frame keeps their lifetime the graph's.
     const rg::Buffer uploaded = rg::addUpload(graph, "integrate.constants", constants);
 
     struct IntegrateData {
-        rg::Texture depth, normal, roughnessMetal;
+        rg::Texture depth, normal, roughnessMetal, motion;
         rg::Buffer constants, rays, classes, reprojected;
         rg::Texture sslrRadiance, sslrConfidence, sslrHit, rtRadiance, rtHitDistance;
+        rg::Texture rtHitMotion;  // the trace's hit motion, or its hit distance as a stand-in (never read)
         rg::Texture particles;    // the particle trace, or the normal as a stand-in (never read)
         rg::Texture environment;  // the prefiltered image, or the normal as a stand-in (never read)
         IntegrateOutputs out;
@@ -111,6 +118,7 @@ IntegrateOutputs addIntegratePass(rg::Graph& graph, IntegratePipelines& pipeline
             d.depth = b.read(gbuf.depth, rg::Access::SampledRead);
             d.normal = b.read(gbuf.normal, rg::Access::SampledRead);
             d.roughnessMetal = b.read(gbuf.roughnessMetal, rg::Access::SampledRead);
+            d.motion = b.read(gbuf.motion, rg::Access::SampledRead);
             // The shader declares the particles in every variant (one flag
             // in the constants rather than twice the variants); without
             // them a texture this pass reads anyway fills the binding.
@@ -127,6 +135,8 @@ IntegrateOutputs addIntegratePass(rg::Graph& graph, IntegratePipelines& pipeline
             if (hasRt) {
                 d.rtRadiance = b.read(inputs.rtRadiance, rg::Access::SampledRead);
                 d.rtHitDistance = b.read(inputs.rtHitDistance, rg::Access::SampledRead);
+                d.rtHitMotion = inputs.rtHitMotion.valid() ? b.read(inputs.rtHitMotion, rg::Access::SampledRead)
+                                                           : d.rtHitDistance;
             }
             d.out = out;
             const auto texture = [&](const char* name, VkFormat format) {
@@ -135,6 +145,7 @@ IntegrateOutputs addIntegratePass(rg::Graph& graph, IntegratePipelines& pipeline
             };
             d.out.radiance = texture("integrate.radiance", kReflectionRadianceFormat);
             d.out.hitDistance = texture("integrate.hit_distance", kReflectionHitDistanceFormat);
+            d.out.hitMotion = texture("integrate.hit_motion", kReflectionHitMotionFormat);
             d.out.sourceDebug = texture("integrate.source_debug", kReflectionSourceDebugFormat);
             if (hasFeedback) {
                 d.reprojected = b.read(feedback.reprojected, rg::Access::StorageRead);
@@ -150,11 +161,13 @@ IntegrateOutputs addIntegratePass(rg::Graph& graph, IntegratePipelines& pipeline
             push.sampledImage("depthTexture", pc.view(d.depth), sampler, pc.layout(d.depth))
                 .sampledImage("normalTexture", pc.view(d.normal), sampler, pc.layout(d.normal))
                 .sampledImage("roughnessMetalTexture", pc.view(d.roughnessMetal), sampler, pc.layout(d.roughnessMetal))
+                .sampledImage("motionTexture", pc.view(d.motion), sampler, pc.layout(d.motion))
                 .storageBuffer("Constants", pc.buffer(d.constants))
                 .storageBuffer("Rays", pc.buffer(d.rays))
                 .storageBuffer("Classes", pc.buffer(d.classes))
                 .storageImage("radianceImage", pc.view(d.out.radiance))
                 .storageImage("hitDistanceImage", pc.view(d.out.hitDistance))
+                .storageImage("hitMotionImage", pc.view(d.out.hitMotion))
                 .storageImage("sourceImage", pc.view(d.out.sourceDebug))
                 .sampledImage("particlesTexture", pc.view(d.particles), sampler, pc.layout(d.particles))
                 .sampledImage("environmentTexture", pc.view(d.environment),
@@ -173,7 +186,8 @@ IntegrateOutputs addIntegratePass(rg::Graph& graph, IntegratePipelines& pipeline
             if ((variant & kVariantRt) != 0) {
                 push.sampledImage("rtRadianceTexture", pc.view(d.rtRadiance), sampler, pc.layout(d.rtRadiance))
                     .sampledImage("rtHitDistanceTexture", pc.view(d.rtHitDistance), sampler,
-                                  pc.layout(d.rtHitDistance));
+                                  pc.layout(d.rtHitDistance))
+                    .sampledImage("rtHitMotionTexture", pc.view(d.rtHitMotion), sampler, pc.layout(d.rtHitMotion));
             }
             push.push(pipelines.ctx_, pc.cmd());
             pc.dispatch(pipeline, (d.out.width + shader::kTileSize - 1) / shader::kTileSize,

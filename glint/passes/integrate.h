@@ -51,6 +51,7 @@ namespace glint::passes {
 
 inline constexpr VkFormat kReflectionRadianceFormat = VK_FORMAT_R16G16B16A16_SFLOAT;
 inline constexpr VkFormat kReflectionHitDistanceFormat = VK_FORMAT_R32_SFLOAT;
+inline constexpr VkFormat kReflectionHitMotionFormat = VK_FORMAT_R16G16B16A16_SFLOAT;
 inline constexpr VkFormat kReflectionSourceDebugFormat = VK_FORMAT_R8G8B8A8_UNORM;
 
 struct IntegrateInputs {
@@ -61,6 +62,9 @@ struct IntegrateInputs {
     // RGBA16F radiance, a = 1 where traced (at ray leaders); R32F hit distance.
     rg::Texture rtRadiance;
     rg::Texture rtHitDistance;
+    // Optional, with them: the ray tracer's hit motion (RtTraceOutputs::
+    // hitMotion); without it the traced hits count as still.
+    rg::Texture rtHitMotion;
     FeedbackOutputs feedback;          // reprojected in, counters.current out
     // Optional: the particle trace's radiance (passes/particles.h,
     // ParticleTraceOutputs::radiance: RGBA16F, premultiplied rgb, a =
@@ -97,6 +101,11 @@ struct IntegrateSettings {
 struct IntegrateOutputs {
     rg::Texture radiance;     // kReflectionRadianceFormat: reflected radiance, a = 1 where a surface reflects
     rg::Texture hitDistance;  // kReflectionHitDistanceFormat: world units; kMissHitDistance for env/miss/sky
+    // kReflectionHitMotionFormat: xyz, where the reflected point was last
+    // frame minus where it is (world units): a ray-traced hit's instance
+    // motion, an SSLR hit's G-buffer motion at the hit (at the view depth
+    // last frame's camera gives it); zero at infinity.
+    rg::Texture hitMotion;
     rg::Texture sourceDebug;  // kReflectionSourceDebugFormat: a colour per source (debug view "reflection_source")
     rg::Buffer counters;      // the new version of feedback.counters.current (invalid without feedback)
     uint32_t width = 0;

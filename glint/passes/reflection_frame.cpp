@@ -221,6 +221,7 @@ ReflectionFrame ReflectionRenderer::addFrame(rg::Graph& graph, const scene::Came
     if (f.rt) {
         integrateInputs.rtRadiance = f.rt->radiance;
         integrateInputs.rtHitDistance = f.rt->hitDistance;
+        integrateInputs.rtHitMotion = f.rt->hitMotion;
     }
     if (f.feedback) {
         integrateInputs.feedback = *f.feedback;
@@ -240,6 +241,9 @@ ReflectionFrame ReflectionRenderer::addFrame(rg::Graph& graph, const scene::Came
     temporalInputs.gbuffer = f.gbuffer;
     temporalInputs.radiance = f.integrate.radiance;
     temporalInputs.hitDistance = f.integrate.hitDistance;
+    if (settings.reflectedMotion) {
+        temporalInputs.hitMotion = f.integrate.hitMotion;
+    }
     temporalInputs.camera = camera;
     temporalInputs.frameIndex = frameIndex;
     temporalInputs.resetHistory = settings.resetHistory;

@@ -102,6 +102,12 @@ struct ReflectionFrameSettings {
     // (RayGenerationSettings::sslrFirst, IntegrateSettings::rtMissesTrusted).
     // Off: the incomplete BVH is traced as it is.
     bool sslrWhileBvhBuilds = true;
+    // Reflected objects carry their own motion: temporal accumulation
+    // reprojects a reflection through where its reflected point was last
+    // frame (a ray-traced hit's instance motion, an SSLR hit's G-buffer
+    // motion; IntegrateOutputs::hitMotion). Off: only the camera's motion
+    // reprojects, and a moving object's reflection smears behind it.
+    bool reflectedMotion = true;
     // Empty or "final": the composited image; otherwise one of
     // debugViews(), shown in `output` instead.
     std::string debugView;

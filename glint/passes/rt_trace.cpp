@@ -201,23 +201,26 @@ RtTraceOutputs addRtTracePass(rg::Graph& graph, RtTracePipelines& pipelines, con
     };
     rg::Texture radiance = texture("rt_trace.radiance", kRtRadianceFormat);
     rg::Texture hitDistance = texture("rt_trace.hit_distance", kRtHitDistanceFormat);
+    rg::Texture hitMotion = texture("rt_trace.hit_motion", kRtHitMotionFormat);
     if (settings.clearUntraced) {
         struct ClearData {
-            rg::Texture radiance, hitDistance;
+            rg::Texture radiance, hitDistance, hitMotion;
         };
         const ClearData& clear = graph.addPass<ClearData>(
             "rt_trace.clear", rg::Queue::Graphics,
             [&](rg::Builder& b, ClearData& d) {
                 d.radiance = b.write(radiance, rg::Access::StorageWrite);
                 d.hitDistance = b.write(hitDistance, rg::Access::StorageWrite);
+                d.hitMotion = b.write(hitMotion, rg::Access::StorageWrite);
             },
             [&pipelines](const ClearData& d, rg::PassContext& pc) {
-                for (const rg::Texture t : {d.radiance, d.hitDistance}) {
+                for (const rg::Texture t : {d.radiance, d.hitDistance, d.hitMotion}) {
                     pipelines.clearer_.clear(pc, t);
                 }
             });
         radiance = clear.radiance;
         hitDistance = clear.hitDistance;
+        hitMotion = clear.hitMotion;
     }
 
     struct TraceData {
@@ -253,6 +256,7 @@ RtTraceOutputs addRtTracePass(rg::Graph& graph, RtTracePipelines& pipelines, con
             d.out.height = gbuf.height;
             d.out.radiance = b.write(radiance, rg::Access::StorageWrite);
             d.out.hitDistance = b.write(hitDistance, rg::Access::StorageWrite);
+            d.out.hitMotion = b.write(hitMotion, rg::Access::StorageWrite);
         },
         [&pipelines, backend](const TraceData& d, rg::PassContext& pc) {
             const gpu::Pipeline& pipeline = backend == RtBackend::RayQuery ? *pipelines.query_ : *pipelines.pipeline_;
@@ -278,6 +282,7 @@ RtTraceOutputs addRtTracePass(rg::Graph& graph, RtTracePipelines& pipelines, con
                 .storageBuffer("Constants", pc.buffer(d.constants))
                 .storageImage("radianceImage", pc.view(d.out.radiance))
                 .storageImage("hitDistanceImage", pc.view(d.out.hitDistance))
+                .storageImage("hitMotionImage", pc.view(d.out.hitMotion))
                 .push(pc.gpu(), pc.cmd());
             if (backend == RtBackend::RayQuery) {
                 pc.dispatchIndirect(pipeline, d.rayListArgs, kDispatchArgsBytes);

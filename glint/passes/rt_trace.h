@@ -31,7 +31,7 @@
 //   each frame, after SSLR (which completes the RT list):
 //     const auto rt = passes::addRtTracePass(graph, rtPipelines,
 //         {gbuf, rays.rtRays, rays.rtArgs, bvh, passes::sceneLighting(scene, gbufSettings.lighting), camera, frame});
-//     ... integrate reads rt.radiance and rt.hitDistance ...
+//     ... integrate reads rt.radiance, rt.hitDistance and rt.hitMotion ...
 
 #include "glint/gpu/context.h"
 #include "glint/gpu/pipeline.h"
@@ -51,6 +51,7 @@ namespace glint::passes {
 
 inline constexpr VkFormat kRtRadianceFormat = VK_FORMAT_R16G16B16A16_SFLOAT;
 inline constexpr VkFormat kRtHitDistanceFormat = VK_FORMAT_R32_SFLOAT;
+inline constexpr VkFormat kRtHitMotionFormat = VK_FORMAT_R16G16B16A16_SFLOAT;
 
 // Auto: ray query where the device has it (one compute dispatch, no shader
 // binding table), else the ray tracing pipeline.
@@ -125,6 +126,11 @@ struct RtTraceOutputs {
     // kRtHitDistanceFormat: world distance to the hit; kMissHitDistance
     // (glint/ray_generation_shared.h) on a miss; at the listed rays' pixels.
     rg::Texture hitDistance;
+    // kRtHitMotionFormat: xyz, where the hit point was last frame minus
+    // where it is, in world units (its instance's motion, the BVH's
+    // material rows; zero on a miss); at the listed rays' pixels. Temporal
+    // accumulation reprojects a moving object's reflection with it.
+    rg::Texture hitMotion;
     uint32_t width = 0;
     uint32_t height = 0;
 };

@@ -61,6 +61,7 @@ shader::TemporalFrame frameConstants(const TemporalInputs& in, const TemporalSet
     f.spatialNormalPower = s.spatialNormalPower;
     f.spatialRoughnessSigma = s.spatialRoughnessSigma;
     f.spatialRoughnessMax = s.spatialRoughnessMax;
+    f.hitMotionBound = in.hitMotion.valid() ? 1u : 0u;
     return f;
 }
 
@@ -86,7 +87,8 @@ TemporalOutputs addTemporalPass(rg::Graph& graph, TemporalPipelines& pipelines, 
         throw gpu::GpuError("addTemporalPass: the radiance and the hit distance are required");
     }
     checkSettings(settings);
-    for (const rg::Texture t : {inputs.radiance, inputs.hitDistance}) {
+    for (const rg::Texture t : {inputs.radiance, inputs.hitDistance, inputs.hitMotion}) {
+        if (!t.valid()) continue;
         if (t.graph == graph.id() && t.index < graph.declaration().resources.size()) {
             const rg::TextureDesc& d = graph.declaration().resources[t.index].texture;
             if (d.width != gbuf.width || d.height != gbuf.height) {
@@ -119,6 +121,7 @@ TemporalOutputs addTemporalPass(rg::Graph& graph, TemporalPipelines& pipelines, 
     struct AccumulateData {
         rg::Buffer frame;
         rg::Texture depth, normal, roughnessMetal, motion, radiance, hitDistance, previousRadiance, previousSurface;
+        rg::Texture hitMotion;  // the reflected points' motion, or the hit distance as a stand-in (never read)
         rg::Texture radianceOut, surfaceOut, motionOut, lengthOut;
     };
     const AccumulateData& accumulate = graph.addPass<AccumulateData>(
@@ -131,6 +134,7 @@ TemporalOutputs addTemporalPass(rg::Graph& graph, TemporalPipelines& pipelines, 
             d.motion = b.read(gbuf.motion, rg::Access::SampledRead);
             d.radiance = b.read(inputs.radiance, rg::Access::SampledRead);
             d.hitDistance = b.read(inputs.hitDistance, rg::Access::SampledRead);
+            d.hitMotion = inputs.hitMotion.valid() ? b.read(inputs.hitMotion, rg::Access::SampledRead) : d.hitDistance;
             d.previousRadiance = b.read(radianceHistory.previous, rg::Access::SampledRead);
             d.previousSurface = b.read(surfaceHistory.previous, rg::Access::SampledRead);
             d.radianceOut = b.write(radianceHistory.current, rg::Access::StorageWrite);
@@ -152,6 +156,7 @@ TemporalOutputs addTemporalPass(rg::Graph& graph, TemporalPipelines& pipelines, 
                 .sampledImage("motionTexture", pc.view(d.motion), sampler, pc.layout(d.motion))
                 .sampledImage("radianceTexture", pc.view(d.radiance), sampler, pc.layout(d.radiance))
                 .sampledImage("hitDistanceTexture", pc.view(d.hitDistance), sampler, pc.layout(d.hitDistance))
+                .sampledImage("hitMotionTexture", pc.view(d.hitMotion), sampler, pc.layout(d.hitMotion))
                 .sampledImage("previousRadianceTexture", pc.view(d.previousRadiance), sampler,
                               pc.layout(d.previousRadiance))
                 .sampledImage("previousSurfaceTexture", pc.view(d.previousSurface), sampler,

@@ -6,6 +6,7 @@
 //   temporal.accumulate  per pixel: sanitise this frame's radiance (NaN and
 //                        Inf never reach the history), reproject through the
 //                        reflected (virtual) point at the hit distance and
+//                        (moved by the reflected object's own motion) and
 //                        through the surface (G-buffer motion), blend the two
 //                        by roughness, reject history whose surface differs
 //                        (plane, normal, roughness: disocclusions), clip it
@@ -50,6 +51,11 @@ struct TemporalInputs {
     GBufferOutputs gbuffer;   // depth, normal, roughnessMetal, motion
     rg::Texture radiance;     // reflection radiance (any float format), a > 0 where a surface reflects
     rg::Texture hitDistance;  // r: distance to the reflected hit; >= shader::kMissHitDistance: at infinity
+    // Optional: xyz, where the reflected point was last frame minus where it
+    // is (world units; IntegrateOutputs::hitMotion). A moving object's
+    // reflection is reprojected with it; without it reflected points count
+    // as still and only the camera's motion reprojects.
+    rg::Texture hitMotion;
     // This and last frame's unjittered matrices and positions (the
     // G-buffer's camera).
     scene::Camera camera;

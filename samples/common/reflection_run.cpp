@@ -50,7 +50,7 @@ constexpr std::array<bool, 3> kEveryMode{true, true, true};
 
 // The one table of parameters: name, field, the viewer's range, the
 // bench's sweep, and where the value lives.
-const std::array<ParameterSlot, 16> kParameters = {{
+const std::array<ParameterSlot, 17> kParameters = {{
     // A confidence; the talk's 0.9 (default) bracketed from "trust SSLR
     // often" to "almost never".
     {{"sslr_threshold", "ReflectionFrameSettings::confidenceThreshold", 0.0f, 1.0f, false, {0.5, 0.7, 0.8, 0.95, 0.99},
@@ -120,6 +120,11 @@ const std::array<ParameterSlot, 16> kParameters = {{
     {{"blue_noise", "RayGenerationSettings::blueNoise (1: spatiotemporal blue noise, 0: hashed sequences)", 0.0f,
       1.0f, true, {0}, {0}, kEveryMode},
      nullptr, nullptr, [](ReflectionRunOptions& o) { return &o.frame.rays.blueNoise; }},
+    // Reflected objects' own motion in the reprojection (default on): off,
+    // only the camera's motion reprojects (what moving objects' trails
+    // were before it).
+    {{"reflected_motion", "ReflectionFrameSettings::reflectedMotion (0 or 1)", 0.0f, 1.0f, true, {}, {}, {}}, nullptr,
+     nullptr, [](ReflectionRunOptions& o) { return &o.frame.reflectedMotion; }},
 }};
 
 const ParameterSlot& findParameter(std::string_view name) {

@@ -30,6 +30,11 @@ layout(set = 0, binding = 5, scalar) readonly buffer Classes { uint classes[]; }
 layout(set = 0, binding = 6, rgba16f) uniform writeonly image2D radianceImage;
 layout(set = 0, binding = 7, r32f) uniform writeonly image2D hitDistanceImage;
 layout(set = 0, binding = 8, rgba8) uniform writeonly image2D sourceImage;
+// RGBA16F has no required storage format: the context enables
+// shaderStorageImageWriteWithoutFormat.
+layout(set = 0, binding = 18) uniform writeonly image2D hitMotionImage;
+// The G-buffer's motion (pixels to last frame): an SSLR hit's motion.
+layout(set = 0, binding = 19) uniform sampler2D motionTexture;
 #if GLINT_INTEGRATE_FEEDBACK
 layout(set = 0, binding = 9, scalar) readonly buffer Reprojected { uint reprojected[]; };
 layout(set = 0, binding = 10, scalar) writeonly buffer Counters { uint counters[]; };
@@ -42,6 +47,8 @@ layout(set = 0, binding = 13) uniform sampler2D sslrHitTexture;
 #if GLINT_INTEGRATE_RT
 layout(set = 0, binding = 14) uniform sampler2D rtRadianceTexture;
 layout(set = 0, binding = 15) uniform sampler2D rtHitDistanceTexture;
+// Read where C.rtHitMotionBound says it holds the trace's hit motion.
+layout(set = 0, binding = 20) uniform sampler2D rtHitMotionTexture;
 #endif
 
 // The particle trace's radiance (passes/particles.h): bound in every
@@ -70,10 +77,38 @@ vec3 worldPosition(vec2 pixelPosition, float depth) {
     return world.xyz / world.w;
 }
 
+// Where the surface seen at pixel position `pixelPosition` (pixels, this
+// frame) was last frame: the G-buffer's motion there gives last frame's
+// pixel, and the point is taken at the view depth last frame's camera has
+// for `position` (exact for motion across the view; the G-buffer keeps no
+// depth motion). Returns last frame's position minus this one's.
+vec3 surfaceMotion(ivec2 texel, vec3 position) {
+    const vec2 motion = texelFetch(motionTexture, texel, 0).xy;
+    if (!isFinite(motion)) {
+        return vec3(0.0);
+    }
+    const vec2 previousPixel = vec2(texel) + 0.5 + motion;
+    const vec2 ndc = previousPixel / vec2(C.size) * 2.0 - 1.0;
+    const vec4 near = C.previousInverseViewProjection * vec4(ndc, 1.0, 1.0);
+    const vec3 camera = C.previousCameraPosition.xyz;
+    const vec3 dir = near.xyz / near.w - camera;
+    const mat4 m = C.previousViewProjection;
+    const vec3 wRow = vec3(m[0][3], m[1][3], m[2][3]);
+    const float w = dot(wRow, position) + m[3][3];
+    const float wPerUnit = dot(wRow, dir);
+    if (!(abs(wPerUnit) > 1e-12) || !(w > 0.0)) {
+        return vec3(0.0);
+    }
+    const vec3 previous = camera + dir * (w / wPerUnit);
+    const vec3 d = previous - position;
+    return isFinite(d) ? d : vec3(0.0);
+}
+
 struct Reflection {
     vec3 radiance;
     float reflects;     // 1 where a surface reflects
     float hitDistance;
+    vec3 hitMotion;     // last frame's reflected point minus this frame's
     uint source;
 };
 
@@ -82,6 +117,7 @@ Reflection integratePixel(uvec2 pixel) {
     r.radiance = vec3(0.0);
     r.reflects = 0.0;
     r.hitDistance = kMissHitDistance;
+    r.hitMotion = vec3(0.0);
     r.source = kSourceSky;
     const uint index = pixel.y * C.size.x + pixel.x;
     const uint pixelClass = classes[index];
@@ -144,6 +180,7 @@ Reflection integratePixel(uvec2 pixel) {
     bool rtTraced = false;
     vec3 rtRadiance = vec3(0.0);
     float rtHitDistance = kMissHitDistance;
+    vec3 rtHitMotion = vec3(0.0);
 #if GLINT_INTEGRATE_RT
     if (traced && handedToRt) {
         const vec4 radiance = texelFetch(rtRadianceTexture, leader, 0);
@@ -153,6 +190,10 @@ Reflection integratePixel(uvec2 pixel) {
         // A follower takes its leader's ray length: the quad shares one ray,
         // and its origins lie a pixel apart.
         rtHitDistance = isFinite(d) ? clamp(d, 0.0, kMissHitDistance) : kMissHitDistance;
+        if (C.rtHitMotionBound != 0u) {
+            const vec3 motion = texelFetch(rtHitMotionTexture, leader, 0).xyz;
+            rtHitMotion = isFinite(motion) ? motion : vec3(0.0);
+        }
     }
 #endif
 
@@ -163,6 +204,7 @@ Reflection integratePixel(uvec2 pixel) {
     if (trace == kTraceRt) {
         r.radiance = rtRadiance;
         r.hitDistance = rtHitDistance;
+        r.hitMotion = rtHitDistance < kMissHitDistance ? rtHitMotion : vec3(0.0);
         r.source = kSourceRt;
     }
     if (trace == kTraceSslr) {
@@ -175,6 +217,7 @@ Reflection integratePixel(uvec2 pixel) {
         if (hitDepth > 0.0) {
             const vec3 hitPosition = worldPosition(vec2(hitTexel) + 0.5, hitDepth);
             r.hitDistance = min(length(hitPosition - position), kMissHitDistance);
+            r.hitMotion = surfaceMotion(hitTexel, hitPosition);
         }
     }
     // Particles between the surface and what it reflects (the leader's
@@ -204,10 +247,11 @@ void main() {
     if (pixel.x < C.size.x && pixel.y < C.size.y) {
         const Reflection r = integratePixel(pixel);
         const vec3 radiance = clamp(r.radiance, vec3(0.0), vec3(kMaxHalf));
-        const bool finite = isFinite(radiance) && isFinite(r.hitDistance);
+        const bool finite = isFinite(radiance) && isFinite(r.hitDistance) && isFinite(r.hitMotion);
         const ivec2 p = ivec2(pixel);
         imageStore(radianceImage, p, vec4(finite ? radiance : vec3(0.0), r.reflects));
         imageStore(hitDistanceImage, p, vec4(finite ? r.hitDistance : kMissHitDistance));
+        imageStore(hitMotionImage, p, vec4(finite ? r.hitMotion : vec3(0.0), 0.0));
         imageStore(sourceImage, p, integrateSourceColour(r.source));
     }
     barrier();

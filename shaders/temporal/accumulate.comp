@@ -7,7 +7,9 @@
 //   2. reflection motion: the reflected (virtual) point lies hitDistance
 //      behind the surface along the view ray; projected with last frame's
 //      view-projection it says where last frame saw this reflection
-//      (misses: the view direction alone, a point at infinity). Rough
+//      (misses: the view direction alone, a point at infinity); where the
+//      reflected object itself moved (hitMotionTexture), last frame's
+//      virtual point is the mirror image of where it was. Rough
 //      reflections are blurry and follow the surface instead: the two
 //      motions blend by roughness;
 //   3. history at each candidate, bilinear over four taps, each tap kept
@@ -43,6 +45,9 @@ layout(set = 0, binding = 10, rgba16f) uniform writeonly image2D surfaceHistory;
 // format qualifier; the context enables shaderStorageImageWriteWithoutFormat.
 layout(set = 0, binding = 11) uniform writeonly image2D motionImage;
 layout(set = 0, binding = 12) uniform writeonly image2D lengthImage;
+// xyz: where the reflected point was last frame minus where it is (world;
+// passes/integrate.h's hitMotion). Read where frame.hitMotionBound says so.
+layout(set = 0, binding = 13) uniform sampler2D hitMotionTexture;
 
 vec3 rgbToYCoCg(vec3 c) {
     return vec3(0.25 * c.r + 0.5 * c.g + 0.25 * c.b, 0.5 * c.r - 0.5 * c.b, -0.25 * c.r + 0.5 * c.g - 0.25 * c.b);
@@ -227,7 +232,17 @@ void main() {
         // At infinity (NaN lands here too): only the direction reprojects.
         clip = frame.previousViewProjection * vec4(viewDir, 0.0);
     } else {
-        clip = frame.previousViewProjection * vec4(px.position + viewDir * max(hitDistance, 0.0), 1.0);
+        // The virtual point is the mirror image of the reflected one in the
+        // surface's plane; a reflected point that moved by m moved its
+        // image by m mirrored in that plane.
+        vec3 virtualPoint = px.position + viewDir * max(hitDistance, 0.0);
+        if (frame.hitMotionBound != 0u) {
+            const vec3 m = texelFetch(hitMotionTexture, p, 0).xyz;
+            if (isFinite(m)) {
+                virtualPoint += reflect(m, px.normal);
+            }
+        }
+        clip = frame.previousViewProjection * vec4(virtualPoint, 1.0);
     }
     // Motion runs between unjittered positions (the G-buffer's
     // convention); every point of the view ray, the virtual one included,

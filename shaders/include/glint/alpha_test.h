@@ -35,12 +35,19 @@ GLINT_CONST uint kAlphaWrapClamp = 1u;
 GLINT_CONST uint kAlphaWrapMirror = 2u;
 
 // One row per primitive offset row (glint/packing.h's
-// primitiveOffsetSlot: a TLAS instance's BLAS geometry), 24 bytes.
+// primitiveOffsetSlot: a TLAS instance's BLAS geometry), 72 bytes.
 struct RtGeometryMaterial {
     vec3 emission;        // glTF units: the material's mean (scene::meanEmission)
     uint alphaTriangles;  // the geometry's first AlphaTriangle; kAlphaOpaque: no alpha test
     uint alphaMask;       // layer | wrap u << kAlphaWrapShiftU | wrap v << kAlphaWrapShiftV
     float alphaCutoff;    // glTF alphaCutoff
+    // The instance's motion: the rows of the 3x4 matrix that takes a world
+    // point on it this frame to where that point was last frame (last
+    // frame's object-to-world times the inverse of this frame's; identity
+    // for a still instance). Reflections reproject a moving object's hits
+    // with it (passes/temporal.h). Skinned and morphed vertices move inside
+    // the object too: that motion is not in it.
+    vec4 previousFromCurrent[3];
 };
 
 // One triangle of an alpha-tested geometry, 16 bytes: the base colour

@@ -8,6 +8,8 @@
 //   hitDistance  world distance from the surface to the reflected point;
 //                kMissHitDistance (glint/ray_generation_shared.h) for the
 //                environment, misses and the sky
+//   hitMotion    xyz: where the reflected point was last frame minus where
+//                it is (world units; zero where it is at infinity)
 //   sourceDebug  integrateSourceColour(source) (debug view "reflection_source")
 //   counters     one u32 per 8x8 tile (glint/feedback_shared.h)
 #ifndef GLINT_INTEGRATE_SHARED_H
@@ -77,23 +79,28 @@ GLINT_FUNC uint chooseReflectionTrace(float sslrConfidence, float confidenceThre
 }
 
 // Per-frame constants (a storage buffer: with the lighting they outgrow the
-// 128 bytes of push constants every device has; 352 bytes).
+// 128 bytes of push constants every device has; 496 bytes).
 struct IntegrateConstants {
-    mat4 inverseViewProjection;  // unjittered, the G-buffer's camera
+    mat4 inverseViewProjection;          // unjittered, the G-buffer's camera
+    // Last frame's unjittered matrices and position: where an SSLR hit was
+    // last frame (its G-buffer motion) becomes a world point.
+    mat4 previousViewProjection;
+    mat4 previousInverseViewProjection;
     vec4 cameraPosition;
+    vec4 previousCameraPosition;
     SceneLighting lighting;
     uvec2 size;                  // pixels
     uvec2 tiles;                 // 8x8 tiles in x and y
     float confidenceThreshold;   // SSLR confidence that counts as a hit
     uint particlesBound;         // 1: composite the particle trace (passes/particles.h) over the reflection
     uint rtMissesTrusted;        // 0 while the BVH builds objects in range (IntegrateSettings::rtMissesTrusted)
-    uint pad2;
+    uint rtHitMotionBound;       // 1: the ray tracer's hit motion is bound (else its hits count as still)
 };
 
 GLINT_END
 
 #ifdef __cplusplus
-static_assert(sizeof(glint::shader::IntegrateConstants) == 352);
+static_assert(sizeof(glint::shader::IntegrateConstants) == 496);
 #endif
 
 #endif

@@ -41,6 +41,10 @@ layout(set = 0, binding = 7, scalar) readonly buffer Offsets { uint primitiveOff
 layout(set = 0, binding = 8, scalar) readonly buffer Constants { RtTraceConstants rt; };
 layout(set = 0, binding = 9, rgba16f) uniform writeonly image2D radianceImage;
 layout(set = 0, binding = 10, r32f) uniform writeonly image2D hitDistanceImage;
+// xyz: where the hit point was last frame minus where it is (world; zero
+// for misses and still objects); RGBA16F has no required storage format:
+// the context enables shaderStorageImageWriteWithoutFormat.
+layout(set = 0, binding = 15) uniform writeonly image2D hitMotionImage;
 // Bindings 12-14: the material rows and the alpha test.
 #include "glint/rt_geometry.glsl"
 
@@ -145,9 +149,20 @@ Surface rtHitSurface(RtRay ray, RtHit hit) {
     return s;
 }
 
-void rtWriteResult(RtRay ray, vec3 radiance, float hitDistance) {
+void rtWriteResult(RtRay ray, vec3 radiance, float hitDistance, vec3 hitMotion) {
     imageStore(radianceImage, ray.pixel, vec4(radiance, 1.0));
     imageStore(hitDistanceImage, ray.pixel, vec4(hitDistance));
+    imageStore(hitMotionImage, ray.pixel, vec4(hitMotion, 0.0));
+}
+
+// Where the hit point was last frame, relative to where it is: its
+// instance's motion (glint/alpha_test.h's previousFromCurrent).
+vec3 rtHitMotion(RtHit hit, vec3 position) {
+    const RtGeometryMaterial m = rtGeometryMaterial(hit.customIndex, hit.geometry);
+    const vec4 p = vec4(position, 1.0);
+    const vec3 previous = vec3(dot(m.previousFromCurrent[0], p), dot(m.previousFromCurrent[1], p),
+                               dot(m.previousFromCurrent[2], p));
+    return previous - position;
 }
 
 // Traces list entry `index` and writes its result.
@@ -158,7 +173,7 @@ void rtTraceListEntry(uint index) {
     }
     const RtHit hit = rtTraceClosest(ray.origin, ray.direction, ray.tMax);
     if (hit.hit == 0u) {
-        rtWriteResult(ray, environmentRadiance(rt.lighting, ray.direction, ray.roughness), kMissHitDistance);
+        rtWriteResult(ray, environmentRadiance(rt.lighting, ray.direction, ray.roughness), kMissHitDistance, vec3(0.0));
         return;
     }
     const Surface s = rtHitSurface(ray, hit);
@@ -172,7 +187,8 @@ void rtTraceListEntry(uint index) {
     }
     // Emission, unlit and unshadowed as in the G-buffer's lit colour.
     const vec3 emission = rtGeometryMaterial(hit.customIndex, hit.geometry).emission * rt.lighting.sunDirection.w;
-    rtWriteResult(ray, shadeSurface(rt.lighting, s, -ray.direction, sunVisibility) + emission, hit.t);
+    rtWriteResult(ray, shadeSurface(rt.lighting, s, -ray.direction, sunVisibility) + emission, hit.t,
+                  rtHitMotion(hit, s.position));
 }
 
 #endif

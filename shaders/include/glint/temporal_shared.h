@@ -54,7 +54,7 @@ struct TemporalFrame {
     float spatialNormalPower;
     float spatialRoughnessSigma;
     float spatialRoughnessMax;
-    float pad1;
+    uint hitMotionBound;                 // 1: the reflected points' own motion is bound
 };
 
 GLINT_END
