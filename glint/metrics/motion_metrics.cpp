@@ -2,6 +2,7 @@
 
 #include <glm/common.hpp>
 
+#include <algorithm>
 #include <cmath>
 #include <limits>
 #include <stdexcept>
@@ -23,54 +24,90 @@ void requireSize(const Image& image, size_t pixels, const char* what) {
 
 float luminance(const glm::vec3& rgb) { return 0.2126f * rgb.r + 0.7152f * rgb.g + 0.0722f * rgb.b; }
 
-std::vector<uint8_t> footprint(const Image& withObject, const Image& without, float threshold) {
-    requireSameSize(withObject, without);
-    std::vector<uint8_t> inside(withObject.linear.size(), 0);
-    for (size_t i = 0; i < inside.size(); ++i) {
-        inside[i] = std::abs(luminance(withObject.linear[i]) - luminance(without.linear[i])) > threshold ? 1 : 0;
+namespace {
+
+void requireSameSize(const Contribution& a, const Contribution& b) {
+    if (a.width != b.width || a.height != b.height || a.luminance.size() != b.luminance.size() ||
+        a.luminance.size() != size_t(a.width) * a.height || a.luminance.empty()) {
+        throw std::invalid_argument("'" + a.name + "' is " + std::to_string(a.width) + "x" + std::to_string(a.height) +
+                                    ", '" + b.name + "' " + std::to_string(b.width) + "x" + std::to_string(b.height) +
+                                    ": expected two contributions of one non-empty size");
     }
-    return inside;
 }
 
-double ghostEnergy(const Image& reference, const Image& test, std::span<const uint8_t> inside) {
+} // namespace
+
+Contribution contribution(const Image& withObject, const Image& without) {
+    requireSameSize(withObject, without);
+    Contribution c{withObject.width, withObject.height, std::vector<float>(withObject.linear.size()),
+                   withObject.name + " - " + without.name};
+    for (size_t i = 0; i < c.luminance.size(); ++i) {
+        c.luminance[i] = luminance(withObject.linear[i]) - luminance(without.linear[i]);
+    }
+    return c;
+}
+
+std::vector<uint8_t> footprint(const Contribution& reference, float threshold, uint32_t dilation) {
+    std::vector<uint8_t> inside(reference.luminance.size(), 0);
+    for (size_t i = 0; i < inside.size(); ++i) inside[i] = std::abs(reference.luminance[i]) > threshold ? 1 : 0;
+    if (dilation == 0 || inside.size() != size_t(reference.width) * reference.height) return inside;
+    // Separable: rows, then columns.
+    const int64_t w = reference.width, h = reference.height, r = dilation;
+    std::vector<uint8_t> rows(inside.size(), 0);
+    for (int64_t y = 0; y < h; ++y) {
+        for (int64_t x = 0; x < w; ++x) {
+            for (int64_t d = std::max<int64_t>(0, x - r); d <= std::min(w - 1, x + r) && !rows[y * w + x]; ++d) {
+                rows[y * w + x] = inside[y * w + d];
+            }
+        }
+    }
+    std::vector<uint8_t> grown(inside.size(), 0);
+    for (int64_t y = 0; y < h; ++y) {
+        for (int64_t x = 0; x < w; ++x) {
+            for (int64_t d = std::max<int64_t>(0, y - r); d <= std::min(h - 1, y + r) && !grown[y * w + x]; ++d) {
+                grown[y * w + x] = rows[d * w + x];
+            }
+        }
+    }
+    return grown;
+}
+
+double ghostEnergy(const Contribution& reference, const Contribution& test, std::span<const uint8_t> inside) {
     requireSameSize(reference, test);
-    if (inside.size() != reference.linear.size()) {
+    if (inside.size() != reference.luminance.size()) {
         throw std::invalid_argument("ghostEnergy: the footprint has " + std::to_string(inside.size()) +
-                                    " pixels, the images " + std::to_string(reference.linear.size()));
+                                    " pixels, the contributions " + std::to_string(reference.luminance.size()));
     }
     double objectEnergy = 0.0, trail = 0.0;
     for (size_t i = 0; i < inside.size(); ++i) {
-        const double ref = luminance(reference.linear[i]);
+        const double ref = std::abs(double(reference.luminance[i]));
         if (inside[i] != 0) {
             objectEnergy += ref;
         } else {
-            trail += std::max(0.0, double(luminance(test.linear[i])) - ref);
+            trail += std::max(0.0, std::abs(double(test.luminance[i])) - ref);
         }
     }
     if (!(objectEnergy > 0.0)) {
         throw std::invalid_argument("ghostEnergy: the reference '" + reference.name +
-                                    "' has no luminance inside the footprint");
+                                    "' contributes nothing inside the footprint");
     }
     return trail / objectEnergy;
 }
 
-double lagPixels(const Image& reference, const Image& test, const Image& without) {
+double lagPixels(const Contribution& reference, const Contribution& test) {
     requireSameSize(reference, test);
-    requireSameSize(reference, without);
-    const auto centroid = [&](const Image& image) {
+    const auto centroid = [&](const Contribution& c) {
         double sum = 0.0, x = 0.0, y = 0.0;
-        for (uint32_t row = 0; row < image.height; ++row) {
-            for (uint32_t col = 0; col < image.width; ++col) {
-                const size_t i = size_t(row) * image.width + col;
-                const double w = std::abs(double(luminance(image.linear[i])) - luminance(without.linear[i]));
+        for (uint32_t row = 0; row < c.height; ++row) {
+            for (uint32_t col = 0; col < c.width; ++col) {
+                const double w = std::abs(double(c.luminance[size_t(row) * c.width + col]));
                 sum += w;
                 x += w * (col + 0.5);
                 y += w * (row + 0.5);
             }
         }
         if (!(sum > 0.0)) {
-            throw std::invalid_argument("lagPixels: '" + image.name + "' does not differ from '" + without.name +
-                                        "' anywhere");
+            throw std::invalid_argument("lagPixels: '" + c.name + "' is zero everywhere");
         }
         return std::array<double, 2>{x / sum, y / sum};
     };

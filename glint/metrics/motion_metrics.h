@@ -14,31 +14,44 @@
 #include <array>
 #include <cstdint>
 #include <span>
+#include <string>
 #include <vector>
 
 namespace glint::metrics {
 
 float luminance(const glm::vec3& rgb);
 
-// Pixels where `withObject` differs from `without` (the same frame rendered
-// without the moving object) by more than `threshold` in luminance: where
-// the object, or its reflection, is. Throws std::invalid_argument unless
-// the sizes agree.
-std::vector<uint8_t> footprint(const Image& withObject, const Image& without, float threshold = 1e-3f);
+// What an object adds to an image: the luminance of the frame rendered with
+// it minus the same frame without it, per pixel (negative where it hides
+// something brighter). Comparing contributions, not images, leaves out
+// whatever else a renderer gets wrong (noise, bias) alike with and without
+// the object. Throws std::invalid_argument unless the sizes agree.
+struct Contribution {
+    uint32_t width = 0;
+    uint32_t height = 0;
+    std::vector<float> luminance;
+    std::string name;
+};
+Contribution contribution(const Image& withObject, const Image& without);
 
-// The trail: the luminance `test` has in excess of `reference` outside the
+// Pixels where the contribution exceeds `threshold` in magnitude: where the
+// object, or its reflection, is; grown by `dilation` pixels each way (a
+// square), so an edge a pixel off counts as in place rather than as trail.
+std::vector<uint8_t> footprint(const Contribution& reference, float threshold = 1e-3f, uint32_t dilation = 0);
+
+// The trail: the magnitude `test` contributes beyond `reference` outside the
 // object's true footprint (`inside`, one byte per pixel, non-zero inside),
-// as a fraction of the luminance the reference has inside it. 0 when the
+// as a fraction of what the reference contributes inside it. 0 when the
 // object's reflection is only where it belongs; 0.05 when 5% of its energy
-// is left behind. Throws std::invalid_argument on mismatched sizes or an
-// empty footprint.
-double ghostEnergy(const Image& reference, const Image& test, std::span<const uint8_t> inside);
+// is left behind. Throws std::invalid_argument on mismatched sizes or a
+// reference that contributes nothing inside the footprint.
+double ghostEnergy(const Contribution& reference, const Contribution& test, std::span<const uint8_t> inside);
 
 // How far the object's reflection in `test` is from where the reference
-// has it, in pixels: the distance between the luminance-weighted centroids
-// of |image - without| over the two images. Throws std::invalid_argument on
-// mismatched sizes or where an image differs nowhere from `without`.
-double lagPixels(const Image& reference, const Image& test, const Image& without);
+// has it, in pixels: the distance between the centroids of the two
+// contributions' magnitudes. Throws std::invalid_argument on mismatched
+// sizes or a contribution that is zero everywhere.
+double lagPixels(const Contribution& reference, const Contribution& test);
 
 // Mean absolute change from one frame to the next over pixels, channels
 // and frame pairs (linear values): 0 for a converged reference with a still

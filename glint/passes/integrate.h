@@ -62,9 +62,6 @@ struct IntegrateInputs {
     // RGBA16F radiance, a = 1 where traced (at ray leaders); R32F hit distance.
     rg::Texture rtRadiance;
     rg::Texture rtHitDistance;
-    // Optional, with them: the ray tracer's hit motion (RtTraceOutputs::
-    // hitMotion); without it the traced hits count as still.
-    rg::Texture rtHitMotion;
     FeedbackOutputs feedback;          // reprojected in, counters.current out
     // Optional: the particle trace's radiance (passes/particles.h,
     // ParticleTraceOutputs::radiance: RGBA16F, premultiplied rgb, a =
@@ -86,6 +83,9 @@ struct IntegrateInputs {
     // SSLR confidence is below it (compared, as SSLR does, at
     // sslrStoredThreshold), since nothing clears the traces' outputs.
     float confidenceThreshold = kDefaultConfidenceThreshold;
+    // Optional, with them: the ray tracer's hit motion (RtTraceOutputs::
+    // hitMotion); without it the traced hits count as still.
+    rg::Texture rtHitMotion;
 };
 
 struct IntegrateSettings {

@@ -51,11 +51,6 @@ struct TemporalInputs {
     GBufferOutputs gbuffer;   // depth, normal, roughnessMetal, motion
     rg::Texture radiance;     // reflection radiance (any float format), a > 0 where a surface reflects
     rg::Texture hitDistance;  // r: distance to the reflected hit; >= shader::kMissHitDistance: at infinity
-    // Optional: xyz, where the reflected point was last frame minus where it
-    // is (world units; IntegrateOutputs::hitMotion). A moving object's
-    // reflection is reprojected with it; without it reflected points count
-    // as still and only the camera's motion reprojects.
-    rg::Texture hitMotion;
     // This and last frame's unjittered matrices and positions (the
     // G-buffer's camera).
     scene::Camera camera;
@@ -64,6 +59,11 @@ struct TemporalInputs {
     uint64_t frameIndex = 0;
     // Discard the history (a camera cut, a teleport, a new scene).
     bool resetHistory = false;
+    // Optional: xyz, where the reflected point was last frame minus where it
+    // is (world units; IntegrateOutputs::hitMotion). A moving object's
+    // reflection is reprojected with it; without it reflected points count
+    // as still and only the camera's motion reprojects.
+    rg::Texture hitMotion;
 };
 
 struct TemporalSettings {

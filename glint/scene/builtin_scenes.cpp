@@ -652,7 +652,7 @@ Scene buildHardCases() {
 } // namespace
 
 std::span<const std::string_view> builtinSceneNames() {
-    static constexpr std::array<std::string_view, 3> kNames = {"plaza", "hard-cases", "city"};
+    static constexpr std::array<std::string_view, 4> kNames = {"plaza", "hard-cases", "city", "mirror-motion"};
     return kNames;
 }
 
@@ -683,7 +683,10 @@ Scene makeBuiltinScene(std::string_view name) {
     if (name.substr(0, name.find(':')) == "city") {
         return makeCity(parseCityOptions(name));
     }
-    throw SceneError(std::string(name), "", "no such built-in scene (plaza, hard-cases, city)");
+    if (name == "mirror-motion") {
+        return makeMirrorMotion();
+    }
+    throw SceneError(std::string(name), "", "no such built-in scene (plaza, hard-cases, city, mirror-motion)");
 }
 
 Scene loadScene(std::string_view nameOrPath, const GltfLoadOptions& options) {

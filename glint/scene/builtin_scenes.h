@@ -19,6 +19,11 @@
 //   beside the camera (only RT can). "city:instances=N,triangles=T,seed=S"
 //   sets its size (CityOptions); streets, lamps and cars grow with it.
 //
+//  "mirror-motion": a bright lamp sliding across a mirror floor in front of
+//   a wall, then the camera strafing past it (kMirrorMotion's timeline):
+//   what reflections in motion are measured on (ghosting behind a moving
+//   object, lag under camera motion; glint-bench --motion).
+//
 //  "hard-cases": everything offset to about 10^4 m from the origin; a
 //   grazing mirror corridor, walls 2 mm thick and zero thick, roughness 0
 //   and 1, degenerate triangles, a 1 cm object 3 cm from the camera and a
@@ -58,6 +63,23 @@ struct CityOptions {
 // throws SceneError naming the key for anything else or out of range.
 CityOptions parseCityOptions(std::string_view spec);
 
+// The mirror-motion scene's timeline (seconds, metres): the lamp stands
+// at objectStartX until objectStartSeconds, slides along +x at objectSpeed
+// until objectStopSeconds and stands again; the camera stands until
+// cameraStartSeconds, then strafes along +x at cameraSpeed.
+struct MirrorMotionTimeline {
+    float objectStartSeconds = 2.0f;
+    float objectStopSeconds = 3.0f;
+    float objectStartX = -1.5f;
+    float objectSpeed = 2.0f;
+    float objectHeight = 0.5f;
+    float objectZ = 0.0f;
+    float cameraStartSeconds = 3.0f;
+    float cameraSpeed = 1.5f;
+    float loopSeconds = 10.0f;  // the lamp's animation loops after this
+};
+inline constexpr MirrorMotionTimeline kMirrorMotion{};
+
 std::span<const std::string_view> builtinSceneNames();
 // A built-in name, or "city:..." with the city's options.
 bool isBuiltinScene(std::string_view name);
@@ -68,6 +90,9 @@ Scene makeBuiltinScene(std::string_view name);
 Scene makePlaza();
 Scene makeHardCases();
 Scene makeCity(const CityOptions& options = {});
+// withObject false: the same scene without the lamp (where its reflection
+// should be is where the two differ).
+Scene makeMirrorMotion(bool withObject = true);
 
 // A built-in scene by name, otherwise a glTF file by path.
 Scene loadScene(std::string_view nameOrPath, const GltfLoadOptions& options = {});

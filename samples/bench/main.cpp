@@ -13,6 +13,7 @@
 // reference's camera stands still.
 
 #include "bench/measure.h"
+#include "bench/motion.h"
 #include "bench/report.h"
 #include "bench/scale.h"
 #include "common/app.h"
@@ -48,11 +49,12 @@ constexpr const char* kUsage =
     "both reflection terms (*_reflections.png, tonemapped as the \"resolved\" debug view).";
 
 const std::vector<app::Flag> kFlags = {
-    {"scene", "plaza (default), hard-cases, city[:OPTIONS], FILE.gltf or FILE.glb"},
+    {"scene", "plaza (default), hard-cases, city[:OPTIONS], mirror-motion, FILE.gltf or FILE.glb"},
     {"frames", "frames per run (default 16)"},
     {"size", "WxH or N; default 256x256 on a CPU device, 1920x1080 on a GPU"},
     {"modes", "the modes run with defaults (default hybrid,ssr,rt)"},
     {"sweep-modes", "the modes the parameter sweeps run in (default hybrid; \"\": no sweeps)"},
+    {"sweep", "NAME,...: sweep only these parameters (default: every parameter with a sweep)"},
     {"out-dir", "DIR for everything written (default build/bench)"},
     {"csv", "the CSV (default DIR/<scene>_bench.csv)"},
     {"json", "the JSON (default DIR/<scene>_bench.json)"},
@@ -106,32 +108,43 @@ std::string utcNow() {
     return buffer;
 }
 
-struct Configuration {
-    passes::ReflectionMode mode;
-    std::string param;  // bench::kDefaultParam or a parameter name
-    double value = 0.0;
-};
-
 } // namespace
 
 int main(int argc, char** argv) {
     return app::runMain("glint-bench", [&] {
         const app::Args args(argc, argv, kUsage, kFlags,
                              {{"quick", "a short run: fewer frames and sweep values (what CI runs)"},
-                              {"jitter", "jitter the camera as the measured runs would (default off)"}});
+                              {"jitter", "jitter the camera as the measured runs would (default off)"},
+                              {"motion", "reflections in motion instead: each configuration along the camera path "
+                                         "(--frames, default 64) against references of 4 frames along it, a still "
+                                         "camera (flip_still, flicker), and the mirror-motion scene (ghost_energy_1/4/16, "
+                                         "lag_px); writes DIR/<scene>_motion.{csv,json,png}"}});
         const std::string sceneName = args.get("scene", "plaza");
-        const uint32_t frames = args.getUint("frames", 16);
+        const uint32_t frames = args.getUint("frames", args.has("motion") ? 64 : 16);
         if (frames == 0) throw std::runtime_error("--frames 0: must be at least 1");
         const bool quick = args.has("quick");
         const std::vector<passes::ReflectionMode> modes = parseModes("modes", args.get("modes", "hybrid,ssr,rt"));
         if (modes.empty()) throw std::runtime_error("--modes: name at least one of hybrid, ssr, rt");
         const std::vector<passes::ReflectionMode> sweepModes = parseModes("sweep-modes", args.get("sweep-modes", "hybrid"));
+        std::vector<std::string> sweepOnly;
+        if (args.has("sweep")) {
+            const std::string text = args.get("sweep", "");
+            for (size_t start = 0; start <= text.size();) {
+                const size_t end = std::min(text.find(',', start), text.size());
+                const std::string name = text.substr(start, end - start);
+                app::getParameter(app::ReflectionRunOptions{}, name);  // throws naming an unknown parameter
+                sweepOnly.push_back(name);
+                start = end + 1;
+            }
+        }
         const double ppd = args.has("ppd") ? parsePositive("ppd", args.get("ppd", ""), false) : metrics::kDefaultPpd;
         const std::filesystem::path outDir = args.get("out-dir", "build/bench");
         const bool scaleRun = args.has("scale");
+        const bool motionRun = args.has("motion");
+        if (scaleRun && motionRun) throw std::runtime_error("--scale and --motion: choose one");
         const std::string stem =
             scaleRun ? std::string("city") : std::filesystem::path(sceneName).stem().string();
-        const std::string suffix = scaleRun ? "_scale" : "_bench";
+        const std::string suffix = scaleRun ? "_scale" : motionRun ? "_motion" : "_bench";
         const std::filesystem::path csvPath = args.get("csv", (outDir / (stem + suffix + ".csv")).string());
         const std::filesystem::path jsonPath = args.get("json", (outDir / (stem + suffix + ".json")).string());
         const std::filesystem::path plotPath = args.get("plot", (outDir / (stem + suffix + ".png")).string());
@@ -227,13 +240,17 @@ int main(int argc, char** argv) {
         scene::Scene scene = scene::loadScene(sceneName, args.gltfOptions());
 
         // Every configuration, so progress can say "k of n".
-        std::vector<Configuration> configurations;
+        std::vector<bench::Configuration> configurations;
         for (const passes::ReflectionMode mode : modes) configurations.push_back({mode, std::string(bench::kDefaultParam)});
         // The sweeps come with the parameters (app::Parameter): values equal
         // to the default are skipped, the mode's default row has them.
         for (const app::Parameter& sweep : app::parameters()) {
             for (const passes::ReflectionMode mode : modes) {
                 if (!sweep.sweepModes[size_t(mode)]) continue;
+                if (!sweepOnly.empty() &&
+                    std::find(sweepOnly.begin(), sweepOnly.end(), std::string(sweep.name)) == sweepOnly.end()) {
+                    continue;
+                }
                 if (std::find(sweepModes.begin(), sweepModes.end(), mode) == sweepModes.end()) continue;
                 const double defaultValue = app::getParameter(base, sweep.name);
                 for (const double v : quick ? sweep.quickSweep : sweep.sweep) {
@@ -250,6 +267,55 @@ int main(int argc, char** argv) {
             return std::chrono::duration<double>(std::chrono::steady_clock::now() - benchStart).count();
         };
 
+        if (motionRun) {
+            bench::MotionSettings motion;
+            motion.base = base;
+            motion.pathFrames = frames;
+            motion.ppd = ppd;
+            motion.referenceMaxFrames = referenceMaxFrames;
+            motion.warmupFrames = warmupFrames;
+            if (quick) {
+                motion.stillFrames = 12;
+                motion.flickerFrames = 4;
+            }
+            const bench::MotionReferences references = bench::renderMotionReferences(ctx, scene, motion);
+            spdlog::info("motion: references of {} path frames and the mirror-motion scene in {:.1f} s",
+                         references.pathFrames.size(), elapsed());
+            std::vector<bench::MotionRow> rows;
+            for (size_t k = 0; k < configurations.size(); ++k) {
+                const bench::Configuration& c = configurations[k];
+                const app::ReflectionRunOptions options = bench::configure(base, c);
+                bench::MotionRow row = bench::measureMotion(ctx, scene, motion, options, references);
+                row.scene = stem;
+                row.mode = passes::modeName(c.mode);
+                row.param = c.param;
+                if (c.param != bench::kDefaultParam) row.value = app::getParameter(options, c.param);
+                spdlog::info("[{}/{}] {}: reflections {:.3f} ms, FLIP still {:.4f}, in motion {:.4f}, ghost "
+                             "{:.3f}/{:.3f}/{:.3f}, lag {:.2f} px, flicker {:.5f} ({:.0f} s)",
+                             k + 1, configurations.size(), bench::describe(c), row.reflectionMs.value_or(0.0),
+                             row.flipStill, row.flipMotion, row.ghostEnergy[0], row.ghostEnergy[1],
+                             row.ghostEnergy[2], row.lagPixels, row.flicker, elapsed());
+                rows.push_back(std::move(row));
+            }
+            const std::string csv = bench::toMotionCsv(rows);
+            std::fputs(csv.c_str(), stdout);
+            std::fflush(stdout);
+            bench::writeText(csvPath, csv);
+            spdlog::info("wrote {}", csvPath.string());
+            bench::writeText(jsonPath, bench::toMotionJson(info, rows));
+            spdlog::info("wrote {}", jsonPath.string());
+            bench::PlotOptions plot;
+            plot.title = stem + " in motion " + std::to_string(width) + "x" + std::to_string(height) + ", " +
+                         std::to_string(frames) + " frames, " + info.device + ", " + info.date.substr(0, 10);
+            plot.xLabel = cpuDevice ? "reflection_ms (host time of the reflection passes, each submitted alone)"
+                                    : "reflection_ms (GPU time of the reflection passes, median)";
+            plot.yLabel = "flip_motion (reflection term against per-frame references, mean)";
+            bench::writePlot(plotPath, bench::motionPlotPoints(rows), plot);
+            spdlog::info("wrote {} ({:.0f} s in all)", plotPath.string(), elapsed());
+            ctx.waitIdle();
+            return app::validationClean(ctx) ? 0 : 2;
+        }
+
         // 1. The reference at the last measured frame's pose and scene time.
         const bench::Reference reference = bench::renderReference(ctx, scene, base, referenceMaxFrames);
         const metrics::Image& referenceImage = reference.image;
@@ -263,14 +329,11 @@ int main(int argc, char** argv) {
         // 2. Every configuration over the same path.
         std::vector<bench::Row> rows;
         for (size_t k = 0; k < configurations.size(); ++k) {
-            const Configuration& c = configurations[k];
-            app::ReflectionRunOptions options = base;
-            options.frame.mode = c.mode;
+            const bench::Configuration& c = configurations[k];
+            const app::ReflectionRunOptions options = bench::configure(base, c);
             const bool baseline = c.param == bench::kDefaultParam;
-            if (!baseline) app::setParameter(options, c.param, bench::formatValue(c.value));
             const std::string modeName(passes::modeName(c.mode));
-            const std::string what =
-                baseline ? modeName + " defaults" : modeName + " " + c.param + "=" + bench::formatValue(c.value);
+            const std::string what = bench::describe(c);
 
             const app::ReflectionRunResult result = bench::runMeasured(ctx, scene, options, warmupFrames);
             const metrics::Image image = metrics::imageFromSrgb8(width, height, result.rgba, 4, what);

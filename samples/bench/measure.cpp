@@ -72,17 +72,26 @@ ErrorMetrics measure(const metrics::Image& reference, const metrics::Image& test
     return m;
 }
 
+app::ReflectionRunOptions configure(const app::ReflectionRunOptions& base, const Configuration& c) {
+    app::ReflectionRunOptions options = base;
+    options.frame.mode = c.mode;
+    if (c.param != kDefaultParam) app::setParameter(options, c.param, formatValue(c.value));
+    return options;
+}
+
+std::string describe(const Configuration& c) {
+    const std::string mode(passes::modeName(c.mode));
+    return c.param == kDefaultParam ? mode + " defaults" : mode + " " + c.param + "=" + formatValue(c.value);
+}
+
 Reference renderReference(gpu::Context& ctx, scene::Scene& scene, const app::ReflectionRunOptions& base,
-                          std::optional<uint32_t> maxFrames) {
-    // A still camera path that holds the last frame's pose
-    // (CameraPath::evaluate returns the first key exactly at or before its
-    // time), restored after.
-    const uint32_t frames = std::max(base.frames, 1u);
-    const float lastSeconds = base.startSeconds + float(frames - 1) * base.frameSeconds;
-    const scene::CameraPose lastPose = app::cameraPoseAt(scene, base, frames - 1);
+                          std::optional<uint32_t> maxFrames, std::optional<uint32_t> frame) {
+    const uint32_t at = frame.value_or(std::max(base.frames, 1u) - 1);
     app::ReflectionRunOptions options = base;
     options.reference.enabled = true;
-    options.startSeconds = lastSeconds;
+    options.startSeconds = base.freezeTime ? base.startSeconds : base.startSeconds + float(at) * base.frameSeconds;
+    options.stillPose = base.stillPose ? *base.stillPose : app::cameraPoseAt(scene, base, at);
+    options.captureFrames.clear();
     if (maxFrames) {
         if (*maxFrames == 0 || *maxFrames > 2048) {
             throw std::runtime_error("--reference-max-frames: expected 1..2048");
@@ -91,19 +100,10 @@ Reference renderReference(gpu::Context& ctx, scene::Scene& scene, const app::Ref
         options.reference.minFrames = std::min(options.reference.minFrames, *maxFrames);
         options.reference.checkEvery = std::min(options.reference.checkEvery, *maxFrames);
     }
-    const scene::CameraPath path = scene.cameraPath;
-    scene.cameraPath.keys = {{lastSeconds, lastPose.position, lastPose.target},
-                             {lastSeconds + 1.0f, lastPose.position, lastPose.target}};
-    spdlog::info("reference: {}x{} at the pose of frame {} ({:.3f} s)", base.width, base.height, frames - 1,
-                 lastSeconds);
+    spdlog::info("reference: {}x{} at the pose of frame {} ({:.3f} s)", base.width, base.height, at,
+                 options.startSeconds);
     Reference r;
-    try {
-        r.result = app::runReflections(ctx, scene, options);
-    } catch (...) {
-        scene.cameraPath = path;
-        throw;
-    }
-    scene.cameraPath = path;
+    r.result = app::runReflections(ctx, scene, options);
     r.image = metrics::imageFromSrgb8(base.width, base.height, r.result.rgba, 4, "reference");
     r.term = reflectionTerm(r.result.resolved, base.width, base.height, base.frame.composite.exposure, "reference");
     return r;
@@ -116,6 +116,7 @@ app::ReflectionRunResult runMeasured(gpu::Context& ctx, scene::Scene& scene, con
         warmup.frames = warmupFrames;
         warmup.readResolved = false;
         warmup.timeEveryFrame = false;
+        warmup.captureFrames.clear();
         app::runReflections(ctx, scene, warmup);
     }
     return app::runReflections(ctx, scene, options);

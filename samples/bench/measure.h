@@ -33,6 +33,18 @@ std::vector<uint8_t> toSrgb8(const metrics::Image& image);
 ErrorMetrics measure(const metrics::Image& reference, const metrics::Image& test, double ppd,
                      const metrics::Image* referenceRadiance = nullptr, const metrics::Image* testRadiance = nullptr);
 
+// One configuration: a mode with its defaults, or with one parameter
+// (app::parameters()) set.
+struct Configuration {
+    passes::ReflectionMode mode = passes::ReflectionMode::Hybrid;
+    std::string param{kDefaultParam};  // kDefaultParam or a parameter name
+    double value = 0.0;
+};
+// `base` in the configuration's mode with its parameter set.
+app::ReflectionRunOptions configure(const app::ReflectionRunOptions& base, const Configuration& c);
+// "hybrid defaults", "rt sslr_steps=32".
+std::string describe(const Configuration& c);
+
 struct Reference {
     app::ReflectionRunResult result;
     metrics::Image image;  // the final image
@@ -40,11 +52,12 @@ struct Reference {
 };
 
 // The reference (app::ReferenceOptions) of runs made with `base`: rendered
-// at the pose and scene time of their last frame, a still camera path that
-// holds that pose (the scene's own path is restored after). `maxFrames`
+// at the pose and scene time of their frame `frame` (default: the last), a
+// still camera at that pose and the scene's time frozen there. `maxFrames`
 // caps its accumulation.
 Reference renderReference(gpu::Context& ctx, scene::Scene& scene, const app::ReflectionRunOptions& base,
-                          std::optional<uint32_t> maxFrames = std::nullopt);
+                          std::optional<uint32_t> maxFrames = std::nullopt,
+                          std::optional<uint32_t> frame = std::nullopt);
 
 // `warmupFrames` untimed frames of the configuration, then the measured run.
 // While the metrics run on the CPU the GPU idles and drops its clocks, and

@@ -229,6 +229,66 @@ std::string toScaleJson(const RunInfo& info, std::span<const ScaleRow> rows) {
     return j.dump(2) + "\n";
 }
 
+std::string toMotionCsv(std::span<const MotionRow> rows) {
+    std::string out(kMotionCsvHeader);
+    out += '\n';
+    for (const MotionRow& r : rows) {
+        std::string scene = r.scene;
+        std::replace(scene.begin(), scene.end(), ',', '_');
+        out += scene + ',' + r.mode + ',' + r.param + ',' + formatValue(r.value) + ',' + std::to_string(r.width) + ',' +
+               std::to_string(r.height) + ',' + number(r.reflectionMs) + ',' + number(r.flipStill) + ',' +
+               number(r.flipMotion);
+        for (const double g : r.ghostEnergy) out += ',' + number(g);
+        out += ',' + number(r.lagPixels) + ',' + number(r.flicker);
+        for (const double b : r.flipBand) out += ',' + number(b);
+        out += '\n';
+    }
+    return out;
+}
+
+std::string toMotionJson(const RunInfo& info, std::span<const MotionRow> rows) {
+    Json j = Json::parse(toJson(info, {}));
+    j.erase("rows");
+    Json list = Json::array();
+    for (const MotionRow& r : rows) {
+        Json row = {{"scene", r.scene},
+                    {"mode", r.mode},
+                    {"param", r.param},
+                    {"value", jsonNumber(r.value)},
+                    {"width", r.width},
+                    {"height", r.height},
+                    {"reflection_ms", jsonNumber(r.reflectionMs)},
+                    {"flip_still", jsonNumber(r.flipStill)},
+                    {"flip_motion", jsonNumber(r.flipMotion)}};
+        const std::array<const char*, 3> ghost = {"ghost_energy_1", "ghost_energy_4", "ghost_energy_16"};
+        for (size_t k = 0; k < ghost.size(); ++k) row[ghost[k]] = jsonNumber(r.ghostEnergy[k]);
+        row["lag_px"] = jsonNumber(r.lagPixels);
+        row["flicker"] = jsonNumber(r.flicker);
+        const std::array<const char*, 4> bands = {"flip_mirror", "flip_glossy", "flip_rough", "flip_very_rough"};
+        for (size_t k = 0; k < bands.size(); ++k) row[bands[k]] = jsonNumber(r.flipBand[k]);
+        Json perFrame = Json::array();
+        for (const double f : r.flipPerFrame) perFrame.push_back(jsonNumber(f));
+        row["flip_per_frame"] = perFrame;
+        list.push_back(row);
+    }
+    j["rows"] = list;
+    return j.dump(2) + "\n";
+}
+
+std::vector<PlotPoint> motionPlotPoints(std::span<const MotionRow> rows) {
+    std::vector<PlotPoint> points;
+    for (const MotionRow& r : rows) {
+        if (!r.reflectionMs) continue;
+        PlotPoint p;
+        p.at = {*r.reflectionMs, r.flipMotion};
+        p.series = r.mode;
+        p.baseline = r.param == kDefaultParam;
+        p.label = p.baseline ? r.mode : r.param + "=" + formatValue(r.value);
+        points.push_back(p);
+    }
+    return points;
+}
+
 std::vector<PlotPoint> scalePlotPoints(std::span<const ScaleRow> rows) {
     std::vector<PlotPoint> points;
     for (const ScaleRow& r : rows) {

@@ -4,6 +4,7 @@
 // (drawn by matplotlib). Pure CPU code with no Vulkan, so the tests check
 // the schema and the plot without a device.
 
+#include <array>
 #include <cstdint>
 #include <filesystem>
 #include <optional>
@@ -182,6 +183,44 @@ std::string toScaleJson(const RunInfo& info, std::span<const ScaleRow> rows);
 
 // x = instanced triangles, y = reflection_ms, one series per mode.
 std::vector<PlotPoint> scalePlotPoints(std::span<const ScaleRow> rows);
+
+// ---- Reflections in motion (glint-bench --motion) ---------------------------
+
+// The CSV header of the motion run, column for column. flip_* are the
+// reflection term's LDR-FLIP against per-frame references: flip_still at a
+// still camera, flip_motion the mean along the path, flip_<band> along the
+// path over the pixels whose surface roughness lies in the band
+// (metrics::kRoughnessBandEdges).
+inline constexpr std::string_view kMotionCsvHeader =
+    "scene,mode,param,value,width,height,reflection_ms,flip_still,flip_motion,ghost_energy_1,ghost_energy_4,"
+    "ghost_energy_16,lag_px,flicker,flip_mirror,flip_glossy,flip_rough,flip_very_rough";
+
+// One configuration measured in motion.
+struct MotionRow {
+    std::string scene;
+    std::string mode;
+    std::string param{kDefaultParam};
+    std::optional<double> value;
+    uint32_t width = 0;
+    uint32_t height = 0;
+    std::optional<double> reflectionMs;  // median over the path run's frames
+    double flipStill = 0.0;
+    double flipMotion = 0.0;
+    std::vector<double> flipPerFrame;  // JSON only: at each captured path frame
+    std::array<double, 3> ghostEnergy{};  // 1, 4 and 16 frames after the object starts to move
+    double lagPixels = 0.0;
+    // metrics::flicker of the tonemapped reflection term over a still
+    // camera's last frames (time frozen): 0 for the reference.
+    double flicker = 0.0;
+    std::array<double, 4> flipBand{};  // NaN where no pixel lies in the band
+};
+
+std::string toMotionCsv(std::span<const MotionRow> rows);
+// {info..., "rows": [every CSV column, "flip_per_frame": [...]]}.
+std::string toMotionJson(const RunInfo& info, std::span<const MotionRow> rows);
+// x = reflection_ms, y = flip_motion, one series per mode; defaults as
+// baselines, the front labelled.
+std::vector<PlotPoint> motionPlotPoints(std::span<const MotionRow> rows);
 
 // Writes `text` to `path`, creating the folder; throws naming the file.
 void writeText(const std::filesystem::path& path, std::string_view text);

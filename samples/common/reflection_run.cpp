@@ -50,7 +50,7 @@ constexpr std::array<bool, 3> kEveryMode{true, true, true};
 
 // The one table of parameters: name, field, the viewer's range, the
 // bench's sweep, and where the value lives.
-const std::array<ParameterSlot, 17> kParameters = {{
+const std::array<ParameterSlot, 19> kParameters = {{
     // A confidence; the talk's 0.9 (default) bracketed from "trust SSLR
     // often" to "almost never".
     {{"sslr_threshold", "ReflectionFrameSettings::confidenceThreshold", 0.0f, 1.0f, false, {0.5, 0.7, 0.8, 0.95, 0.99},
@@ -120,10 +120,20 @@ const std::array<ParameterSlot, 17> kParameters = {{
     {{"blue_noise", "RayGenerationSettings::blueNoise (1: spatiotemporal blue noise, 0: hashed sequences)", 0.0f,
       1.0f, true, {0}, {0}, kEveryMode},
      nullptr, nullptr, [](ReflectionRunOptions& o) { return &o.frame.rays.blueNoise; }},
+    // The longest temporal history (default 32 frames): longer averages
+    // more noise away (less flicker) and trails further behind what the
+    // clamp lets through.
+    {{"history_frames", "TemporalSettings::maxHistoryFrames", 1.0f, 256.0f, false, {8, 16, 64, 128}, {}, kEveryMode},
+     [](ReflectionRunOptions& o) { return &o.frame.temporal.maxHistoryFrames; }, nullptr},
+    // The neighbourhood clamp's width in standard deviations (default 1.25):
+    // narrower rejects stale history sooner and lets more noise through.
+    {{"clamp_gamma", "TemporalSettings::clampGamma", 0.25f, 4.0f, false, {0.75, 1.0, 1.5, 2.0}, {}, kEveryMode},
+     [](ReflectionRunOptions& o) { return &o.frame.temporal.clampGamma; }, nullptr},
     // Reflected objects' own motion in the reprojection (default on): off,
     // only the camera's motion reprojects (what moving objects' trails
     // were before it).
-    {{"reflected_motion", "ReflectionFrameSettings::reflectedMotion (0 or 1)", 0.0f, 1.0f, true, {}, {}, {}}, nullptr,
+    {{"reflected_motion", "ReflectionFrameSettings::reflectedMotion (0 or 1)", 0.0f, 1.0f, true, {0}, {}, kEveryMode},
+     nullptr,
      nullptr, [](ReflectionRunOptions& o) { return &o.frame.reflectedMotion; }},
 }};
 
@@ -227,7 +237,28 @@ ReflectionRunOptions referenceSettings(const ReflectionRunOptions& in) {
     o.frame.temporal.neighbourhoodClamp = false;
     o.frame.temporal.spatialRadius = 0;
     o.frame.debugView.clear();
+    o.freezeTime = true;
+    o.captureFrames.clear();
     return o;
+}
+
+// The resolved reflections (RGBA16F) as floats.
+std::vector<float> resolvedFloats(const rg::HostReadback& resolved, size_t pixels) {
+    const auto halves = resolved.as<uint16_t>();
+    std::vector<float> out(pixels * 4);
+    for (size_t k = 0; k < out.size(); ++k) out[k] = glm::unpackHalf1x16(halves[k]);
+    return out;
+}
+
+// The G-buffer's roughness (RGBA8 unorm, r) where a reflection exists, -1
+// elsewhere.
+std::vector<float> roughnessFloats(const rg::HostReadback& roughnessMetal, const std::vector<float>& resolved) {
+    const auto bytes = roughnessMetal.as<uint8_t>();
+    std::vector<float> out(resolved.size() / 4);
+    for (size_t p = 0; p < out.size(); ++p) {
+        out[p] = resolved[p * 4 + 3] > 0.0f ? float(bytes[p * 4]) / 255.0f : -1.0f;
+    }
+    return out;
 }
 
 // Mean of the reflected radiance (rgb summed) over the pixels that reflect.
@@ -267,8 +298,19 @@ ReflectionRunResult runReflections(gpu::Context& ctx, scene::Scene& scene, const
     const uint32_t w = options.width, h = options.height;
     const rg::HostReadback image(ctx, VkDeviceSize(w) * h * 4, "readback.output");
     const rg::HostReadback counts(ctx, shader::kReflectionCountWords * 4u, "readback.counts");
-    std::optional<rg::HostReadback> resolved;
-    if (reference || options.readResolved) resolved.emplace(ctx, VkDeviceSize(w) * h * 8, "readback.resolved");
+    std::optional<rg::HostReadback> resolved, roughness;
+    const bool captures = !options.captureFrames.empty();
+    if (reference || options.readResolved || captures) {
+        resolved.emplace(ctx, VkDeviceSize(w) * h * 8, "readback.resolved");
+    }
+    if (options.readResolved || captures) roughness.emplace(ctx, VkDeviceSize(w) * h * 4, "readback.roughness");
+    for (size_t k = 0; k < options.captureFrames.size(); ++k) {
+        if (options.captureFrames[k] >= options.frames || (k > 0 && options.captureFrames[k] <= options.captureFrames[k - 1])) {
+            throw std::invalid_argument("captureFrames: expected increasing frame indices below " +
+                                        std::to_string(options.frames));
+        }
+    }
+    size_t nextCapture = 0;
     std::optional<double> previousMean;
     const uint64_t frameBase = reference ? uint64_t(options.reference.seed) << 20 : 0;
 
@@ -321,14 +363,16 @@ ReflectionRunResult runReflections(gpu::Context& ctx, scene::Scene& scene, const
     for (uint32_t i = 0; i < options.frames; ++i) {
         // The reference stands still: one pose, one scene time; only the
         // frame index (the noise) moves.
-        const scene::CameraPose pose = cameraPoseAt(scene, options, reference ? 0 : i);
+        const scene::CameraPose pose =
+            options.stillPose ? *options.stillPose : cameraPoseAt(scene, options, reference ? 0 : i);
         if (i == 0) {
             camera.reset(pose, frameBase);
         } else {
             camera.advance(pose, frameBase + i);
         }
-        scene::advanceScene(scene, options.startSeconds + (reference ? 0.0f : float(i) * options.frameSeconds),
+        scene::advanceScene(scene, options.startSeconds + (options.freezeTime ? 0.0f : float(i) * options.frameSeconds),
                             &camera);
+        const bool capture = nextCapture < options.captureFrames.size() && options.captureFrames[nextCapture] == i;
 
         const bool check = reference && (i + 1) % options.reference.checkEvery == 0;
         const bool last = i + 1 == options.frames || check;
@@ -343,8 +387,11 @@ ReflectionRunResult runReflections(gpu::Context& ctx, scene::Scene& scene, const
             image.copy(graph, resources, frame.output.color);
             counts.copy(graph, resources, frame.counts);
         }
-        if (check || (last && options.readResolved)) {
+        if (check || (last && options.readResolved) || capture) {
             resolved->copy(graph, resources, frame.temporal.resolved);
+        }
+        if ((last && options.readResolved) || capture) {
+            roughness->copy(graph, resources, frame.gbuffer.roughnessMetal);
         }
         // Timed frames alternate: per-pass times (odd frames), then the
         // reflection chain as one span without them (reflection_span_ms,
@@ -390,6 +437,15 @@ ReflectionRunResult runReflections(gpu::Context& ctx, scene::Scene& scene, const
         }
 
         result.framesRun = i + 1;
+        if (capture) {
+            executor.waitIdle();
+            FrameCapture c;
+            c.frame = i;
+            c.resolved = resolvedFloats(*resolved, size_t(w) * h);
+            c.roughness = roughnessFloats(*roughness, c.resolved);
+            result.captures.push_back(std::move(c));
+            ++nextCapture;
+        }
         if (i == 0) blockingAfterFirst = ctx.blockingSubmits();
         if (check) {
             executor.waitIdle();
@@ -441,9 +497,8 @@ ReflectionRunResult runReflections(gpu::Context& ctx, scene::Scene& scene, const
     result.rgba.resize(size_t(w) * h * 4);
     std::memcpy(result.rgba.data(), image.bytes().data(), result.rgba.size());
     if (options.readResolved) {
-        const auto halves = resolved->as<uint16_t>();
-        result.resolved.resize(size_t(w) * h * 4);
-        for (size_t k = 0; k < result.resolved.size(); ++k) result.resolved[k] = glm::unpackHalf1x16(halves[k]);
+        result.resolved = resolvedFloats(*resolved, size_t(w) * h);
+        result.roughness = roughnessFloats(*roughness, result.resolved);
     }
     std::vector<uint32_t> words(shader::kReflectionCountWords);
     std::memcpy(words.data(), counts.bytes().data(), words.size() * 4);

@@ -54,6 +54,15 @@ struct ReflectionRunOptions {
     // pass's output) into ReflectionRunResult::resolved: the benchmark
     // measures the reflection term's error on it, before the composite.
     bool readResolved = false;
+    // Frames (indices from 0) whose resolved reflections and surface
+    // roughness are read back into ReflectionRunResult::captures, waiting
+    // for each: the per-frame error of a sequence in motion.
+    std::vector<uint32_t> captureFrames;
+    // A still camera at this pose on every frame (else the scene's path).
+    std::optional<scene::CameraPose> stillPose;
+    // The scene stays at startSeconds on every frame (else it is animated
+    // along with the frames). References freeze it.
+    bool freezeTime = false;
     // How pass times are taken; none: host-serial on a CPU device (lavapipe's
     // timestamps do not cover compute dispatches), GPU timestamps elsewhere.
     std::optional<rg::PassTimer> passTimer;
@@ -69,12 +78,27 @@ struct PassTime {
     std::optional<double> cpuMilliseconds;  // host-serial timing only: median process CPU time
 };
 
+// One frame read back (ReflectionRunOptions::captureFrames).
+struct FrameCapture {
+    uint32_t frame = 0;
+    // Linear resolved reflections, width x height x 4 (as
+    // ReflectionRunResult::resolved).
+    std::vector<float> resolved;
+    // The G-buffer's perceptual roughness per pixel; -1 where no surface
+    // reflects (the sky).
+    std::vector<float> roughness;
+};
+
 struct ReflectionRunResult {
     std::vector<uint8_t> rgba;  // the last frame's output, width x height x 4, sRGB-encoded
     // With ReflectionRunOptions::readResolved: the last frame's resolved
     // reflections, width x height x 4 floats, linear radiance (a > 0 where
     // the pixel has a reflection, else all zero).
     std::vector<float> resolved;
+    // The last frame's roughness, as FrameCapture::roughness (with
+    // readResolved).
+    std::vector<float> roughness;
+    std::vector<FrameCapture> captures;  // in frame order
     std::vector<PassTime> passes;
     rg::PassTimer passTimer = rg::PassTimer::GpuTimestamps;  // how `passes` were timed
     std::optional<double> reflectionMs;  // median per-frame sum of the reflection passes

@@ -6,6 +6,7 @@
 #include <doctest/doctest.h>
 #include <nlohmann/json.hpp>
 
+#include <algorithm>
 #include <cmath>
 #include <filesystem>
 #include <fstream>
@@ -254,4 +255,53 @@ TEST_CASE("the scale CSV has its header and a row per size and mode; the plot pu
     for (const auto& p : json["points"]) CHECK(p["front"] == false);
     writePlot("test-out/bench/scale.png", points, options);
     CHECK(pngSize("test-out/bench/scale.png") == std::pair<uint32_t, uint32_t>{options.width, options.height});
+}
+
+TEST_CASE("the motion CSV has its header and the motion metrics per configuration; empty bands are nan and null") {
+    std::vector<MotionRow> rows(2);
+    for (size_t k = 0; k < rows.size(); ++k) {
+        MotionRow& r = rows[k];
+        r.scene = "plaza";
+        r.mode = k == 0 ? "hybrid" : "rt";
+        r.width = 1920;
+        r.height = 1080;
+        r.reflectionMs = 0.5 + double(k);
+        r.flipStill = 0.05;
+        r.flipMotion = 0.06;
+        r.flipPerFrame = {0.05, 0.07};
+        r.ghostEnergy = {0.1, 0.04, 0.02};
+        r.lagPixels = 1.5;
+        r.flicker = 0.002;
+        r.flipBand = {0.03, 0.05, 0.08, std::numeric_limits<double>::quiet_NaN()};
+    }
+    rows[1].param = "history_frames";
+    rows[1].value = 64.0;
+    const std::vector<std::string> csv = lines(toMotionCsv(rows));
+    REQUIRE(csv.size() == 3);
+    CHECK(csv[0] == kMotionCsvHeader);
+    const std::vector<std::string> header = split(std::string(kMotionCsvHeader), ',');
+    const std::vector<std::string> cells = split(csv[2], ',');
+    REQUIRE(cells.size() == header.size());
+    const auto column = [&](const char* name) {
+        return cells[size_t(std::find(header.begin(), header.end(), name) - header.begin())];
+    };
+    CHECK(column("param") == "history_frames");
+    CHECK(column("value") == "64");
+    CHECK(std::stod(column("ghost_energy_4")) == doctest::Approx(0.04));
+    CHECK(std::stod(column("lag_px")) == doctest::Approx(1.5));
+    CHECK(std::stod(column("flicker")) == doctest::Approx(0.002));
+    CHECK(column("flip_very_rough") == "nan");
+
+    const auto json = nlohmann::json::parse(toMotionJson(RunInfo{}, rows));
+    REQUIRE(json["rows"].size() == 2);
+    CHECK(json["rows"][0]["flip_per_frame"].size() == 2);
+    CHECK(json["rows"][0]["flip_very_rough"].is_null());
+    CHECK(json["rows"][1]["ghost_energy_16"] == doctest::Approx(0.02));
+
+    const std::vector<PlotPoint> points = motionPlotPoints(rows);
+    REQUIRE(points.size() == 2);
+    CHECK(points[1].at.x == 1.5);
+    CHECK(points[1].at.y == 0.06);
+    CHECK(points[0].baseline);
+    CHECK(points[1].label == "history_frames=64");
 }

@@ -28,26 +28,49 @@ void block(Image& image, uint32_t x, uint32_t y, glm::vec3 value) {
 } // namespace
 
 TEST_CASE("a trail of a quarter of the object's brightness behind it is a ghost energy of 0.25") {
-    const Image without = black("without");
-    Image reference = black("reference");
-    block(reference, 20, 6, glm::vec3(1.0f));
-    const std::vector<uint8_t> inside = footprint(reference, without);
+    // A grey background the object's renders share, with a bias of the
+    // test renderer's own: comparing contributions leaves the bias out.
+    Image without = black("without"), testWithout = black("test without");
+    for (glm::vec3& c : without.linear) c = glm::vec3(0.2f);
+    for (glm::vec3& c : testWithout.linear) c = glm::vec3(0.3f);
+    Image reference = without;
+    block(reference, 20, 6, glm::vec3(1.2f));
+    const Contribution ref = contribution(reference, without);
+    const std::vector<uint8_t> inside = footprint(ref);
     size_t count = 0;
     for (const uint8_t v : inside) count += v;
     CHECK(count == 16);
+    // Grown by a pixel each way: 6x6.
+    size_t grown = 0;
+    for (const uint8_t v : footprint(ref, 1e-3f, 1)) grown += v;
+    CHECK(grown == 36);
+    // At the image's corner the square is cut off: 5x5 of a block at (0, 0).
+    Image corner = without;
+    block(corner, 0, 0, glm::vec3(1.2f));
+    size_t cut = 0;
+    for (const uint8_t v : footprint(contribution(corner, without), 1e-3f, 1)) cut += v;
+    CHECK(cut == 25);
 
-    CHECK(ghostEnergy(reference, reference, inside) == doctest::Approx(0.0));
-    Image trailing = reference;
-    block(trailing, 10, 6, glm::vec3(0.25f));  // left behind, same size
-    CHECK(ghostEnergy(reference, trailing, inside) == doctest::Approx(0.25));
-    // Darker than the reference outside the footprint is no trail.
-    Image darker = reference;
-    darker.linear[0] = glm::vec3(-1.0f);
-    CHECK(ghostEnergy(reference, darker, inside) == doctest::Approx(0.0));
+    CHECK(ghostEnergy(ref, ref, inside) == doctest::Approx(0.0));
+    Image same = testWithout;
+    block(same, 20, 6, glm::vec3(1.3f));
+    CHECK(ghostEnergy(ref, contribution(same, testWithout), inside) == doctest::Approx(0.0));
+    Image trailing = same;
+    block(trailing, 10, 6, glm::vec3(0.55f));  // a quarter of the object's 1.0 left behind
+    CHECK(ghostEnergy(ref, contribution(trailing, testWithout), inside) == doctest::Approx(0.25));
+    // A dark trail (the object hid something) counts by its magnitude.
+    Image dark = same;
+    block(dark, 10, 6, glm::vec3(0.05f));
+    CHECK(ghostEnergy(ref, contribution(dark, testWithout), inside) == doctest::Approx(0.25));
 
-    CHECK_THROWS_WITH_AS(ghostEnergy(reference, trailing, std::vector<uint8_t>(kWidth * kHeight, 0)),
-                         doctest::Contains("no luminance inside the footprint"), std::invalid_argument);
-    CHECK_THROWS_AS(ghostEnergy(reference, trailing, std::vector<uint8_t>(3, 1)), std::invalid_argument);
+    CHECK_THROWS_WITH_AS(ghostEnergy(ref, ref, std::vector<uint8_t>(kWidth * kHeight, 0)),
+                         doctest::Contains("contributes nothing inside the footprint"), std::invalid_argument);
+    CHECK_THROWS_AS(ghostEnergy(ref, ref, std::vector<uint8_t>(3, 1)), std::invalid_argument);
+    Image small = black("small");
+    small.width = 3;
+    small.height = 1;
+    small.linear.resize(3);
+    CHECK_THROWS_AS(contribution(reference, small), std::invalid_argument);
 }
 
 TEST_CASE("a reflection three pixels behind lags by three pixels") {
@@ -55,9 +78,10 @@ TEST_CASE("a reflection three pixels behind lags by three pixels") {
     Image reference = black("reference"), late = black("late");
     block(reference, 20, 6, glm::vec3(0.8f, 0.5f, 0.2f));
     block(late, 17, 6, glm::vec3(0.8f, 0.5f, 0.2f));
-    CHECK(lagPixels(reference, reference, without) == doctest::Approx(0.0));
-    CHECK(lagPixels(reference, late, without) == doctest::Approx(3.0));
-    CHECK_THROWS_WITH_AS(lagPixels(reference, without, without), doctest::Contains("does not differ"),
+    const Contribution ref = contribution(reference, without);
+    CHECK(lagPixels(ref, ref) == doctest::Approx(0.0));
+    CHECK(lagPixels(ref, contribution(late, without)) == doctest::Approx(3.0));
+    CHECK_THROWS_WITH_AS(lagPixels(ref, contribution(without, without)), doctest::Contains("zero everywhere"),
                          std::invalid_argument);
 }
 

@@ -199,7 +199,7 @@ TEST_CASE("built-in scenes name their camera presets") {
 TEST_CASE("built-in scenes are the same on every build") {
     CHECK(positionHash(makePlaza()) == positionHash(makePlaza()));
     CHECK(positionHash(makeHardCases()) == positionHash(makeHardCases()));
-    CHECK(builtinSceneNames().size() == 3);
+    CHECK(builtinSceneNames().size() == 4);
     CHECK(isBuiltinScene(kDefaultSceneName));
     try {
         makeBuiltinScene("atrium");

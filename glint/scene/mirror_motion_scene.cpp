@@ -1,0 +1,74 @@
+// The built-in "mirror-motion" (builtin_scenes.h): a bright object moving
+// across a mirror floor, then a camera moving past it; what reflections in
+// motion are measured on (glint-bench --motion, the ghosting tests).
+
+#include "glint/scene/builtin_scenes.h"
+
+#include "glint/scene/animation.h"
+#include "glint/scene/procedural_meshes.h"
+#include "glint/scene/scene_builder.h"
+
+#include <algorithm>
+
+namespace glint::scene {
+
+namespace {
+
+// The object's x along its line at `seconds` (metres).
+float objectX(float seconds) {
+    if (seconds <= kMirrorMotion.objectStartSeconds) return kMirrorMotion.objectStartX;
+    const float moved = std::min(seconds, kMirrorMotion.objectStopSeconds) - kMirrorMotion.objectStartSeconds;
+    return kMirrorMotion.objectStartX + kMirrorMotion.objectSpeed * moved;
+}
+
+} // namespace
+
+Scene makeMirrorMotion(bool withObject) {
+    SceneBuilder b("mirror-motion");
+    Scene& s = b.scene;
+    const MirrorMotionTimeline& m = kMirrorMotion;
+    const uint32_t mirror = b.material(makeMaterial("wet floor", {0.9f, 0.92f, 0.95f}, 1.0f, 0.1f));
+    const uint32_t wall = b.material(makeMaterial("backdrop", {0.08f, 0.1f, 0.14f}, 0.0f, 0.8f));
+    const uint32_t pillar = b.material(makeMaterial("pillar", {0.2f, 0.25f, 0.35f}, 0.0f, 0.5f));
+    const uint32_t lamp = b.material(makeEmissive("moving lamp", {1.0f, 0.55f, 0.2f}, 6.0f));
+
+    // A 16 m square mirror, a wall behind it and two still pillars, so the
+    // reflection has still neighbours to be compared with.
+    const uint32_t floor = b.mesh("mirror floor", {{makeGrid({16, 16}, {4, 4}, mirror)}});
+    b.place("mirror floor", floor, {0, 0, 0});
+    const uint32_t backdrop = b.mesh("backdrop", {{makeBox({16.0f, 4.0f, 0.2f}, wall)}});
+    b.place("backdrop", backdrop, {0, 2.0f, -6.0f});
+    const uint32_t post = b.mesh("pillar", {{makeBox({0.3f, 1.6f, 0.3f}, pillar)}});
+    b.place("pillar left", post, {-2.5f, 0.8f, -1.5f});
+    b.place("pillar right", post, {2.5f, 0.8f, -1.5f});
+
+    if (withObject) {
+        const uint32_t cube = b.mesh("moving lamp", {{makeBox({0.5f, 0.5f, 0.5f}, lamp)}});
+        const uint32_t node = b.node("moving lamp", kNone, {objectX(0.0f), m.objectHeight, m.objectZ});
+        b.instance("moving lamp", cube, node, Motion::Dynamic);
+        Animation slide;
+        slide.name = "moving lamp";
+        // Keys every 50 ms: the start and the stop fall on keys, so the
+        // linear track is the piecewise-linear motion exactly.
+        b.translationTrack(slide, node, m.loopSeconds, uint32_t(m.loopSeconds * 20.0f) + 1,
+                           [&](float t) { return glm::vec3(objectX(t), m.objectHeight, m.objectZ); });
+        b.play(std::move(slide));
+    }
+
+    s.sun.directionToLight = glm::normalize(glm::vec3(-0.4f, 0.8f, 0.45f));
+    s.lens = {glm::radians(60.0f), 0.05f, kInfiniteFar};
+    // Still until the camera's start, then a strafe to the right at a
+    // constant speed (the keys before and after keep Catmull-Rom straight).
+    const glm::vec3 eye(0.0f, 1.4f, 3.5f), target(0.0f, 0.1f, -1.0f);
+    const glm::vec3 step(m.cameraSpeed * 0.5f, 0.0f, 0.0f);
+    s.cameraPath.keys = {{0.0f, eye, target}};
+    for (int k = 0; k <= 4; ++k) {
+        const glm::vec3 offset = float(std::max(k - 1, 0)) * step;
+        s.cameraPath.keys.push_back({m.cameraStartSeconds - 0.5f + 0.5f * float(k), eye + offset, target + offset});
+    }
+    s.views.push_back({"mirror", s.lens, eye, target});
+    prepareScene(s);
+    return s;
+}
+
+} // namespace glint::scene
