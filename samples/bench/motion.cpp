@@ -102,9 +102,7 @@ MirrorReferences renderMirrorReferences(gpu::Context& ctx, const app::Reflection
         const metrics::Image image = mirrorReference(ctx, with, options, frame, maxFrames, &r.ghostFloor.back());
         r.ghost.push_back(onFloor(metrics::contribution(image, still), r.ghostFloor.back()));
     }
-    const metrics::Image lag = mirrorReference(ctx, with, options, r.frames.lag, maxFrames, &r.lagFloor);
-    r.lag = onFloor(metrics::contribution(lag, mirrorReference(ctx, without, options, r.frames.lag, maxFrames)),
-                    r.lagFloor);
+    mirrorReference(ctx, with, options, r.frames.lag, maxFrames, &r.lagFloor);
     return r;
 }
 
@@ -114,23 +112,37 @@ MirrorMetrics measureMirror(gpu::Context& ctx, const app::ReflectionRunOptions& 
     o.captureFrames.assign(references.frames.ghost.begin(), references.frames.ghost.end());
     o.captureFrames.push_back(references.frames.lag);
     o.timeEveryFrame = false;
-    const auto run = [&](bool withLamp) {
+    // The lag frame again, the camera standing at its pose and the scene's
+    // time frozen there: where this configuration puts the reflection when
+    // nothing moves.
+    app::ReflectionRunOptions standing = o;
+    standing.frames = kLagStillFrames;
+    standing.captureFrames = {kLagStillFrames - 1};
+    standing.freezeTime = true;
+    standing.startSeconds = float(references.frames.lag) * o.frameSeconds;
+    {
+        const scene::Scene scene = scene::makeMirrorMotion(true);
+        standing.stillPose = app::cameraPoseAt(scene, o, references.frames.lag);
+    }
+    const auto run = [&](bool withLamp, const app::ReflectionRunOptions& runOptions) {
         scene::Scene scene = scene::makeMirrorMotion(withLamp);
-        app::ReflectionRunResult result = app::runReflections(ctx, scene, o);
-        if (result.captures.size() != o.captureFrames.size()) {
+        const app::ReflectionRunResult result = app::runReflections(ctx, scene, runOptions);
+        if (result.captures.size() != runOptions.captureFrames.size()) {
             throw std::runtime_error("mirror-motion: " + std::to_string(result.captures.size()) + " of " +
-                                     std::to_string(o.captureFrames.size()) + " frames captured");
+                                     std::to_string(runOptions.captureFrames.size()) + " frames captured");
         }
         std::vector<metrics::Image> images;
         for (const app::FrameCapture& c : result.captures) {
-            images.push_back(reflectionTerm(c.resolved, o.width, o.height, o.frame.composite.exposure,
+            images.push_back(reflectionTerm(c.resolved, runOptions.width, runOptions.height,
+                                            runOptions.frame.composite.exposure,
                                             std::string("mirror-motion ") + (withLamp ? "" : "without lamp ") +
                                                 "frame " + std::to_string(c.frame))
                                  .radiance);
         }
         return images;
     };
-    const std::vector<metrics::Image> with = run(true), without = run(false);
+    const std::vector<metrics::Image> with = run(true, o), without = run(false, o);
+    const std::vector<metrics::Image> still = run(true, standing), stillWithout = run(false, standing);
     MirrorMetrics m;
     for (size_t k = 0; k < references.ghost.size(); ++k) {
         const std::vector<uint8_t> inside = metrics::footprint(references.ghost[k], 1e-3f, kGhostEdgePixels);
@@ -138,8 +150,9 @@ MirrorMetrics measureMirror(gpu::Context& ctx, const app::ReflectionRunOptions& 
             references.ghost[k], onFloor(metrics::contribution(with[k], without[k]), references.ghostFloor[k]), inside);
     }
     const size_t lag = references.ghost.size();
-    m.lagPixels = metrics::lagPixels(references.lag,
-                                     onFloor(metrics::contribution(with[lag], without[lag]), references.lagFloor));
+    m.lagPixels =
+        metrics::lagPixels(onFloor(metrics::contribution(still[0], stillWithout[0]), references.lagFloor),
+                           onFloor(metrics::contribution(with[lag], without[lag]), references.lagFloor));
     return m;
 }
 

@@ -9,8 +9,11 @@
 //     last frames);
 //   - the built-in "mirror-motion" scene (scene::kMirrorMotion): the lamp's
 //     trail on the mirror 1, 4 and 16 frames after it starts to move
-//     (ghost_energy_*), and how far its reflection lags behind the reference
-//     16 frames into the camera's strafe (lag_px).
+//     (ghost_energy_*), and how far its reflection lags 16 frames into the
+//     camera's strafe behind where the same configuration puts it with the
+//     camera standing at that pose (lag_px: the temporal lag alone; what
+//     screen-space tracing cannot see of the lamp, e.g. its underside, is a
+//     spatial error and is left out).
 // The references are rendered once and shared by every configuration.
 
 #include "bench/measure.h"
@@ -38,20 +41,20 @@ struct MirrorMotionFrames {
 };
 inline constexpr std::array<uint32_t, 3> kGhostFramesAfter = {1, 4, 16};
 inline constexpr uint32_t kLagFramesAfter = 16;
+inline constexpr uint32_t kLagStillFrames = 48;
 // The trail is counted a pixel beyond the reference's footprint: edges a
 // pixel off are an edge error, not a trail (metrics::footprint's dilation).
 inline constexpr uint32_t kGhostEdgePixels = 1;
 MirrorMotionFrames mirrorMotionFrames(float frameSeconds);
 
 // What the lamp contributes to the reference's reflection term at each
-// ghost frame and at the lag frame (metrics::contribution: the reference
-// with the lamp minus the reference without it).
+// ghost frame (metrics::contribution: the reference with the lamp minus the
+// reference without it), and where the floor is at the lag frame.
 // Only the mirror floor's pixels count (the reference's roughness in the
 // mirror band): the lamp's own reflection term is not its reflection.
 struct MirrorReferences {
     MirrorMotionFrames frames;
     std::vector<metrics::Contribution> ghost;
-    metrics::Contribution lag;
     std::vector<std::vector<uint8_t>> ghostFloor;  // per ghost frame: 1 on the mirror floor
     std::vector<uint8_t> lagFloor;
 };
@@ -63,13 +66,16 @@ MirrorReferences renderMirrorReferences(gpu::Context& ctx, const app::Reflection
 
 struct MirrorMetrics {
     std::array<double, 3> ghostEnergy{};  // metrics::ghostEnergy at kGhostFramesAfter
-    double lagPixels = 0.0;               // metrics::lagPixels at the lag frame
+    // metrics::lagPixels at the lag frame against the same configuration's
+    // still camera at that pose (kLagStillFrames frames, time frozen).
+    double lagPixels = 0.0;
 };
 
-// Two runs of the mirror-motion scene with `options` (mode and settings;
-// the scene's own time and camera), with the lamp and without: what the
-// lamp contributes to their reflection terms against what it contributes
-// to the references'.
+// Runs of the mirror-motion scene with `options` (mode and settings; the
+// scene's own time and camera), with the lamp and without: what the lamp
+// contributes to their reflection terms against what it contributes to
+// the references' (the trail), and the same at the lag frame with the
+// camera standing there (the lag).
 MirrorMetrics measureMirror(gpu::Context& ctx, const app::ReflectionRunOptions& options,
                             const MirrorReferences& references);
 
