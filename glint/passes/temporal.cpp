@@ -23,12 +23,13 @@ void checkSettings(const TemporalSettings& s) {
                     s.planeTolerance > 0.0f && s.roughnessTolerance >= 0.0f &&
                     s.surfaceMotionRoughnessStart <= s.surfaceMotionRoughnessEnd &&
                     s.spatialRoughnessStart <= s.spatialRoughnessEnd &&
-                    s.spatialRadius <= shader::kTemporalMaxSpatialRadius && s.spatialPlaneSigma > 0.0f &&
+                    s.spatialRadius <= shader::kTemporalMaxSpatialRadius &&
+                    s.clampRadius <= shader::kTemporalMaxClampRadius && s.spatialPlaneSigma > 0.0f &&
                     s.spatialRoughnessSigma > 0.0f;
     if (!ok) {
         throw gpu::GpuError(
             "addTemporalPass: invalid settings (maxHistoryFrames >= 1, clampGamma > 0, 0 < maxRadiance <= 65504, "
-            "positive tolerances and sigmas, ramps with start <= end, spatialRadius <= 4)");
+            "positive tolerances and sigmas, ramps with start <= end, spatialRadius <= 4, clampRadius <= 3)");
     }
 }
 
@@ -62,6 +63,7 @@ shader::TemporalFrame frameConstants(const TemporalInputs& in, const TemporalSet
     f.spatialRoughnessSigma = s.spatialRoughnessSigma;
     f.spatialRoughnessMax = s.spatialRoughnessMax;
     f.hitMotionBound = in.hitMotion.valid() ? 1u : 0u;
+    f.clampRadius = s.clampRadius;
     return f;
 }
 

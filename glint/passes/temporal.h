@@ -78,6 +78,12 @@ struct TemporalSettings {
     // history every frame).
     bool neighbourhoodClamp = true;
     float clampGamma = 1.25f;
+    // The neighbourhood's radius: (2 r + 1)^2 pixels, at most
+    // shader::kTemporalMaxClampRadius. 1 (3x3) is Salvi's; where quads
+    // share one ray (ray generation's reuse) a 3x3 window holds only two to
+    // four independent samples, and a box estimated from so few jumps from
+    // frame to frame and drags the history with it (flicker).
+    uint32_t clampRadius = 1;
     // History rejection: a history texel counts only if last frame's
     // surface there lies within planeTolerance x view depth of this pixel's
     // tangent plane, its normal within acos(normalTolerance) and its

@@ -55,6 +55,7 @@ const std::vector<app::Flag> kFlags = {
     {"modes", "the modes run with defaults (default hybrid,ssr,rt)"},
     {"sweep-modes", "the modes the parameter sweeps run in (default hybrid; \"\": no sweeps)"},
     {"sweep", "NAME,...: sweep only these parameters (default: every parameter with a sweep)"},
+    {"set", "NAME=VALUE[,NAME=VALUE...]: parameters of every run, the defaults the sweeps start from"},
     {"out-dir", "DIR for everything written (default build/bench)"},
     {"csv", "the CSV (default DIR/<scene>_bench.csv)"},
     {"json", "the JSON (default DIR/<scene>_bench.json)"},
@@ -189,6 +190,7 @@ int main(int argc, char** argv) {
         } catch (const std::invalid_argument& e) {
             throw std::runtime_error(std::string("--backend: ") + e.what());
         }
+        app::setParameters(base, args.get("set", ""));
         const float exposure = base.frame.composite.exposure;
         // A CPU device has no GPU clocks to raise (and a warm-up would double
         // its long runs); a GPU gets about a second of load at 1080p.
@@ -212,6 +214,7 @@ int main(int argc, char** argv) {
         // is submitted alone and timed on the host (rg::PassTimer::HostSerial).
         info.timeAxis = "reflection_ms";
         info.passTimer = cpuDevice ? "host_serial" : "gpu_timestamps";
+        info.set = args.get("set", "");
         info.referenceTolerance = app::ReferenceOptions{}.tolerance;
         std::optional<uint32_t> referenceMaxFrames;
         if (args.has("reference-max-frames")) referenceMaxFrames = args.getUint("reference-max-frames", 0);

@@ -100,6 +100,7 @@ std::string toJson(const RunInfo& info, std::span<const Row> rows) {
     j["relmse_epsilon"] = info.relMseEpsilon;
     j["time_axis"] = info.timeAxis;
     j["pass_timer"] = info.passTimer;
+    j["set"] = info.set;
     j["reference"] = {{"frames", info.referenceFrames},
                       {"converged", info.referenceConverged},
                       {"last_change", info.referenceLastChange},

@@ -69,6 +69,9 @@ struct RunInfo {
     // How pass times were taken: "gpu_timestamps", or "host_serial" (each
     // pass submitted alone and timed on the host: CPU devices).
     std::string passTimer = "gpu_timestamps";
+    // --set: the parameters every run (the references' own settings aside)
+    // started from, "NAME=VALUE,..."; empty: Glint's defaults.
+    std::string set;
     uint32_t referenceFrames = 0;
     bool referenceConverged = false;
     double referenceLastChange = 0.0;

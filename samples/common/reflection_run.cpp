@@ -21,6 +21,7 @@
 #include <cstring>
 #include <limits>
 #include <map>
+#include <stdexcept>
 
 namespace glint::app {
 
@@ -50,7 +51,7 @@ constexpr std::array<bool, 3> kEveryMode{true, true, true};
 
 // The one table of parameters: name, field, the viewer's range, the
 // bench's sweep, and where the value lives.
-const std::array<ParameterSlot, 19> kParameters = {{
+const std::array<ParameterSlot, 20> kParameters = {{
     // A confidence; the talk's 0.9 (default) bracketed from "trust SSLR
     // often" to "almost never".
     {{"sslr_threshold", "ReflectionFrameSettings::confidenceThreshold", 0.0f, 1.0f, false, {0.5, 0.7, 0.8, 0.95, 0.99},
@@ -129,6 +130,10 @@ const std::array<ParameterSlot, 19> kParameters = {{
     // narrower rejects stale history sooner and lets more noise through.
     {{"clamp_gamma", "TemporalSettings::clampGamma", 0.25f, 4.0f, false, {0.75, 1.0, 1.5, 2.0}, {}, kEveryMode},
      [](ReflectionRunOptions& o) { return &o.frame.temporal.clampGamma; }, nullptr},
+    // The clamp's neighbourhood radius (default 1: 3x3): wider estimates
+    // the box from more independent rays.
+    {{"clamp_radius", "TemporalSettings::clampRadius", 1.0f, 3.0f, true, {2, 3}, {}, kEveryMode}, nullptr,
+     [](ReflectionRunOptions& o) { return &o.frame.temporal.clampRadius; }},
     // Reflected objects' own motion in the reprojection (default on): off,
     // only the camera's motion reprojects (what moving objects' trails
     // were before it).
@@ -182,6 +187,21 @@ void setParameter(ReflectionRunOptions& options, std::string_view name, std::str
         *slot.uintField(options) = uint32_t(v);
     } else {
         *slot.floatField(options) = float(v);
+    }
+}
+
+void setParameters(ReflectionRunOptions& options, std::string_view list) {
+    for (size_t start = 0; start < list.size();) {
+        const size_t end = std::min(list.find(',', start), list.size());
+        const std::string item(list.substr(start, end - start));
+        const size_t eq = item.find('=');
+        if (eq == std::string::npos) throw std::runtime_error("--set " + item + ": expected NAME=VALUE");
+        try {
+            setParameter(options, item.substr(0, eq), item.substr(eq + 1));
+        } catch (const std::invalid_argument& e) {
+            throw std::runtime_error(std::string("--set: ") + e.what());
+        }
+        start = end + 1;
     }
 }
 

@@ -162,6 +162,9 @@ std::span<const Parameter> parameters();
 // Sets one parameter; throws std::invalid_argument naming the parameter and
 // the value when either is not accepted.
 void setParameter(ReflectionRunOptions& options, std::string_view name, std::string_view value);
+// "NAME=VALUE[,NAME=VALUE...]" (--set), in order; throws
+// std::runtime_error naming --set and the item that is not accepted.
+void setParameters(ReflectionRunOptions& options, std::string_view list);
 // The parameter's current value.
 double getParameter(const ReflectionRunOptions& options, std::string_view name);
 

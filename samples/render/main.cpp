@@ -127,19 +127,7 @@ int main(int argc, char** argv) {
             throw std::runtime_error(std::string("--mode/--backend: ") + e.what());
         }
         // --set a=1,b=2: the tunable parameters (--list-parameters).
-        const std::string sets = args.get("set", "");
-        for (size_t start = 0; start < sets.size();) {
-            const size_t end = std::min(sets.find(',', start), sets.size());
-            const std::string item = sets.substr(start, end - start);
-            const size_t eq = item.find('=');
-            if (eq == std::string::npos) throw std::runtime_error("--set " + item + ": expected NAME=VALUE");
-            try {
-                app::setParameter(options, item.substr(0, eq), item.substr(eq + 1));
-            } catch (const std::invalid_argument& e) {
-                throw std::runtime_error(std::string("--set: ") + e.what());
-            }
-            start = end + 1;
-        }
+        app::setParameters(options, args.get("set", ""));
         // Where the BVH builds run: async compute (default; the graphics
         // queue on one-queue devices) or the graphics queue, to measure what
         // the overlap buys.

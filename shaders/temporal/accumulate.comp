@@ -15,7 +15,8 @@
 //   3. history at each candidate, bilinear over four taps, each tap kept
 //      only if last frame's surface there lies on this pixel's plane with a
 //      similar normal and roughness (disocclusion and history rejection);
-//   4. variance clipping of the history in YCoCg over the 3x3 neighbourhood
+//   4. variance clipping of the history in YCoCg over the (2 r + 1)^2
+//      neighbourhood (r = clampRadius, 1: 3x3)
 //      (Salvi, "An Excursion in Temporal Supersampling", GDC 2016; YCoCg,
 //      clipping towards the mean and the luma-compressed space as Karis,
 //      "High Quality Temporal Supersampling", SIGGRAPH 2014);
@@ -204,8 +205,9 @@ void main() {
     vec3 sum = vec3(0.0);
     vec3 sumSquares = vec3(0.0);
     float count = 0.0;
-    for (int dy = -1; dy <= 1; ++dy) {
-        for (int dx = -1; dx <= 1; ++dx) {
+    const int r = int(min(frame.clampRadius, kTemporalMaxClampRadius));
+    for (int dy = -r; dy <= r; ++dy) {
+        for (int dx = -r; dx <= r; ++dx) {
             const ivec2 q = p + ivec2(dx, dy);
             if (any(lessThan(q, ivec2(0))) || any(greaterThanEqual(q, ivec2(frame.size)))) continue;
             vec3 c;

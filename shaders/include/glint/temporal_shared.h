@@ -25,6 +25,7 @@ GLINT_CONST uint kTemporalGroupSize = 8u;
 
 // The spatial filter's largest radius in pixels (its loop bound).
 GLINT_CONST uint kTemporalMaxSpatialRadius = 4u;
+GLINT_CONST uint kTemporalMaxClampRadius = 3u;
 
 // Positions are reconstructed with the jittered matrices the depth was
 // rasterised with (exact points); motion uses the unjittered ones, as the
@@ -55,12 +56,16 @@ struct TemporalFrame {
     float spatialRoughnessSigma;
     float spatialRoughnessMax;
     uint hitMotionBound;                 // 1: the reflected points' own motion is bound
+    uint clampRadius;                    // the clip box's neighbourhood: (2 r + 1)^2 pixels
+    uint pad0;
+    uint pad1;
+    uint pad2;
 };
 
 GLINT_END
 
 #ifdef __cplusplus
-static_assert(sizeof(glint::shader::TemporalFrame) == 4 * 64 + 2 * 16 + 80);
+static_assert(sizeof(glint::shader::TemporalFrame) == 4 * 64 + 2 * 16 + 96);
 #endif
 
 #endif
