@@ -68,10 +68,11 @@ struct TemporalInputs {
 
 struct TemporalSettings {
     // The longest history, in frames: a new frame's weight never drops
-    // below 1 / maxHistoryFrames. Glint's starting value: 32 frames halve
-    // the noise of a single-ray reflection about 5.6 times; the clamp keeps
-    // longer histories from lagging.
-    float maxHistoryFrames = 32.0f;
+    // below 1 / maxHistoryFrames. 64 (was 32) from glint-bench --motion on
+    // the plaza at 1080p (docs/results.md): with the 5x5 clamp it flickers
+    // a sixth less than 32 at the same FLIP in motion, and the clamp keeps
+    // it from lagging (trails stay under 1% of the object's energy).
+    float maxHistoryFrames = 64.0f;
     // Variance clipping in YCoCg over the 3x3 neighbourhood, to
     // mean +- clampGamma * sigma (Salvi, GDC 2016, suggests gamma near 1;
     // the little extra keeps single-ray noise from clipping a converged
@@ -79,11 +80,13 @@ struct TemporalSettings {
     bool neighbourhoodClamp = true;
     float clampGamma = 1.25f;
     // The neighbourhood's radius: (2 r + 1)^2 pixels, at most
-    // shader::kTemporalMaxClampRadius. 1 (3x3) is Salvi's; where quads
+    // shader::kTemporalMaxClampRadius. Salvi's is 1 (3x3); where quads
     // share one ray (ray generation's reuse) a 3x3 window holds only two to
     // four independent samples, and a box estimated from so few jumps from
-    // frame to frame and drags the history with it (flicker).
-    uint32_t clampRadius = 1;
+    // frame to frame and drags the history with it: on the plaza at 1080p
+    // 5x5 halves the flicker of 3x3 for 0.06 ms (glint-bench --motion,
+    // docs/results.md).
+    uint32_t clampRadius = 2;
     // History rejection: a history texel counts only if last frame's
     // surface there lies within planeTolerance x view depth of this pixel's
     // tangent plane, its normal within acos(normalTolerance) and its

@@ -174,7 +174,30 @@ void writeNothing(ivec2 p, vec2 motion) {
     imageStore(lengthImage, p, vec4(0.0));
 }
 
+// The workgroup's pixels and a border of kTemporalMaxClampRadius around
+// them, as the clip box's statistics want them: YCoCg of the compressed
+// radiance, w = 1 where this frame's radiance there is valid. Loaded once
+// per workgroup: a 5x5 box would otherwise fetch and convert every texel 25
+// times.
+const int kTile = int(kTemporalGroupSize) + 2 * int(kTemporalMaxClampRadius);
+shared vec4 tile[kTile * kTile];
+
+void loadTile() {
+    const ivec2 origin = ivec2(gl_WorkGroupID.xy) * int(kTemporalGroupSize) - int(kTemporalMaxClampRadius);
+    for (uint i = gl_LocalInvocationIndex; i < uint(kTile * kTile); i += kTemporalGroupSize * kTemporalGroupSize) {
+        const ivec2 q = origin + ivec2(int(i) % kTile, int(i) / kTile);
+        vec4 entry = vec4(0.0);
+        vec3 c;
+        if (all(greaterThanEqual(q, ivec2(0))) && all(lessThan(q, ivec2(frame.size))) && currentRadiance(q, c)) {
+            entry = vec4(rgbToYCoCg(compress(c)), 1.0);
+        }
+        tile[i] = entry;
+    }
+    barrier();
+}
+
 void main() {
+    loadTile();
     const ivec2 p = ivec2(gl_GlobalInvocationID.xy);
     if (p.x >= int(frame.size.x) || p.y >= int(frame.size.y)) {
         return;
@@ -206,16 +229,13 @@ void main() {
     vec3 sumSquares = vec3(0.0);
     float count = 0.0;
     const int r = int(min(frame.clampRadius, kTemporalMaxClampRadius));
+    const ivec2 local = ivec2(gl_LocalInvocationID.xy) + int(kTemporalMaxClampRadius);
     for (int dy = -r; dy <= r; ++dy) {
         for (int dx = -r; dx <= r; ++dx) {
-            const ivec2 q = p + ivec2(dx, dy);
-            if (any(lessThan(q, ivec2(0))) || any(greaterThanEqual(q, ivec2(frame.size)))) continue;
-            vec3 c;
-            if (!currentRadiance(q, c)) continue;
-            const vec3 y = rgbToYCoCg(compress(c));
-            sum += y;
-            sumSquares += y * y;
-            count += 1.0;
+            const vec4 entry = tile[(local.y + dy) * kTile + local.x + dx];
+            sum += entry.xyz;
+            sumSquares += entry.xyz * entry.xyz;
+            count += entry.w;
         }
     }
     const vec3 mean = count > 0.0 ? sum / count : vec3(0.0);
