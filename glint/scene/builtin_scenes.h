@@ -19,8 +19,10 @@
 //   beside the camera (only RT can). "city:instances=N,triangles=T,seed=S"
 //   sets its size (CityOptions); streets, lamps and cars grow with it.
 //
-//  "mirror-motion": a bright lamp sliding across a mirror floor in front of
-//   a wall, then the camera strafing past it (kMirrorMotion's timeline):
+//  "mirror-motion": a bright lamp sliding across a wet floor (glossy metal,
+//   roughness 0.1: traced, and noisy enough for the temporal pass's clamp
+//   to be loose) in front of a wall, then the camera strafing past it
+//   (kMirrorMotion's timeline):
 //   what reflections in motion are measured on (ghosting behind a moving
 //   object, lag under camera motion; glint-bench --motion).
 //

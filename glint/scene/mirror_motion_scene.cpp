@@ -1,5 +1,5 @@
 // The built-in "mirror-motion" (builtin_scenes.h): a bright object moving
-// across a mirror floor, then a camera moving past it; what reflections in
+// across a wet floor, then a camera moving past it; what reflections in
 // motion are measured on (glint-bench --motion, the ghosting tests).
 
 #include "glint/scene/builtin_scenes.h"
@@ -27,15 +27,15 @@ Scene makeMirrorMotion(bool withObject) {
     SceneBuilder b("mirror-motion");
     Scene& s = b.scene;
     const MirrorMotionTimeline& m = kMirrorMotion;
-    const uint32_t mirror = b.material(makeMaterial("wet floor", {0.9f, 0.92f, 0.95f}, 1.0f, 0.1f));
+    const uint32_t wet = b.material(makeMaterial("wet floor", {0.9f, 0.92f, 0.95f}, 1.0f, 0.1f));
     const uint32_t wall = b.material(makeMaterial("backdrop", {0.08f, 0.1f, 0.14f}, 0.0f, 0.8f));
     const uint32_t pillar = b.material(makeMaterial("pillar", {0.2f, 0.25f, 0.35f}, 0.0f, 0.5f));
     const uint32_t lamp = b.material(makeEmissive("moving lamp", {1.0f, 0.55f, 0.2f}, 6.0f));
 
-    // A 16 m square mirror, a wall behind it and two still pillars, so the
+    // A 16 m square of wet floor, a wall behind it and two still pillars, so the
     // reflection has still neighbours to be compared with.
-    const uint32_t floor = b.mesh("mirror floor", {{makeGrid({16, 16}, {4, 4}, mirror)}});
-    b.place("mirror floor", floor, {0, 0, 0});
+    const uint32_t floor = b.mesh("wet floor", {{makeGrid({16, 16}, {4, 4}, wet)}});
+    b.place("wet floor", floor, {0, 0, 0});
     const uint32_t backdrop = b.mesh("backdrop", {{makeBox({16.0f, 4.0f, 0.2f}, wall)}});
     b.place("backdrop", backdrop, {0, 2.0f, -6.0f});
     const uint32_t post = b.mesh("pillar", {{makeBox({0.3f, 1.6f, 0.3f}, pillar)}});

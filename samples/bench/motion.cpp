@@ -4,8 +4,6 @@
 #include "glint/metrics/flip.h"
 #include "glint/scene/builtin_scenes.h"
 
-#include <spdlog/spdlog.h>
-
 #include <algorithm>
 #include <cmath>
 #include <limits>
@@ -29,7 +27,8 @@ app::ReflectionRunOptions mirrorOptions(const app::ReflectionRunOptions& options
 }
 
 // A reference of frame `frame` of a mirror-motion run: its reflection
-// term's radiance, and where the mirror floor is when `floor` is given.
+// term's radiance, and where the wet floor is when `floor` is given (the
+// mirror and glossy roughness bands: the lamp and the walls are rougher).
 metrics::Image mirrorReference(gpu::Context& ctx, scene::Scene& scene, const app::ReflectionRunOptions& options,
                                uint32_t frame, std::optional<uint32_t> maxFrames,
                                std::vector<uint8_t>* floor = nullptr) {
@@ -44,7 +43,7 @@ metrics::Image mirrorReference(gpu::Context& ctx, scene::Scene& scene, const app
     return std::move(r.term.radiance);
 }
 
-// The contribution with everything off the mirror floor zeroed.
+// The contribution with everything off the floor zeroed.
 metrics::Contribution onFloor(metrics::Contribution c, const std::vector<uint8_t>& floor) {
     for (size_t p = 0; p < c.luminance.size(); ++p) {
         if (p >= floor.size() || floor[p] == 0) c.luminance[p] = 0.0f;

@@ -50,12 +50,12 @@ MirrorMotionFrames mirrorMotionFrames(float frameSeconds);
 // What the lamp contributes to the reference's reflection term at each
 // ghost frame (metrics::contribution: the reference with the lamp minus the
 // reference without it), and where the floor is at the lag frame.
-// Only the mirror floor's pixels count (the reference's roughness in the
-// mirror band): the lamp's own reflection term is not its reflection.
+// Only the floor's pixels count (the reference's roughness in the mirror
+// or glossy band): the lamp's own reflection term is not its reflection.
 struct MirrorReferences {
     MirrorMotionFrames frames;
     std::vector<metrics::Contribution> ghost;
-    std::vector<std::vector<uint8_t>> ghostFloor;  // per ghost frame: 1 on the mirror floor
+    std::vector<std::vector<uint8_t>> ghostFloor;  // per ghost frame: 1 on the floor
     std::vector<uint8_t> lagFloor;
 };
 
