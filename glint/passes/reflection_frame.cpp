@@ -244,6 +244,9 @@ ReflectionFrame ReflectionRenderer::addFrame(rg::Graph& graph, const scene::Came
     if (settings.reflectedMotion) {
         temporalInputs.hitMotion = f.integrate.hitMotion;
     }
+    temporalInputs.sharedRayRoughness = settings.rays.checkerboard ? 0.0f
+                                        : settings.rays.reuse      ? settings.rays.reuseRoughness
+                                                                   : 2.0f;
     temporalInputs.camera = camera;
     temporalInputs.frameIndex = frameIndex;
     temporalInputs.resetHistory = settings.resetHistory;

@@ -64,6 +64,7 @@ shader::TemporalFrame frameConstants(const TemporalInputs& in, const TemporalSet
     f.spatialRoughnessMax = s.spatialRoughnessMax;
     f.hitMotionBound = in.hitMotion.valid() ? 1u : 0u;
     f.clampRadius = s.clampRadius;
+    f.sharedRayRoughness = in.sharedRayRoughness;
     return f;
 }
 

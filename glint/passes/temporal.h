@@ -64,6 +64,11 @@ struct TemporalInputs {
     // reflection is reprojected with it; without it reflected points count
     // as still and only the camera's motion reprojects.
     rg::Texture hitMotion;
+    // Perceptual roughness from which neighbouring pixels share rays (ray
+    // generation's RayGenerationSettings::reuseRoughness with its reuse on;
+    // 0 with its checkerboard; above 1: nowhere): there the clip box spans
+    // TemporalSettings::clampRadius.
+    float sharedRayRoughness = 2.0f;
 };
 
 struct TemporalSettings {
@@ -79,13 +84,15 @@ struct TemporalSettings {
     // history every frame).
     bool neighbourhoodClamp = true;
     float clampGamma = 1.25f;
-    // The neighbourhood's radius: (2 r + 1)^2 pixels, at most
-    // shader::kTemporalMaxClampRadius. Salvi's is 1 (3x3); where quads
-    // share one ray (ray generation's reuse) a 3x3 window holds only two to
-    // four independent samples, and a box estimated from so few jumps from
-    // frame to frame and drags the history with it: on the plaza at 1080p
-    // 5x5 halves the flicker of 3x3 for 0.06 ms (glint-bench --motion,
-    // docs/results.md).
+    // The neighbourhood's radius where quads share rays
+    // (TemporalInputs::sharedRayRoughness and above): (2 r + 1)^2 pixels, at
+    // most shader::kTemporalMaxClampRadius; elsewhere 3x3 (Salvi's). Where
+    // quads share one ray a 3x3 window holds only two to four independent
+    // samples, and a box estimated from so few jumps from frame to frame
+    // and drags the history with it: on the plaza at 1080p 5x5 there halves
+    // the flicker of 3x3 (glint-bench --motion, docs/results.md); where
+    // every pixel has its own ray 5x5 only admits more stale history in
+    // motion (DamagedHelmet: FLIP in motion +9%).
     uint32_t clampRadius = 2;
     // History rejection: a history texel counts only if last frame's
     // surface there lies within planeTolerance x view depth of this pixel's

@@ -16,7 +16,7 @@
 //      only if last frame's surface there lies on this pixel's plane with a
 //      similar normal and roughness (disocclusion and history rejection);
 //   4. variance clipping of the history in YCoCg over the (2 r + 1)^2
-//      neighbourhood (r = clampRadius, 1: 3x3)
+//      neighbourhood (r = clampRadius where quads share rays, else 1: 3x3)
 //      (Salvi, "An Excursion in Temporal Supersampling", GDC 2016; YCoCg,
 //      clipping towards the mean and the luma-compressed space as Karis,
 //      "High Quality Temporal Supersampling", SIGGRAPH 2014);
@@ -228,7 +228,10 @@ void main() {
     vec3 sum = vec3(0.0);
     vec3 sumSquares = vec3(0.0);
     float count = 0.0;
-    const int r = int(min(frame.clampRadius, kTemporalMaxClampRadius));
+    // The wide box only where neighbouring pixels share rays; 3x3 where
+    // each has its own.
+    const uint radius = px.roughness >= frame.sharedRayRoughness ? frame.clampRadius : min(frame.clampRadius, 1u);
+    const int r = int(min(radius, kTemporalMaxClampRadius));
     const ivec2 local = ivec2(gl_LocalInvocationID.xy) + int(kTemporalMaxClampRadius);
     for (int dy = -r; dy <= r; ++dy) {
         for (int dx = -r; dx <= r; ++dx) {

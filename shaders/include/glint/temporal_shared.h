@@ -56,8 +56,8 @@ struct TemporalFrame {
     float spatialRoughnessSigma;
     float spatialRoughnessMax;
     uint hitMotionBound;                 // 1: the reflected points' own motion is bound
-    uint clampRadius;                    // the clip box's neighbourhood: (2 r + 1)^2 pixels
-    uint pad0;
+    uint clampRadius;                    // the clip box's neighbourhood where rays are shared: (2 r + 1)^2 pixels
+    float sharedRayRoughness;            // from this roughness on, quads share rays (above 1: nowhere)
     uint pad1;
     uint pad2;
 };
