@@ -23,6 +23,7 @@
 #include "glint/scene/animation.h"
 
 #include "glint/ray_generation_shared.h"
+#include "glint/temporal_shared.h"
 
 #include <glm/gtc/matrix_transform.hpp>
 #include <glm/gtc/packing.hpp>
@@ -174,6 +175,8 @@ struct FrameInput {
     std::vector<float> hitDistance = std::vector<float>(kPixels, 2.0f);
     scene::Camera camera = testCamera();
     bool reset = false;
+    // TemporalInputs::sharedRayRoughness (above 1: no pixel shares rays).
+    float sharedRayRoughness = 2.0f;
     // Called before the frame's G-buffer is declared (moves objects).
     std::function<void(scene::Scene&)> update;
 };
@@ -206,8 +209,9 @@ std::vector<FrameOutput> runTemporal(scene::Scene& scene, const std::vector<Fram
                                                    VK_FORMAT_R32G32B32A32_SFLOAT, in.radiance.data());
         const rg::Texture hit =
             uploadTexture(graph, resources, staging, "test.hit", VK_FORMAT_R32_SFLOAT, in.hitDistance.data());
-        const passes::TemporalOutputs out = passes::addTemporalPass(
-            graph, pipelines, {gbuf, radiance, hit, in.camera, uint64_t(f), in.reset}, settings);
+        passes::TemporalInputs inputs{gbuf, radiance, hit, in.camera, uint64_t(f), in.reset};
+        inputs.sharedRayRoughness = in.sharedRayRoughness;
+        const passes::TemporalOutputs out = passes::addTemporalPass(graph, pipelines, inputs, settings);
         REQUIRE(out.width == kSize);
         readbacks.push_back({&readTexture(graph, resources, staging, out.resolved, passes::kTemporalResolvedFormat,
                                           "resolved"),
@@ -542,6 +546,37 @@ TEST_CASE("a reset discards the history; without it the history lingers") {
     }
 }
 
+TEST_CASE("the clip box spans 5x5 where rays are shared, 3x3 where each pixel has its own") {
+    // A history of 0.5; then a frame of 0.1 in the 3x3 around the centre
+    // and 0.9 beyond. The 3x3 box holds only 0.1: the history is clipped to
+    // it. The 5x5 box also holds sixteen 0.9s, wide enough for 0.5 to
+    // stand: the new frame takes half (two frames of history).
+    constexpr uint32_t kCentre = 32;
+    for (const bool shared : {false, true}) {
+        CAPTURE(shared);
+        scene::Scene scene = wallScene(material(0.05f, 1.0f));
+        std::vector<FrameInput> frames(2);
+        std::fill(frames[0].radiance.begin(), frames[0].radiance.end(), glm::vec4(0.5f, 0.5f, 0.5f, 1.0f));
+        for (uint32_t y = 0; y < kSize; ++y) {
+            for (uint32_t x = 0; x < kSize; ++x) {
+                const bool inner = std::max(std::abs(int(x) - int(kCentre)), std::abs(int(y) - int(kCentre))) <= 1;
+                frames[1].radiance[at(x, y)] = inner ? glm::vec4(0.1f, 0.1f, 0.1f, 1.0f) : glm::vec4(0.9f, 0.9f, 0.9f, 1.0f);
+            }
+        }
+        for (FrameInput& f : frames) f.sharedRayRoughness = shared ? 0.0f : 2.0f;
+        passes::TemporalSettings settings;
+        settings.clampRadius = 2;
+        const std::vector<FrameOutput> out = runTemporal(scene, frames, settings);
+        const float v = out.back().resolved[at(kCentre, kCentre)].g;
+        CHECK(out.back().length[at(kCentre, kCentre)] == 2.0f);
+        if (shared) {
+            CHECK(v == doctest::Approx(0.3f).epsilon(0.01));
+        } else {
+            CHECK(v == doctest::Approx(0.1f).epsilon(0.01));
+        }
+    }
+}
+
 TEST_CASE("temporal settings out of range are an error naming the pass") {
     test::GpuTest gpu;
     passes::TemporalPipelines pipelines(gpu.ctx());
@@ -559,6 +594,10 @@ TEST_CASE("temporal settings out of range are an error naming the pass") {
     settings.spatialRadius = 9;
     CHECK_THROWS_WITH_AS(passes::addTemporalPass(graph, pipelines, {gbuf, fake, fake, testCamera()}, settings),
                          doctest::Contains("addTemporalPass"), gpu::GpuError);
+    settings = {};
+    settings.clampRadius = shader::kTemporalMaxClampRadius + 1;
+    CHECK_THROWS_WITH_AS(passes::addTemporalPass(graph, pipelines, {gbuf, fake, fake, testCamera()}, settings),
+                         doctest::Contains("clampRadius <= 3"), gpu::GpuError);
 }
 
 // ---------------------------------------------------------------- composite
