@@ -106,7 +106,9 @@ struct ReflectionFrameSettings {
     // reprojects a reflection through where its reflected point was last
     // frame (a ray-traced hit's instance motion, an SSLR hit's G-buffer
     // motion; IntegrateOutputs::hitMotion). Off: only the camera's motion
-    // reprojects, and a moving object's reflection smears behind it.
+    // reprojects, and a moving object's reflection looks its history up
+    // where the object no longer is (the temporal pass's clip hides most of
+    // the trail that leaves, docs/results.md, but the history is lost).
     bool reflectedMotion = true;
     // Empty or "final": the composited image; otherwise one of
     // debugViews(), shown in `output` instead.
