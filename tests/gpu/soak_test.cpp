@@ -78,6 +78,7 @@ constexpr std::array<passes::ReflectionMode, 3> kModes = {
 constexpr std::array<glm::uvec2, 2> kSizes = {glm::uvec2(64, 64), glm::uvec2(96, 48)};
 // Segments until every mode has run at every size (3 and 2 are coprime).
 constexpr uint32_t kCycleSegments = uint32_t(kModes.size() * kSizes.size());
+constexpr float kPlazaPathSeconds = 20.0f;
 static_assert(kWarmUpSegments % kCycleSegments == 0 && kWarmUpSegments >= 2 * kCycleSegments);
 
 // Bytes the heap has handed out and not had back: glibc's arenas and its
@@ -140,7 +141,12 @@ TEST_CASE("2,400 frames with mode switches, resizes and history resets hold memo
         const glm::uvec2 size = kSizes[segment % kSizes.size()];
         for (uint32_t f = 0; f < kSegmentFrames; ++f) {
             const uint32_t frame = segment * kSegmentFrames + f;
-            const float seconds = float(frame % 600) / 30.0f;  // the plaza's 20-second path
+            // Each cycle of segments walks the plaza's whole 20-second path
+            // (at 30 frames a second in 100-frame segments, twice as fast in
+            // 50), so a segment meets the same stretch of it as the same
+            // combination one cycle before (the device memory check below).
+            constexpr uint32_t kCycleFrames = kCycleSegments * kSegmentFrames;
+            const float seconds = kPlazaPathSeconds * float(frame % kCycleFrames) / float(kCycleFrames);
             const scene::CameraPose pose = scene.cameraPath.evaluate(seconds);
             camera.resolution = size;
             if (f == 0) {
