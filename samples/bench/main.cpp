@@ -131,8 +131,8 @@ int main(int argc, char** argv) {
                               {"jitter", "jitter the camera as the measured runs would (default off)"},
                               {"motion", "reflections in motion instead: each configuration along the camera path "
                                          "(--frames, default 64) against references of 4 frames along it, a still "
-                                         "camera (flip_still, flicker), and the mirror-motion scene (ghost_energy_1/4/16, "
-                                         "lag_px); writes DIR/<scene>_motion.{csv,json,png}"}});
+                                         "camera (flip_still, flicker), and the mirror-motion scene "
+                                         "(ghost_energy_1/4/16, lag_px); writes DIR/<scene>_motion.{csv,json,png}"}});
         const std::string sceneName = args.get("scene", "plaza");
         const uint32_t frames = args.getUint("frames", args.has("motion") ? 64 : 16);
         if (frames == 0) throw std::runtime_error("--frames 0: must be at least 1");

@@ -121,7 +121,7 @@ const std::array<ParameterSlot, 20> kParameters = {{
     {{"blue_noise", "RayGenerationSettings::blueNoise (1: spatiotemporal blue noise, 0: hashed sequences)", 0.0f,
       1.0f, true, {0}, {0}, kEveryMode},
      nullptr, nullptr, [](ReflectionRunOptions& o) { return &o.frame.rays.blueNoise; }},
-    // The longest temporal history (default 32 frames): longer averages
+    // The longest temporal history (default 64 frames): longer averages
     // more noise away (less flicker) and trails further behind what the
     // clamp lets through.
     {{"history_frames", "TemporalSettings::maxHistoryFrames", 1.0f, 256.0f, false, {8, 16, 64, 128}, {}, kEveryMode},
@@ -130,13 +130,13 @@ const std::array<ParameterSlot, 20> kParameters = {{
     // narrower rejects stale history sooner and lets more noise through.
     {{"clamp_gamma", "TemporalSettings::clampGamma", 0.25f, 4.0f, false, {0.75, 1.0, 1.5, 2.0}, {}, kEveryMode},
      [](ReflectionRunOptions& o) { return &o.frame.temporal.clampGamma; }, nullptr},
-    // The clamp's neighbourhood radius (default 1: 3x3): wider estimates
-    // the box from more independent rays.
+    // The clamp's neighbourhood radius where quads share rays (default 2:
+    // 5x5; 3x3 elsewhere): wider estimates the box from more independent
+    // rays.
     {{"clamp_radius", "TemporalSettings::clampRadius", 1.0f, 3.0f, true, {2, 3}, {}, kEveryMode}, nullptr,
      [](ReflectionRunOptions& o) { return &o.frame.temporal.clampRadius; }},
     // Reflected objects' own motion in the reprojection (default on): off,
-    // only the camera's motion reprojects (what moving objects' trails
-    // were before it).
+    // only the camera's motion reprojects, as before it.
     {{"reflected_motion", "ReflectionFrameSettings::reflectedMotion (0 or 1)", 0.0f, 1.0f, true, {0}, {}, kEveryMode},
      nullptr,
      nullptr, [](ReflectionRunOptions& o) { return &o.frame.reflectedMotion; }},
@@ -325,7 +325,8 @@ ReflectionRunResult runReflections(gpu::Context& ctx, scene::Scene& scene, const
     }
     if (options.readResolved || captures) roughness.emplace(ctx, VkDeviceSize(w) * h * 4, "readback.roughness");
     for (size_t k = 0; k < options.captureFrames.size(); ++k) {
-        if (options.captureFrames[k] >= options.frames || (k > 0 && options.captureFrames[k] <= options.captureFrames[k - 1])) {
+        const bool increasing = k == 0 || options.captureFrames[k] > options.captureFrames[k - 1];
+        if (options.captureFrames[k] >= options.frames || !increasing) {
             throw std::invalid_argument("captureFrames: expected increasing frame indices below " +
                                         std::to_string(options.frames));
         }

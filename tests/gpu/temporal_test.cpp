@@ -560,7 +560,8 @@ TEST_CASE("the clip box spans 5x5 where rays are shared, 3x3 where each pixel ha
         for (uint32_t y = 0; y < kSize; ++y) {
             for (uint32_t x = 0; x < kSize; ++x) {
                 const bool inner = std::max(std::abs(int(x) - int(kCentre)), std::abs(int(y) - int(kCentre))) <= 1;
-                frames[1].radiance[at(x, y)] = inner ? glm::vec4(0.1f, 0.1f, 0.1f, 1.0f) : glm::vec4(0.9f, 0.9f, 0.9f, 1.0f);
+                const float v = inner ? 0.1f : 0.9f;
+                frames[1].radiance[at(x, y)] = glm::vec4(v, v, v, 1.0f);
             }
         }
         for (FrameInput& f : frames) f.sharedRayRoughness = shared ? 0.0f : 2.0f;
