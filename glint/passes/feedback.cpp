@@ -58,6 +58,7 @@ FeedbackOutputs addFeedbackPass(rg::Graph& graph, FeedbackPipelines& pipelines, 
     constants.sslrMissFraction = settings.sslrMissFraction;
     constants.rtHitFraction = settings.rtHitFraction;
     constants.adaptive = settings.adaptive ? 1u : 0u;
+    constants.resetHistory = inputs.resetHistory ? 1u : 0u;
 
     struct ReprojectData {
         rg::Texture motion;

@@ -38,6 +38,10 @@ struct FeedbackInputs {
     GBufferOutputs gbuffer;  // motion (and the size)
     // Picks each tile's probe pixel; the same index, the same probes.
     uint64_t frameIndex = 0;
+    // Carry no counters (a camera cut, a new scene: the temporal pass's
+    // history is discarded with them): every tile starts hybrid, without
+    // evidence, as on the first frame.
+    bool resetHistory = false;
 };
 
 struct FeedbackSettings {

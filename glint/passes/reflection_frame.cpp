@@ -150,7 +150,8 @@ ReflectionFrame ReflectionRenderer::addFrame(rg::Graph& graph, const scene::Came
     rayInputs.mode = mode;
     rayInputs.sslrMinDistance = settings.reach;
     if (mode == ReflectionMode::Hybrid) {
-        f.feedback = addFeedbackPass(graph, feedback_, {f.gbuffer, frameIndex}, settings.feedback);
+        f.feedback =
+            addFeedbackPass(graph, feedback_, {f.gbuffer, frameIndex, settings.resetHistory}, settings.feedback);
         rayInputs.tileModes = f.feedback->tileModes;
     }
     // 2. Ray generation and tile classification.

@@ -35,8 +35,10 @@ void main() {
     const vec2 motion = texelFetch(motionTexture, ivec2(probe), 0).xy;
     const vec2 last = vec2(probe) + 0.5 + motion;
     uint counter = 0u;
-    // Content that came from off screen has no history: no evidence.
-    if (isFinite(motion) && all(greaterThanEqual(last, vec2(0.0))) && all(lessThan(last, vec2(pc.size)))) {
+    // Content that came from off screen has no history, nor has anything
+    // after a reset: no evidence.
+    if (pc.resetHistory == 0u && isFinite(motion) && all(greaterThanEqual(last, vec2(0.0))) &&
+        all(lessThan(last, vec2(pc.size)))) {
         const uvec2 lastTile = uvec2(last) / kTileSize;
         const uint lastIndex = lastTile.y * pc.tiles.x + lastTile.x;
         // length(): the history pair keeps its size if the image is resized.

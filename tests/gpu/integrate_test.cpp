@@ -641,12 +641,12 @@ public:
         std::vector<glm::vec2> motion;
     };
     FeedbackFrame runFeedback(const scene::Camera& camera, uint64_t frameIndex, const std::vector<uint32_t>& counters,
-                              const passes::FeedbackSettings& settings = {}) {
+                              const passes::FeedbackSettings& settings = {}, bool resetHistory = false) {
         rg::Graph graph(executor_.queueCaps());
         rg::FrameResources resources;
         const passes::GBufferOutputs gbuf = passes::addGBufferPass(graph, renderer_, {camera});
         const passes::FeedbackOutputs feedback =
-            passes::addFeedbackPass(graph, feedbackPipelines_, {gbuf, frameIndex}, settings);
+            passes::addFeedbackPass(graph, feedbackPipelines_, {gbuf, frameIndex, resetHistory}, settings);
         REQUIRE(feedback.tilesX == kTiles);
         REQUIRE(feedback.tilesY == kTiles);
         transfers_.uploadBuffer(graph, resources, "counters", feedback.counters.current, counters);
@@ -1025,6 +1025,12 @@ TEST_CASE("a known camera motion carries each tile's counter from where its cont
     // The camera stays where it moved: no motion, every tile keeps its own.
     camera.advance({moved, moved + glm::vec3(0, 0, -1), {0, 1, 0}}, 2);
     CHECK(harness.runFeedback(camera, 2, counters).reprojected == counters);
+    // A reset (a camera cut) carries nothing: every tile without evidence,
+    // hybrid.
+    camera.advance({moved, moved + glm::vec3(0, 0, -1), {0, 1, 0}}, 3);
+    const auto cut = harness.runFeedback(camera, 3, counters, {}, true);
+    CHECK(cut.reprojected == std::vector<uint32_t>(counters.size(), 0u));
+    CHECK(cut.tileModes == std::vector<uint32_t>(counters.size(), shader::kTileModeHybrid));
 }
 
 TEST_CASE("tile modes follow the carried counts and the feedback settings") {

@@ -97,8 +97,8 @@ struct FeedbackConstants {
     uint minRays;
     float sslrMissFraction;
     float rtHitFraction;
-    uint adaptive;  // 0: every tile hybrid
-    uint pad0;
+    uint adaptive;      // 0: every tile hybrid
+    uint resetHistory;  // 1: carry nothing (a camera cut): every tile starts without evidence
 };
 
 GLINT_END
