@@ -97,7 +97,8 @@ struct RtTraceSettings {
     // shortRangeFraction * RtTraceInputs::maxDistance at shortRangeRoughness: rough
     // reflections blur distant detail away (the talk's range shrinking;
     // the numbers are Glint's starting values, the bench sweeps them).
-    // 0.22 is ray generation's roughness cutoff, the roughest traced.
+    // 0.22 is FidelityFX's roughness cutoff: from there on rays are at
+    // their shortest (ray generation traces up to its own cutoff).
     float shortRangeRoughness = 0.22f;
     float shortRangeFraction = 0.25f;
     // Sun visibility at hits from a shadow ray; off, hits are lit unshadowed

@@ -117,7 +117,7 @@ struct TemporalSettings {
     // spatialRoughnessStart (mirrors need none), full from
     // spatialRoughnessEnd. Radius 0 turns it off; at most
     // shader::kTemporalMaxSpatialRadius. Glint's starting values: rays are
-    // traced up to the roughness cutoff (0.22) and are noisiest there.
+    // traced up to the roughness cutoff and are noisiest there.
     uint32_t spatialRadius = 2;
     float spatialRoughnessStart = 0.1f;
     float spatialRoughnessEnd = 0.2f;

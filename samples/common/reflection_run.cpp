@@ -67,9 +67,9 @@ const std::array<ParameterSlot, 20> kParameters = {{
     // Default 0.02 view-space units.
     {{"sslr_thickness", "SslrSettings::thickness", 0.001f, 0.5f, false, {}, {}, {}},
      [](ReflectionRunOptions& o) { return &o.frame.sslr.thickness; }, nullptr},
-    // A roughness; FidelityFX's 0.22 (default): lower sends more pixels to
-    // the environment, higher traces more.
-    {{"roughness_cutoff", "RayGenerationSettings::roughnessCutoff", 0.0f, 1.0f, false, {0.1, 0.15, 0.3, 0.5}, {0.5},
+    // A roughness; 0.3 (default) against FidelityFX's 0.22: lower sends
+    // more pixels to the environment, higher traces more.
+    {{"roughness_cutoff", "RayGenerationSettings::roughnessCutoff", 0.0f, 1.0f, false, {0.1, 0.15, 0.22, 0.5}, {0.5},
       kEveryMode},
      [](ReflectionRunOptions& o) { return &o.frame.rays.roughnessCutoff; }, nullptr},
     // Quads at or above this roughness share one ray: 0, every traced quad
