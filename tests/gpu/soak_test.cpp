@@ -181,18 +181,22 @@ TEST_CASE("2,400 frames with mode switches, resizes and history resets hold memo
                      samples[segment].commandBuffers);
     }
 
-    // The host's memory is judged by floors over a cycle (one segment of
-    // each mode and size), the last cycle's against the warm-up's last: a
-    // leak raises every segment, the floor with them. The heap in use may
-    // grow by 1% of the resident set (a leak of 2 KB a frame would fail
-    // it), and the resident set, taken as the floor of what is resident
-    // beside the heap (mappings, the driver's own memory, pages the heap
-    // could not give back) plus the heap's floor, by 1%: that part moves
-    // by less than 0.2 MB from segment to segment here (measured).
+    // The host's memory is judged by floors: over the two measured cycles
+    // (one segment of each mode and size per cycle) against the warm-up's
+    // last cycle. A leak raises every segment, the floor with them: the
+    // measured cycles' floor by at least a cycle's worth of frames (600, or
+    // 300 under ASan). The heap in use may grow by 1% of the resident set
+    // (a leak of 4 KB a frame would fail it), and the resident set, taken
+    // as the floor of what is resident beside the heap (mappings, the
+    // driver's own memory, pages the heap could not give back) plus the
+    // heap's floor, by 1%. Both floors over two cycles, not one: lavapipe's
+    // heap in use is bimodal from segment to segment (92 or 104 MB here,
+    // whichever it holds when sampled), and a single cycle's six samples
+    // all caught high read as 5 MB of growth (one CI run in four).
     // The allocator's blocks and the command buffers are exact.
-    const auto floorOver = [&](uint32_t first, auto&& value) {
+    const auto floorOver = [&](uint32_t first, uint32_t count, auto&& value) {
         double lowest = std::numeric_limits<double>::infinity();
-        for (uint32_t segment = first; segment < first + kCycleSegments; ++segment) {
+        for (uint32_t segment = first; segment < first + count; ++segment) {
             lowest = std::min(lowest, double(value(samples[segment])));
         }
         return lowest;
@@ -201,15 +205,17 @@ TEST_CASE("2,400 frames with mode switches, resizes and history resets hold memo
     const auto besideHeap = [](const Sample& s) { return double(s.rss) - double(s.heap); };
     const auto driver = [](const Sample& s) { return s.driverBytes; };
     const uint32_t warmCycle = kWarmUpSegments - kCycleSegments;
-    const uint32_t lastCycle = kSegments - kCycleSegments;
-    const double warmResident = floorOver(warmCycle, besideHeap) + floorOver(warmCycle, heap);
-    const double heapGrowth = floorOver(lastCycle, heap) - floorOver(warmCycle, heap);
-    const double rssGrowth = (floorOver(lastCycle, besideHeap) + floorOver(lastCycle, heap)) / warmResident - 1.0;
+    const uint32_t measured = kSegments - kWarmUpSegments;
+    const auto warmFloor = [&](auto&& value) { return floorOver(warmCycle, kCycleSegments, value); };
+    const auto measuredFloor = [&](auto&& value) { return floorOver(kWarmUpSegments, measured, value); };
+    const double warmResident = warmFloor(besideHeap) + warmFloor(heap);
+    const double heapGrowth = measuredFloor(heap) - warmFloor(heap);
+    const double rssGrowth = (measuredFloor(besideHeap) + measuredFloor(heap)) / warmResident - 1.0;
     CAPTURE(heapGrowth);
     CAPTURE(rssGrowth);
     CHECK(heapGrowth <= 0.01 * warmResident);
     if (!kSanitized) CHECK(rssGrowth <= 0.01);
-    if (!cpuDevice) CHECK(floorOver(lastCycle, driver) <= floorOver(warmCycle, driver) * 1.01);
+    if (!cpuDevice) CHECK(measuredFloor(driver) <= warmFloor(driver) * 1.01);
     // What our allocator hands out depends on the segment's mode, size and
     // stretch of the camera path (the BVH's residents, the transient
     // heaps): each segment against the same combination one cycle before.
