@@ -1,9 +1,10 @@
 // A long run of the whole reflection frame must hold its memory flat: host
 // RSS, device memory and the executor's command buffers.
 // 2,400 frames of the plaza at 64x64 along its camera path (1,200 under
-// AddressSanitizer), in segments of 100 frames (50) that cycle through the modes (hybrid, ssr, rt) and two sizes
-// (a resize rebuilds every size-dependent resource and drops the history),
-// each segment starting with a history reset; once with each pass timer.
+// AddressSanitizer), in segments of 100 frames (50) that cycle through the
+// modes (hybrid, ssr, rt) and two sizes (a resize rebuilds every
+// size-dependent resource and drops the history), each segment starting
+// with a history reset; once with each pass timer.
 // Every six segments see each combination of mode and size; the first
 // twelve are the warm-up, and nothing may grow over the last twelve: not
 // the host heap in use (what malloc has handed out and not had back, in
@@ -63,8 +64,7 @@ namespace {
 // it holds: there the resident set is not checked (LeakSanitizer checks
 // what is still held at exit), the rest is. A sanitized run's frames are
 // several times slower: its segments are half as long (50 frames, 1,200 in
-// all: a per-frame leak still shows over the last twelve segments), which
-// keeps CI within its time.
+// all), which keeps CI within its time.
 #if defined(__SANITIZE_ADDRESS__)
 constexpr bool kSanitized = true;
 #else
