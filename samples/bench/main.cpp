@@ -81,18 +81,28 @@ double parsePositive(const std::string& flag, const std::string& text, bool allo
                              " number");
 }
 
+// "a,b,,c" -> {"a", "b", "", "c"}: empty items are kept, for the caller to
+// refuse by name.
+std::vector<std::string> splitList(const std::string& text) {
+    std::vector<std::string> items;
+    for (size_t start = 0; start <= text.size();) {
+        const size_t end = std::min(text.find(',', start), text.size());
+        items.push_back(text.substr(start, end - start));
+        start = end + 1;
+    }
+    return items;
+}
+
 std::vector<passes::ReflectionMode> parseModes(const std::string& flag, const std::string& text) {
     std::vector<passes::ReflectionMode> modes;
     if (text.empty()) return modes;  // --sweep-modes "": no sweeps
-    for (size_t start = 0; start <= text.size();) {
-        const size_t end = std::min(text.find(',', start), text.size());
+    for (const std::string& item : splitList(text)) {
         try {
-            const passes::ReflectionMode m = passes::parseMode(text.substr(start, end - start));
+            const passes::ReflectionMode m = passes::parseMode(item);
             if (std::find(modes.begin(), modes.end(), m) == modes.end()) modes.push_back(m);
         } catch (const std::invalid_argument& e) {
             throw std::runtime_error("--" + flag + ": " + e.what());
         }
-        start = end + 1;
     }
     return modes;
 }
@@ -142,13 +152,9 @@ int main(int argc, char** argv) {
         const std::vector<passes::ReflectionMode> sweepModes = parseModes("sweep-modes", args.get("sweep-modes", "hybrid"));
         std::vector<std::string> sweepOnly;
         if (args.has("sweep")) {
-            const std::string text = args.get("sweep", "");
-            for (size_t start = 0; start <= text.size();) {
-                const size_t end = std::min(text.find(',', start), text.size());
-                const std::string name = text.substr(start, end - start);
+            sweepOnly = splitList(args.get("sweep", ""));
+            for (const std::string& name : sweepOnly) {
                 app::getParameter(app::ReflectionRunOptions{}, name);  // throws naming an unknown parameter
-                sweepOnly.push_back(name);
-                start = end + 1;
             }
         }
         const double ppd = args.has("ppd") ? parsePositive("ppd", args.get("ppd", ""), false) : metrics::kDefaultPpd;
