@@ -40,6 +40,7 @@ constexpr uint32_t kMinTlasInstances = 64;
 constexpr uint32_t kMinOffsetEntries = 256;
 constexpr VkDeviceSize kMaterialRowBytes = sizeof(shader::RtGeometryMaterial);
 constexpr uint32_t kMinParticles = 64;
+constexpr uint64_t kMinDeformMotionBytes = 1024 * sizeof(shader::DeformMotion);
 
 // The pack pass's source vertices of `g`. Material attributes are sampled
 // here with the CPU reference: texture sampling at the vertices gives the
@@ -110,6 +111,10 @@ struct BvhManager::ResidentBlas {
     // so its positions are released once its build has finished.
     gpu::Buffer positions;
     uint64_t builtInFrame = 0;
+    // Per BLAS geometry, its first DeformMotion in the frame's deform motion
+    // buffer, when the frame builtInFrame rebuilt it over an earlier shape
+    // (kNoDeformMotion: a first build, or a static BLAS).
+    std::vector<uint32_t> deformMotion;
     std::vector<const SourceGeometry*> sources;  // per BLAS geometry
     // Per BLAS geometry, its row of the material table (HitMaterials::row),
     // fixed for the BLAS's life: each frame copies them beside the offsets.
@@ -210,6 +215,7 @@ void BvhManager::bind(rg::FrameResources& resources, const BvhUpdateOutputs& out
     resources.bind(outputs.primitivePool, pool_);
     resources.bind(outputs.primitiveOffsets, offsets_);
     resources.bind(outputs.materials, materials_);
+    resources.bind(outputs.deformMotion, deformMotion_);
     resources.bind(outputs.alphaTriangles, hitMaterials_->alphaTriangles());
     resources.bind(outputs.alphaMasks, hitMaterials_->alphaMasks());
     if (outputs.particleTlas.valid()) {
@@ -319,6 +325,21 @@ void BvhManager::ensurePool(uint32_t triangles, FrameWork& work) {
     }
     pool_ = std::move(grown);
     stats_.poolBytes = pool_.size();
+}
+
+void BvhManager::ensureDeformMotion(uint64_t triangles) {
+    const VkDeviceSize needed = std::max<uint64_t>(triangles, 1) * sizeof(shader::DeformMotion);
+    if (deformMotion_ && deformMotion_.size() >= needed) {
+        return;
+    }
+    // Each frame writes what it reads: nothing to keep from the old one.
+    if (deformMotion_) {
+        stats_.deformMotionBytes -= deformMotion_.size();
+        retire(std::move(deformMotion_));
+    }
+    deformMotion_ = gpu::Buffer(ctx_, {grownCapacity(needed, kMinDeformMotionBytes), VK_BUFFER_USAGE_STORAGE_BUFFER_BIT,
+                                       gpu::MemoryUsage::DeviceLocal, "bvh.deform_motion", true});
+    stats_.deformMotionBytes += deformMotion_.size();
 }
 
 void BvhManager::ensureTlas(uint32_t instances) {
@@ -562,6 +583,7 @@ std::shared_ptr<BvhManager::FrameWork> BvhManager::prepare(const scene::BvhPlan&
         ensureJointPalette(0);
     }
     VkDeviceSize blasScratch = 0;
+    uint64_t deformTriangles = 0;  // DeformMotion entries this frame's rebuilds write
     for (const scene::BlasBuild& build : plan.builds) {
         const scene::BlasDesc* desc = plan.find(build.blas);
         if (!desc) {
@@ -578,8 +600,12 @@ std::shared_ptr<BvhManager::FrameWork> BvhManager::prepare(const scene::BvhPlan&
             blases_.erase(it);
             it = blases_.end();
         }
+        // Only a rebuild has a last shape to tell the traces how its
+        // triangles moved.
+        const bool deforms = it != blases_.end() && desc->motion != scene::Motion::Static;
         ResidentBlas& blas = it != blases_.end() ? *it->second : createBlas(*desc, *work);
         blas.builtInFrame = frame_;
+        blas.deformMotion.assign(desc->geometries.size(), shader::kNoDeformMotion);
         ++(resident ? stats_.blasRebuilds : stats_.blasBuilds);
 
         uint32_t jointOffset = 0, jointCount = 0;
@@ -613,6 +639,11 @@ std::shared_ptr<BvhManager::FrameWork> BvhManager::prepare(const scene::BvhPlan&
             // as in the CPU reference.
             pack.params.jointOffset = jointOffset;
             pack.params.jointCount = source->skin ? jointCount : 0;
+            pack.params.motionOffset = shader::kNoDeformMotion;
+            if (deforms) {
+                pack.params.motionOffset = blas.deformMotion[g] = uint32_t(deformTriangles);
+                deformTriangles += geometry.triangleCount;
+            }
             work->packs.push_back(pack);
             first += geometry.triangleCount;
             stats_.packedTriangles += geometry.triangleCount;
@@ -621,6 +652,8 @@ std::shared_ptr<BvhManager::FrameWork> BvhManager::prepare(const scene::BvhPlan&
         blasScratch += blas.build->scratchSize();
     }
     stats_.packDispatches = uint32_t(work->packs.size());
+    stats_.deformedTriangles = deformTriangles;
+    ensureDeformMotion(deformTriangles);
     stats_.totalBlasBuilds += work->builds.size();
     stats_.residentBlases = uint32_t(blases_.size());
 
@@ -632,6 +665,7 @@ std::shared_ptr<BvhManager::FrameWork> BvhManager::prepare(const scene::BvhPlan&
     shader::RtGeometryMaterial unused{};
     unused.alphaTriangles = shader::kAlphaOpaque;
     unused.alphaMask = shader::kAlphaNoMask;
+    unused.deformMotion = shader::kNoDeformMotion;
     setPreviousFromCurrent(unused, glm::mat4(1.0f));
     work->materials.assign(plan.primitiveOffsets.size(), unused);
     work->instances.reserve(plan.tlas.size());
@@ -643,13 +677,17 @@ std::shared_ptr<BvhManager::FrameWork> BvhManager::prepare(const scene::BvhPlan&
         }
         // The material rows beside the offset rows the planner wrote, each
         // with its instance's motion since last frame.
-        const std::vector<shader::RtGeometryMaterial>& rows = it->second->materialRows;
+        const ResidentBlas& blas = *it->second;
+        const std::vector<shader::RtGeometryMaterial>& rows = blas.materialRows;
         const glm::mat4 previousFromCurrent = instanceMotion(scene_.instances.at(ti.sceneInstance));
+        const bool deformedNow = blas.builtInFrame == frame_;
         for (size_t g = 0; g < rows.size(); ++g) {
             const size_t row = shader::primitiveOffsetSlot(ti.customIndex, uint32_t(g));
             if (row >= work->materials.size()) continue;
             work->materials[row] = rows[g];
             setPreviousFromCurrent(work->materials[row], previousFromCurrent);
+            work->materials[row].deformMotion =
+                deformedNow && g < blas.deformMotion.size() ? blas.deformMotion[g] : shader::kNoDeformMotion;
         }
         const auto transform = scene::rowMajor3x4(ti.transform);
         // glTF's front faces wind counter-clockwise in its right-handed
@@ -700,6 +738,7 @@ void BvhManager::record(FrameWork& work, rg::PassContext& pc, const BvhUpdateOut
     const gpu::Buffer& offsets = pc.buffer(handles.primitiveOffsets);
     const gpu::Buffer& materials = pc.buffer(handles.materials);
     const gpu::Buffer& scratch = pc.buffer(handles.scratch);
+    const gpu::Buffer& deformMotion = pc.buffer(handles.deformMotion);
     const gpu::AccelerationStructure& tlas = pc.accel(handles.tlas);
     const uint32_t slot = work.slot;
 
@@ -788,6 +827,7 @@ void BvhManager::record(FrameWork& work, rg::PassContext& pc, const BvhUpdateOut
                 .storageBuffer("Joints", jointPalettes_[slot])
                 .storageBuffer("Positions", *pack.positions)
                 .storageBuffer("Pool", pool)
+                .storageBuffer("DeformMotions", deformMotion)  // written only where params.motionOffset says
                 .push(ctx_, cmd);
             packPipeline_.pushConstants(cmd, pack.params);
             vkCmdDispatch(cmd, (pack.params.triangleCount + shader::kBvhPackGroupSize - 1) / shader::kBvhPackGroupSize,
@@ -858,6 +898,8 @@ BvhUpdateOutputs BvhManager::declare(rg::Graph& graph, BvhManager& manager, cons
         graph.importBuffer("bvh.primitive_offsets", {{manager.offsets_.size()}, bufferState, bufferState});
     const rg::Buffer materials =
         graph.importBuffer("bvh.materials", {{manager.materials_.size()}, bufferState, bufferState});
+    const rg::Buffer deformMotion =
+        graph.importBuffer("bvh.deform_motion", {{manager.deformMotion_.size()}, bufferState, bufferState});
     const uint64_t scratchBytes = manager.scratchCapacity_;
     const bool particles = !work->particles.empty();
     rg::AccelStruct particleTlas;
@@ -876,6 +918,7 @@ BvhUpdateOutputs BvhManager::declare(rg::Graph& graph, BvhManager& manager, cons
             d.primitiveOffsets = b.write(offsets, rg::Access::TransferDst);
             d.materials = b.write(materials, rg::Access::TransferDst);
             d.scratch = b.write(b.createBuffer("bvh.scratch", {scratchBytes}), rg::Access::AccelBuildWrite);
+            d.deformMotion = b.write(deformMotion, rg::Access::StorageWrite);
             if (particles) {
                 d.particleTlas = b.write(particleTlas, rg::Access::AccelBuildWrite);
                 d.particles = b.write(particleData, rg::Access::TransferDst);

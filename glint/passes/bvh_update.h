@@ -12,13 +12,16 @@
 // one primitive pool (PackedPrimitive per triangle, glint/packing.h), the
 // primitive offset buffer and its parallel material table (emission and
 // the alpha test, passes/bvh_hit_materials.h: alpha-tested geometry is not
-// opaque in its BLAS), the TLAS and its per-frame instance buffers.
+// opaque in its BLAS, and each instance's motion), the deform motion buffer
+// (how the frame's rebuilt triangles moved), the TLAS and its per-frame
+// instance buffers.
 //
 // addBvhUpdatePass() declares the frame's builds as ONE render-graph pass on
 // the async compute queue (the graphics queue on one-queue devices, or where
 // BvhUpdateOptions::queue says Graphics):
 //   copies (new geometry, the offset table, ...) -> barrier ->
-//   pack dispatches (positions + packed primitives, skinning included)
+//   pack dispatches (positions + packed primitives, skinning included; a
+//   rebuild also writes how each triangle moved, BvhUpdateOutputs::deformMotion)
 //   -> barrier -> BLAS builds -> barrier -> TLAS build,
 // with build scratch from the graph.
 //
@@ -93,6 +96,11 @@ struct BvhUpdateOutputs {
     rg::Buffer alphaTriangles;
     rg::Texture alphaMasks;
     rg::Buffer scratch;            // the builds' scratch (transient)
+    // How this frame's rebuilt deformable geometry moved inside its
+    // objects: shader::DeformMotion per triangle where a material row's
+    // deformMotion points (glint/bvh_shared.h), rewritten every frame;
+    // Access::StorageRead by the traces' hit motion.
+    rg::Buffer deformMotion;
     // Invalid when the frame has no particles (or was declared without a
     // camera): the particle TLAS (Access::AccelRead; one instance, SBT
     // offset kSbtOffsetParticles, its primitive p is particle p / 2) and
@@ -115,6 +123,7 @@ struct BvhGpuStats {
     uint32_t blasReleased = 0;     // this frame: BLASes the plan dropped
     uint32_t packedTriangles = 0;  // this frame: triangles the pack dispatches wrote
     uint32_t packDispatches = 0;   // this frame
+    uint64_t deformedTriangles = 0;  // this frame: rebuilt triangles with a DeformMotion (skinning, morphing)
     uint32_t tlasInstances = 0;    // this frame
     uint32_t residentBlases = 0;
     uint32_t uploadedGeometries = 0;  // reflection-LOD geometries on the GPU
@@ -122,6 +131,7 @@ struct BvhGpuStats {
     uint64_t blasBytes = 0;           // storage of the resident BLASes
     uint64_t tlasBytes = 0;
     uint64_t poolBytes = 0;           // allocated (capacity), not just used
+    uint64_t deformMotionBytes = 0;   // allocated for BvhUpdateOutputs::deformMotion
     uint64_t positionBytes = 0;       // unwrapped build positions (deformable BLASes, and static ones until built)
     uint64_t geometryBytes = 0;       // uploaded vertices, indices and skin data
     uint64_t uploadBytes = 0;         // staged for those uploads, all frames (copied inside the update pass)
@@ -206,6 +216,7 @@ private:
     const gpu::Buffer& morphedVertexBuffer(ResidentBlas& blas, size_t geometryIndex, uint32_t slot, VkDeviceSize bytes);
     void ensurePool(uint32_t triangles, FrameWork& work);
     void ensureTlas(uint32_t instances);
+    void ensureDeformMotion(uint64_t triangles);
     void ensureOffsets(size_t entries);
     void ensureJointPalette(size_t matrices);
     template <class T> void retire(T&& object);
@@ -221,6 +232,7 @@ private:
     std::map<GeometryKey, std::unique_ptr<SourceGeometry>> geometries_;
     std::map<scene::BlasId, std::unique_ptr<ResidentBlas>> blases_;
     gpu::Buffer pool_;
+    gpu::Buffer deformMotion_;                    // BvhUpdateOutputs::deformMotion, grown as rebuilds need
     gpu::Buffer offsets_;                         // device-local, read by the traces
     std::vector<gpu::Buffer> offsetStaging_;      // host-visible, one per frame in flight
     // Per offset row, its geometry's material row (BvhUpdateOutputs::materials),

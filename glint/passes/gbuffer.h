@@ -39,8 +39,9 @@
 // (passes/bvh_update.h). The packed primitives of the RT hits keep
 // sampling every texture at their vertices, and keep the vertex normal. Instances of meshes with
 // morph targets draw from a per-frame copy of their vertices with their
-// morph weights applied on the CPU (scene::morphedGeometry); their motion
-// vectors cover transforms and skins, not last frame's morph.
+// morph weights applied on the CPU (scene::morphedGeometry), with last
+// frame's copy beside it when the weights changed, so their motion vectors
+// cover the morph as well as transforms and skins.
 
 #include "glint/gpu/context.h"
 #include "glint/gpu/pipeline.h"

@@ -153,9 +153,10 @@ RtTraceOutputs addRtTracePass(rg::Graph& graph, RtTracePipelines& pipelines, con
         throw gpu::GpuError("addRtTracePass: the RT ray list and its args are required");
     }
     if (!inputs.bvh.tlas.valid() || !inputs.bvh.primitivePool.valid() || !inputs.bvh.primitiveOffsets.valid() ||
-        !inputs.bvh.materials.valid() || !inputs.bvh.alphaTriangles.valid() || !inputs.bvh.alphaMasks.valid()) {
-        throw gpu::GpuError("addRtTracePass: the BVH update's TLAS, primitive pool, offsets, material rows and alpha "
-                            "test data are required");
+        !inputs.bvh.materials.valid() || !inputs.bvh.alphaTriangles.valid() || !inputs.bvh.alphaMasks.valid() ||
+        !inputs.bvh.deformMotion.valid()) {
+        throw gpu::GpuError("addRtTracePass: the BVH update's TLAS, primitive pool, offsets, material rows, alpha "
+                            "test data and deform motion are required");
     }
     if (!(inputs.maxDistance > 0.0f) || !(settings.shortRangeFraction >= 0.0f) ||
         !(inputs.shadowDistance >= 0.0f) || !(settings.originOffsetScale >= 0.0f)) {
@@ -227,7 +228,7 @@ RtTraceOutputs addRtTracePass(rg::Graph& graph, RtTracePipelines& pipelines, con
         rg::Texture depth, normal, roughnessMetal;
         rg::Texture environment;  // the prefiltered image, or the normal as a stand-in (never read)
         rg::Texture alphaMasks;
-        rg::Buffer rayList, rayListArgs, pool, offsets, materials, alphaTriangles, constants;
+        rg::Buffer rayList, rayListArgs, pool, offsets, materials, alphaTriangles, deformMotion, constants;
         rg::AccelStruct tlas;
         RtTraceOutputs out;
     };
@@ -251,6 +252,7 @@ RtTraceOutputs addRtTracePass(rg::Graph& graph, RtTracePipelines& pipelines, con
             d.materials = b.read(inputs.bvh.materials, rg::Access::StorageRead);
             d.alphaTriangles = b.read(inputs.bvh.alphaTriangles, rg::Access::StorageRead);
             d.alphaMasks = b.read(inputs.bvh.alphaMasks, rg::Access::SampledRead);
+            d.deformMotion = b.read(inputs.bvh.deformMotion, rg::Access::StorageRead);
             d.constants = b.read(uploaded, rg::Access::StorageRead);
             d.out.width = gbuf.width;
             d.out.height = gbuf.height;
@@ -279,6 +281,7 @@ RtTraceOutputs addRtTracePass(rg::Graph& graph, RtTracePipelines& pipelines, con
                 .storageBuffer("AlphaTriangles", pc.buffer(d.alphaTriangles))
                 .sampledImage("alphaMasks", pc.view(d.alphaMasks), pipelines.alphaSampler_.handle(),
                               pc.layout(d.alphaMasks))
+                .storageBuffer("DeformMotions", pc.buffer(d.deformMotion))
                 .storageBuffer("Constants", pc.buffer(d.constants))
                 .storageImage("radianceImage", pc.view(d.out.radiance))
                 .storageImage("hitDistanceImage", pc.view(d.out.hitDistance))

@@ -128,8 +128,10 @@ struct RtTraceOutputs {
     // (glint/ray_generation_shared.h) on a miss; at the listed rays' pixels.
     rg::Texture hitDistance;
     // kRtHitMotionFormat: xyz, where the hit point was last frame minus
-    // where it is, in world units (its instance's motion, the BVH's
-    // material rows; zero on a miss); at the listed rays' pixels. Temporal
+    // where it is, in world units (its instance's motion from the BVH's
+    // material rows, plus a skinned or morphed triangle's own movement from
+    // BvhUpdateOutputs::deformMotion; zero on a miss); at the listed rays'
+    // pixels. Temporal
     // accumulation reprojects a moving object's reflection with it.
     rg::Texture hitMotion;
     uint32_t width = 0;

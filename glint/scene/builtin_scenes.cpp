@@ -683,8 +683,8 @@ Scene makeBuiltinScene(std::string_view name) {
     if (name.substr(0, name.find(':')) == "city") {
         return makeCity(parseCityOptions(name));
     }
-    if (name == "mirror-motion") {
-        return makeMirrorMotion();
+    if (name.substr(0, name.find(':')) == "mirror-motion") {
+        return makeMirrorMotion(true, parseMirrorMotionLamp(name));
     }
     throw SceneError(std::string(name), "", "no such built-in scene (plaza, hard-cases, city, mirror-motion)");
 }

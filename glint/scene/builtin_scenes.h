@@ -92,9 +92,16 @@ Scene makeBuiltinScene(std::string_view name);
 Scene makePlaza();
 Scene makeHardCases();
 Scene makeCity(const CityOptions& options = {});
+// How the mirror-motion lamp slides: its instance's transform (Rigid), or
+// with the instance standing, its one joint (Skinned) or its one morph
+// target's weight (Morphed); the same path each way.
+enum class MirrorMotionLamp : uint8_t { Rigid, Skinned, Morphed };
+// "mirror-motion" (Rigid) or "mirror-motion:lamp=rigid|skinned|morphed";
+// throws SceneError naming the option for anything else.
+MirrorMotionLamp parseMirrorMotionLamp(std::string_view spec);
 // withObject false: the same scene without the lamp (where its reflection
 // should be is where the two differ).
-Scene makeMirrorMotion(bool withObject = true);
+Scene makeMirrorMotion(bool withObject = true, MirrorMotionLamp lamp = MirrorMotionLamp::Rigid);
 
 // A built-in scene by name, otherwise a glTF file by path.
 Scene loadScene(std::string_view nameOrPath, const GltfLoadOptions& options = {});

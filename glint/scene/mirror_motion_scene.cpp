@@ -5,6 +5,7 @@
 #include "glint/scene/builtin_scenes.h"
 
 #include "glint/scene/animation.h"
+#include "glint/scene/error.h"
 #include "glint/scene/procedural_meshes.h"
 #include "glint/scene/scene_builder.h"
 
@@ -23,7 +24,25 @@ float objectX(float seconds) {
 
 } // namespace
 
-Scene makeMirrorMotion(bool withObject) {
+MirrorMotionLamp parseMirrorMotionLamp(std::string_view spec) {
+    const size_t colon = spec.find(':');
+    if (spec.substr(0, colon) != "mirror-motion") {
+        throw SceneError(std::string(spec), "", "not a mirror-motion scene (mirror-motion or mirror-motion:lamp=HOW)");
+    }
+    if (colon == std::string_view::npos) return MirrorMotionLamp::Rigid;
+    const std::string_view option = spec.substr(colon + 1);
+    const std::string_view key = option.substr(0, option.find('='));
+    if (key != "lamp" || option.size() == key.size()) {
+        throw SceneError(std::string(spec), std::string(option), "expected lamp=rigid, lamp=skinned or lamp=morphed");
+    }
+    const std::string_view how = option.substr(key.size() + 1);
+    if (how == "rigid") return MirrorMotionLamp::Rigid;
+    if (how == "skinned") return MirrorMotionLamp::Skinned;
+    if (how == "morphed") return MirrorMotionLamp::Morphed;
+    throw SceneError(std::string(spec), "lamp", "'" + std::string(how) + "' is not rigid, skinned or morphed");
+}
+
+Scene makeMirrorMotion(bool withObject, MirrorMotionLamp lampMotion) {
     SceneBuilder b("mirror-motion");
     Scene& s = b.scene;
     const MirrorMotionTimeline& m = kMirrorMotion;
@@ -43,15 +62,53 @@ Scene makeMirrorMotion(bool withObject) {
     b.place("pillar right", post, {2.5f, 0.8f, -1.5f});
 
     if (withObject) {
-        const uint32_t cube = b.mesh("moving lamp", {{makeBox({0.5f, 0.5f, 0.5f}, lamp)}});
-        const uint32_t node = b.node("moving lamp", kNone, {objectX(0.0f), m.objectHeight, m.objectZ});
-        b.instance("moving lamp", cube, node, Motion::Dynamic);
+        Geometry box = makeBox({0.5f, 0.5f, 0.5f}, lamp);
+        const glm::vec3 start(objectX(0.0f), m.objectHeight, m.objectZ);
+        const uint32_t node = b.node("moving lamp", kNone, start);
         Animation slide;
         slide.name = "moving lamp";
         // Keys every 50 ms: the start and the stop fall on keys, so the
-        // linear track is the piecewise-linear motion exactly.
-        b.translationTrack(slide, node, m.loopSeconds, uint32_t(m.loopSeconds * 20.0f) + 1,
-                           [&](float t) { return glm::vec3(objectX(t), m.objectHeight, m.objectZ); });
+        // linear tracks are the piecewise-linear motion exactly.
+        const uint32_t keys = uint32_t(m.loopSeconds * 20.0f) + 1;
+        const auto moved = [&](float t) { return glm::vec3(objectX(t), m.objectHeight, m.objectZ) - start; };
+        switch (lampMotion) {
+        case MirrorMotionLamp::Rigid: {
+            b.instance("moving lamp", b.mesh("moving lamp", {{std::move(box)}}), node, Motion::Dynamic);
+            b.translationTrack(slide, node, m.loopSeconds, keys, [&](float t) { return start + moved(t); });
+            break;
+        }
+        case MirrorMotionLamp::Skinned: {
+            // The instance stands; its one joint carries the box.
+            bindToJoint(box, 0);
+            const auto [skin, joints] = b.jointChain("moving lamp", node, glm::vec3(0.0f), 1);
+            b.instance("moving lamp", b.mesh("moving lamp", {{std::move(box)}}), node, Motion::Skinned).skin = skin;
+            b.translationTrack(slide, joints[0], m.loopSeconds, keys, moved);
+            break;
+        }
+        case MirrorMotionLamp::Morphed: {
+            // The instance stands; one morph target holds the whole slide,
+            // its weight the fraction travelled.
+            const float travel = m.objectSpeed * (m.objectStopSeconds - m.objectStartSeconds);
+            MorphTarget target;
+            target.positions.assign(box.positions.size(), glm::vec3(travel, 0.0f, 0.0f));
+            box.morphTargets.push_back(std::move(target));
+            const uint32_t mesh = b.mesh("moving lamp", {{std::move(box)}});
+            b.scene.meshes[mesh].morphWeights = {0.0f};
+            b.scene.nodes[node].morphWeights = {0.0f};
+            b.instance("moving lamp", mesh, node, Motion::Dynamic);
+            AnimationSampler weights;
+            weights.interpolation = Interpolation::Linear;
+            weights.weightCount = 1;
+            for (uint32_t k = 0; k < keys; ++k) {
+                const float t = m.loopSeconds * float(k) / float(keys - 1);
+                weights.times.push_back(t);
+                weights.weights.push_back(moved(t).x / travel);
+            }
+            slide.samplers.push_back(std::move(weights));
+            slide.channels.push_back({uint32_t(slide.samplers.size() - 1), node, AnimationPath::Weights});
+            break;
+        }
+        }
         b.play(std::move(slide));
     }
 

@@ -49,7 +49,7 @@ constexpr const char* kUsage =
     "both reflection terms (*_reflections.png, tonemapped as the \"resolved\" debug view).";
 
 const std::vector<app::Flag> kFlags = {
-    {"scene", "plaza (default), hard-cases, city[:OPTIONS], mirror-motion, FILE.gltf or FILE.glb"},
+    {"scene", "plaza (default), hard-cases, city[:OPTIONS], mirror-motion[:lamp=rigid|skinned|morphed], FILE.gltf or FILE.glb"},
     {"frames", "frames per run (default 16)"},
     {"size", "WxH or N; default 256x256 on a CPU device, 1920x1080 on a GPU"},
     {"modes", "the modes run with defaults (default hybrid,ssr,rt)"},
@@ -68,6 +68,7 @@ const std::vector<app::Flag> kFlags = {
     {"scale", "N1,N2,...: cost against scene size instead: the city (--scene city:triangles=T,seed=S sets its "
               "other options) at each number of buildings, each with its own reference, every mode with its "
               "defaults; writes DIR/city_scale.{csv,json,png}"},
+    {"motion-lamp", "with --motion: how the mirror-motion lamp moves, rigid (default), skinned or morphed"},
 };
 
 double parsePositive(const std::string& flag, const std::string& text, bool allowZero) {
@@ -162,6 +163,7 @@ int main(int argc, char** argv) {
         const bool scaleRun = args.has("scale");
         const bool motionRun = args.has("motion");
         if (scaleRun && motionRun) throw std::runtime_error("--scale and --motion: choose one");
+        if (args.has("motion-lamp") && !motionRun) throw std::runtime_error("--motion-lamp needs --motion");
         const std::string stem =
             scaleRun ? std::string("city") : std::filesystem::path(sceneName).stem().string();
         const std::string suffix = scaleRun ? "_scale" : motionRun ? "_motion" : "_bench";
@@ -295,6 +297,9 @@ int main(int argc, char** argv) {
             motion.ppd = ppd;
             motion.referenceMaxFrames = referenceMaxFrames;
             motion.warmupFrames = warmupFrames;
+            const std::string lamp = args.get("motion-lamp", "rigid");
+            motion.mirrorLamp = scene::parseMirrorMotionLamp("mirror-motion:lamp=" + lamp);
+            info.mirrorLamp = lamp;
             if (quick) {
                 motion.stillFrames = 12;
                 motion.flickerFrames = 4;

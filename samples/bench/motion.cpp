@@ -87,11 +87,12 @@ MirrorMotionFrames mirrorMotionFrames(float frameSeconds) {
 }
 
 MirrorReferences renderMirrorReferences(gpu::Context& ctx, const app::ReflectionRunOptions& base,
-                                        std::optional<uint32_t> maxFrames) {
+                                        std::optional<uint32_t> maxFrames, scene::MirrorMotionLamp lamp) {
     MirrorReferences r;
+    r.lamp = lamp;
     r.frames = mirrorMotionFrames(base.frameSeconds);
     const app::ReflectionRunOptions options = mirrorOptions(base, r.frames);
-    scene::Scene with = scene::makeMirrorMotion(true);
+    scene::Scene with = scene::makeMirrorMotion(true, lamp);
     scene::Scene without = scene::makeMirrorMotion(false);
     // The camera stands still until the strafe: one image without the lamp
     // serves every ghost frame.
@@ -120,11 +121,11 @@ MirrorMetrics measureMirror(gpu::Context& ctx, const app::ReflectionRunOptions& 
     standing.freezeTime = true;
     standing.startSeconds = float(references.frames.lag) * o.frameSeconds;
     {
-        const scene::Scene scene = scene::makeMirrorMotion(true);
+        const scene::Scene scene = scene::makeMirrorMotion(true, references.lamp);
         standing.stillPose = app::cameraPoseAt(scene, o, references.frames.lag);
     }
     const auto run = [&](bool withLamp, const app::ReflectionRunOptions& runOptions) {
-        scene::Scene scene = scene::makeMirrorMotion(withLamp);
+        scene::Scene scene = scene::makeMirrorMotion(withLamp, references.lamp);
         const app::ReflectionRunResult result = app::runReflections(ctx, scene, runOptions);
         if (result.captures.size() != runOptions.captureFrames.size()) {
             throw std::runtime_error("mirror-motion: " + std::to_string(result.captures.size()) + " of " +
@@ -173,7 +174,7 @@ MotionReferences renderMotionReferences(gpu::Context& ctx, scene::Scene& scene, 
         r.path.push_back(ref.term);
         r.roughness.push_back(ref.result.roughness);
     }
-    r.mirror = renderMirrorReferences(ctx, base, settings.referenceMaxFrames);
+    r.mirror = renderMirrorReferences(ctx, base, settings.referenceMaxFrames, settings.mirrorLamp);
     return r;
 }
 

@@ -22,6 +22,7 @@
 #include "glint/gpu/context.h"
 #include "glint/metrics/image.h"
 #include "glint/metrics/motion_metrics.h"
+#include "glint/scene/builtin_scenes.h"
 #include "glint/scene/scene.h"
 
 #include <array>
@@ -53,6 +54,7 @@ MirrorMotionFrames mirrorMotionFrames(float frameSeconds);
 // Only the floor's pixels count (the reference's roughness in the mirror
 // or glossy band): the lamp's own reflection term is not its reflection.
 struct MirrorReferences {
+    scene::MirrorMotionLamp lamp = scene::MirrorMotionLamp::Rigid;  // how the lamp moves (measureMirror's runs too)
     MirrorMotionFrames frames;
     std::vector<metrics::Contribution> ghost;
     std::vector<std::vector<uint8_t>> ghostFloor;  // per ghost frame: 1 on the floor
@@ -62,7 +64,8 @@ struct MirrorReferences {
 // `base` gives the size, the frame time and the backend; its scene time and
 // camera are the mirror-motion scene's own.
 MirrorReferences renderMirrorReferences(gpu::Context& ctx, const app::ReflectionRunOptions& base,
-                                        std::optional<uint32_t> maxFrames);
+                                        std::optional<uint32_t> maxFrames,
+                                        scene::MirrorMotionLamp lamp = scene::MirrorMotionLamp::Rigid);
 
 struct MirrorMetrics {
     std::array<double, 3> ghostEnergy{};  // metrics::ghostEnergy at kGhostFramesAfter
@@ -90,6 +93,9 @@ struct MotionSettings {
     double ppd = 0.0;
     std::optional<uint32_t> referenceMaxFrames;
     uint32_t warmupFrames = 0;
+    // How the mirror-motion lamp moves (its instance, a joint or a morph
+    // target: whose motion reflections must carry).
+    scene::MirrorMotionLamp mirrorLamp = scene::MirrorMotionLamp::Rigid;
 };
 
 // Every reference a motion run compares with.

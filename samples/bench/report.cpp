@@ -250,6 +250,7 @@ std::string toMotionCsv(std::span<const MotionRow> rows) {
 std::string toMotionJson(const RunInfo& info, std::span<const MotionRow> rows) {
     Json j = Json::parse(toJson(info, {}));
     j.erase("rows");
+    j["mirror_lamp"] = info.mirrorLamp.empty() ? "rigid" : info.mirrorLamp;
     Json list = Json::array();
     for (const MotionRow& r : rows) {
         Json row = {{"scene", r.scene},

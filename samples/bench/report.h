@@ -72,6 +72,8 @@ struct RunInfo {
     // --set: the parameters every run (the references' own settings aside)
     // started from, "NAME=VALUE,..."; empty: Glint's defaults.
     std::string set;
+    // --motion: how the mirror-motion lamp moved (rigid, skinned, morphed).
+    std::string mirrorLamp;
     uint32_t referenceFrames = 0;
     bool referenceConverged = false;
     double referenceLastChange = 0.0;

@@ -51,7 +51,7 @@ constexpr std::array<bool, 3> kEveryMode{true, true, true};
 
 // The one table of parameters: name, field, the viewer's range, the
 // bench's sweep, and where the value lives.
-const std::array<ParameterSlot, 20> kParameters = {{
+const std::array<ParameterSlot, 21> kParameters = {{
     // A confidence; the talk's 0.9 (default) bracketed from "trust SSLR
     // often" to "almost never".
     {{"sslr_threshold", "ReflectionFrameSettings::confidenceThreshold", 0.0f, 1.0f, false, {0.5, 0.7, 0.8, 0.95, 0.99},
@@ -78,6 +78,13 @@ const std::array<ParameterSlot, 20> kParameters = {{
     {{"reuse_roughness", "RayGenerationSettings::reuseRoughness (samples per quad: 1 above it, 4 below)", 0.0f, 1.0f,
       false, {0.0, 0.05, 0.15, 1.0}, {0.0}, kEveryMode},
      [](ReflectionRunOptions& o) { return &o.frame.rays.reuseRoughness; }, nullptr},
+    // SSLR and hybrid rays at least this rough cone-trace the lit pyramid
+    // (default 0.1): noise-free but blurred by a box filter and limited to
+    // what is on screen; 1 (above any traced roughness) never does, each
+    // ray then takes the lit colour at its own hit.
+    {{"cone_roughness", "RayGenerationSettings::coneRoughness (SSLR rays this rough cone-trace)", 0.0f, 1.0f, false,
+      {0.05, 0.2, 1.0}, {}, kScreenSpace},
+     [](ReflectionRunOptions& o) { return &o.frame.rays.coneRoughness; }, nullptr},
     // Pixels nearer than this go straight to RT (default 3 world units): 0
     // tries SSLR first everywhere.
     {{"rt_near_distance", "RayGenerationSettings::rtMaxDistance", 0.0f, 50.0f, false, {0, 1, 6, 10}, {0}, kHybrid},

@@ -28,7 +28,7 @@ constexpr const char* kUsage =
 
 const std::vector<app::Flag> kFlags = {
     {"scene", "plaza (default), hard-cases, city[:instances=N,triangles=T,seed=S] (16..4096 buildings of about T "
-              "triangles; default 64, 40000, 1), mirror-motion, smoke (first light of each ray backend), FILE.gltf or FILE.glb"},
+              "triangles; default 64, 40000, 1), mirror-motion[:lamp=rigid|skinned|morphed], smoke (first light of each ray backend), FILE.gltf or FILE.glb"},
     {"mode", "hybrid (default), ssr, rt, or reference (every ray traced, accumulated from a still camera)"},
     {"size", "WxH or N (square); default 256"},
     {"frames", "frames along the camera path; the last is written (default 1)"},

@@ -35,7 +35,7 @@ glm::uvec2 parseWindowSize(std::string_view text) {
 }
 
 std::vector<app::Flag> viewerFlags() {
-    return {{"scene", "plaza (default), hard-cases, city[:OPTIONS], mirror-motion, FILE.gltf or FILE.glb"},
+    return {{"scene", "plaza (default), hard-cases, city[:OPTIONS], mirror-motion[:lamp=rigid|skinned|morphed], FILE.gltf or FILE.glb"},
             {"size", "WxH: the window's size"},
             {"frames", "close after N frames (smoke tests on a virtual display)"},
             {"mode", "hybrid, ssr or rt: what the panel starts with"},

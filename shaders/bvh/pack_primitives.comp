@@ -1,7 +1,9 @@
 #version 460
 // The BVH update's compute pass, one dispatch per BLAS geometry, one thread
 // per triangle: unwraps the triangle (optionally skinned, linear blend) into
-// the BLAS's build positions and writes its packed primitive into the pool.
+// the BLAS's build positions and writes its packed primitive into the pool;
+// on a rebuild of a deformable BLAS, also how far each vertex moved since
+// the last build (DeformMotion, from the positions that build left).
 // Mirrors scene::unwrapGeometry (packed_primitives.cpp), which the tests
 // compare it against.
 #extension GL_EXT_scalar_block_layout : require
@@ -16,8 +18,10 @@ layout(set = 0, binding = 0, scalar) readonly buffer Vertices { BvhSourceVertex 
 layout(set = 0, binding = 1, scalar) readonly buffer Indices { uint indices[]; };
 layout(set = 0, binding = 2, scalar) readonly buffer Skin { BvhSkinVertex skin[]; };
 layout(set = 0, binding = 3, scalar) readonly buffer Joints { mat4 joints[]; };
-layout(set = 0, binding = 4, scalar) writeonly buffer Positions { vec3 positions[]; };
+// Read before written: a rebuild's last shape.
+layout(set = 0, binding = 4, scalar) buffer Positions { vec3 positions[]; };
 layout(set = 0, binding = 5, scalar) writeonly buffer Pool { PackedPrimitive pool[]; };
+layout(set = 0, binding = 6, scalar) writeonly buffer DeformMotions { DeformMotion deformMotions[]; };
 layout(push_constant, scalar) uniform Push { BvhPackParams params; };
 
 mat4 skinMatrix(uint v) {
@@ -40,6 +44,7 @@ void main() {
         return;
     }
     PackedPrimitive prim;
+    DeformMotion motion;
     for (uint k = 0u; k < 3u; ++k) {
         const uint v = indices[3u * t + k];
         const BvhSourceVertex src = vertices[v];
@@ -52,9 +57,17 @@ void main() {
             const vec3 skinned = mat3(m) * n;
             n = length(skinned) > 0.0f ? normalize(skinned) : n;
         }
-        positions[params.positionOffset + 3u * t + k] = p;
+        const uint slot = params.positionOffset + 3u * t + k;
+        if (params.motionOffset != kNoDeformMotion) {
+            const vec3 moved = positions[slot] - p;
+            motion.vertices[k] = uvec2(packHalf2x16(moved.xy), packHalf2x16(vec2(moved.z, 0.0f)));
+        }
+        positions[slot] = p;
         prim.vertices[k].albedoSmoothness = src.albedoSmoothness;
         prim.vertices[k].normalMetallicReflectance = packOctNormalPrecise(n) | src.metallicReflectance;
     }
     pool[params.poolOffset + t] = prim;
+    if (params.motionOffset != kNoDeformMotion) {
+        deformMotions[params.motionOffset + t] = motion;
+    }
 }

@@ -4,7 +4,10 @@
 // must be the lamp's own displacement since last frame (a ray-traced hit
 // from its instance's transforms, an SSLR hit from the G-buffer's motion at
 // the hit), zero where it reflects still things; and temporal accumulation
-// must move the reflection with the lamp, not hold it still.
+// must move the reflection with the lamp, not hold it still. The same when
+// the lamp slides inside a standing instance, by a joint or a morph target:
+// a ray-traced hit's motion then comes from how its BLAS's triangles moved
+// since the last build.
 #include "support/gpu_test.h"
 
 #include "glint/graph/executor.h"
@@ -13,6 +16,7 @@
 #include "glint/passes/reflection_frame.h"
 #include "glint/scene/animation.h"
 #include "glint/scene/builtin_scenes.h"
+#include "glint/scene/error.h"
 
 #include <glm/gtc/packing.hpp>
 
@@ -43,10 +47,11 @@ std::vector<glm::vec4> halves(const rg::HostReadback& readback, size_t channels)
 // Three frames of the mirror-motion scene from just before the lamp starts
 // to move (it moves between the second and the third); the third frame's
 // motions.
-MotionFrame renderMoving(passes::ReflectionMode mode, bool reflectedMotion) {
+MotionFrame renderMoving(passes::ReflectionMode mode, bool reflectedMotion,
+                         scene::MirrorMotionLamp lamp = scene::MirrorMotionLamp::Rigid) {
     test::GpuTest gpu;
     gpu::Context& ctx = gpu.ctx();
-    scene::Scene s = scene::makeMirrorMotion(true);
+    scene::Scene s = scene::makeMirrorMotion(true, lamp);
     rg::Executor executor(ctx);
     passes::ReflectionRenderer renderer(ctx, s, {});
     const rg::HostReadback hitMotion(ctx, VkDeviceSize(kWidth) * kHeight * 8, "test.hit_motion");
@@ -138,4 +143,31 @@ TEST_CASE("without reflected motion the lamp's reflection is reprojected as if i
     const Census c = census(renderMoving(passes::ReflectionMode::Rt, false));
     CHECK(c.lamp >= 12);
     CHECK(std::abs(c.lampReflectionMotion.x) < 0.2f);
+}
+
+TEST_CASE("a skinned or morphed object's reflection carries its motion: ray-traced hits from how the BLAS's "
+          "triangles moved since its last build, SSLR hits from the G-buffer") {
+    for (const scene::MirrorMotionLamp lamp : {scene::MirrorMotionLamp::Skinned, scene::MirrorMotionLamp::Morphed}) {
+        CAPTURE(lamp == scene::MirrorMotionLamp::Skinned ? "skinned" : "morphed");
+        for (const passes::ReflectionMode mode : {passes::ReflectionMode::Rt, passes::ReflectionMode::Ssr}) {
+            CAPTURE(passes::modeName(mode));
+            const Census c = census(renderMoving(mode, true, lamp));
+            CHECK(c.lamp >= 12);
+            CHECK(c.still > 1000);
+            CHECK(c.other <= c.lamp / 4);
+            CHECK(c.lampReflectionMotion.x < -0.5f);
+            CHECK(c.lampReflectionMotion.x > -2.0f);
+            CHECK(std::abs(c.lampReflectionMotion.y) < 0.5f);
+        }
+    }
+}
+
+TEST_CASE("mirror-motion's lamp option names what it refuses") {
+    CHECK(scene::parseMirrorMotionLamp("mirror-motion") == scene::MirrorMotionLamp::Rigid);
+    CHECK(scene::parseMirrorMotionLamp("mirror-motion:lamp=skinned") == scene::MirrorMotionLamp::Skinned);
+    CHECK(scene::parseMirrorMotionLamp("mirror-motion:lamp=morphed") == scene::MirrorMotionLamp::Morphed);
+    CHECK_THROWS_WITH_AS(scene::parseMirrorMotionLamp("mirror-motion:lamp=wobbly"),
+                         doctest::Contains("'wobbly' is not rigid, skinned or morphed"), scene::SceneError);
+    CHECK_THROWS_WITH_AS(scene::parseMirrorMotionLamp("mirror-motion:speed=3"), doctest::Contains("lamp=rigid"),
+                         scene::SceneError);
 }

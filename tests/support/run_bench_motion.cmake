@@ -1,12 +1,12 @@
 # Runs glint-bench --motion (BENCH) small: the plaza's path and the
-# mirror-motion scene, hybrid defaults only, tiny and short, validation on,
+# mirror-motion scene (its lamp skinned), hybrid defaults only, tiny and short, validation on,
 # writing CSV, JSON and plot under OUT. Checks the exit code, the files, the
 # CSV header (report.h's kMotionCsvHeader), one row whose motion metrics are
 # numbers (the roughness bands may be nan where the image has no such
 # surface), and the JSON's per-frame FLIP.
 cmake_policy(SET CMP0054 NEW)
 file(REMOVE ${OUT}/motion.csv ${OUT}/motion.json ${OUT}/motion.png)
-execute_process(COMMAND ${BENCH} --validate --motion --quick --modes hybrid --sweep-modes "" --size 64x48 --frames 8
+execute_process(COMMAND ${BENCH} --validate --motion --motion-lamp skinned --quick --modes hybrid --sweep-modes "" --size 64x48 --frames 8
                         --reference-max-frames 16 --out-dir ${OUT}
                         --csv ${OUT}/motion.csv --json ${OUT}/motion.json --plot ${OUT}/motion.png
                 RESULT_VARIABLE rc)
@@ -37,4 +37,8 @@ file(READ ${OUT}/motion.json json)
 string(JSON frames LENGTH "${json}" rows 0 flip_per_frame)
 if(NOT frames EQUAL 4)
   message(FATAL_ERROR "${OUT}/motion.json: ${frames} per-frame FLIP values, expected 4")
+endif()
+string(JSON lamp GET "${json}" mirror_lamp)
+if(NOT lamp STREQUAL "skinned")
+  message(FATAL_ERROR "${OUT}/motion.json: mirror_lamp '${lamp}', expected skinned")
 endif()

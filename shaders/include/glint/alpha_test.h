@@ -35,7 +35,7 @@ GLINT_CONST uint kAlphaWrapClamp = 1u;
 GLINT_CONST uint kAlphaWrapMirror = 2u;
 
 // One row per primitive offset row (glint/packing.h's
-// primitiveOffsetSlot: a TLAS instance's BLAS geometry), 72 bytes.
+// primitiveOffsetSlot: a TLAS instance's BLAS geometry), 76 bytes.
 struct RtGeometryMaterial {
     vec3 emission;        // glTF units: the material's mean (scene::meanEmission)
     uint alphaTriangles;  // the geometry's first AlphaTriangle; kAlphaOpaque: no alpha test
@@ -45,9 +45,14 @@ struct RtGeometryMaterial {
     // point on it this frame to where that point was last frame (last
     // frame's object-to-world times the inverse of this frame's; identity
     // for a still instance). Reflections reproject a moving object's hits
-    // with it (passes/temporal.h). Skinned and morphed vertices move inside
-    // the object too: that motion is not in it.
+    // with it (passes/temporal.h).
     vec4 previousFromCurrent[3];
+    // Skinned and morphed vertices move inside the object too: where the
+    // geometry's BLAS was rebuilt this frame over an earlier shape, its
+    // first glint/bvh_shared.h DeformMotion (per triangle, in the frame's
+    // deform motion buffer); else kNoDeformMotion (the shape the rays meet
+    // is last frame's).
+    uint deformMotion;
 };
 
 // One triangle of an alpha-tested geometry, 16 bytes: the base colour

@@ -29,13 +29,30 @@ struct BvhSkinVertex {
     vec4 weights;
 };
 
-// Push constants of one pack dispatch: one BLAS geometry (20 bytes).
+// BvhPackParams::motionOffset and RtGeometryMaterial::deformMotion of a
+// geometry that did not change shape this frame.
+GLINT_CONST uint kNoDeformMotion = 0xFFFFFFFFu;
+
+// Push constants of one pack dispatch: one BLAS geometry (24 bytes).
 struct BvhPackParams {
     uint triangleCount;
     uint poolOffset;      // first triangle of the geometry in the primitive pool
     uint positionOffset;  // first vertex of the geometry in its BLAS's unwrapped positions
     uint jointOffset;     // first matrix of the instance in the joint palette
     uint jointCount;      // joints of the instance's skin; 0: not skinned
+    // A rebuild of a deformable BLAS: its first DeformMotion this frame,
+    // written from the positions its last build left; kNoDeformMotion on a
+    // first build (no earlier shape) and for static BLASes.
+    uint motionOffset;
+};
+
+// How one triangle of a deformed BLAS moved inside its object: per vertex,
+// where it was at the BLAS's previous build minus where it is now (object
+// space; packHalf2x16(x, y), packHalf2x16(z, 0)), 24 bytes. Written by the
+// pack dispatch of a rebuild, read by the reflection trace's hit motion
+// (RtGeometryMaterial::deformMotion) in the same frame.
+struct DeformMotion {
+    uvec2 vertices[3];
 };
 
 // A probe ray and what it hit, read back by tests and debug tools: the hit's

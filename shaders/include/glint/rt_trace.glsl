@@ -24,6 +24,7 @@
 // hits' ambient light.
 #define GLINT_ENVIRONMENT_BINDING 11
 #include "glint/brdf.glsl"
+#include "glint/bvh_shared.h"
 #include "glint/packing.h"
 #include "glint/ray_generation_shared.h"
 #include "glint/rt_hit.glsl"
@@ -45,6 +46,9 @@ layout(set = 0, binding = 10, r32f) uniform writeonly image2D hitDistanceImage;
 // for misses and still objects); RGBA16F has no required storage format:
 // the context enables shaderStorageImageWriteWithoutFormat.
 layout(set = 0, binding = 15) uniform writeonly image2D hitMotionImage;
+// How this frame's rebuilt deformable geometry moved inside its objects
+// (RtGeometryMaterial::deformMotion).
+layout(set = 0, binding = 16, scalar) readonly buffer DeformMotions { DeformMotion deformMotions[]; };
 // Bindings 12-14: the material rows and the alpha test.
 #include "glint/rt_geometry.glsl"
 
@@ -156,12 +160,25 @@ void rtWriteResult(RtRay ray, vec3 radiance, float hitDistance, vec3 hitMotion) 
 }
 
 // Where the hit point was last frame, relative to where it is: its
-// instance's motion (glint/alpha_test.h's previousFromCurrent).
+// instance's motion (glint/alpha_test.h's previousFromCurrent) and, on
+// geometry whose BLAS was rebuilt this frame, its triangle's own movement
+// inside the object (skinning, morphing) at the hit's barycentrics.
 vec3 rtHitMotion(RtHit hit, vec3 position) {
     const RtGeometryMaterial m = rtGeometryMaterial(hit.customIndex, hit.geometry);
-    const vec4 p = vec4(position, 1.0);
-    const vec3 previous = vec3(dot(m.previousFromCurrent[0], p), dot(m.previousFromCurrent[1], p),
-                               dot(m.previousFromCurrent[2], p));
+    const mat4x3 previousFromCurrent =
+        transpose(mat3x4(m.previousFromCurrent[0], m.previousFromCurrent[1], m.previousFromCurrent[2]));
+    vec3 previous = previousFromCurrent * vec4(position, 1.0);
+    if (m.deformMotion != kNoDeformMotion) {
+        const DeformMotion d = deformMotions[m.deformMotion + hit.primitive];
+        const vec3 w = vec3(1.0 - hit.barycentrics.x - hit.barycentrics.y, hit.barycentrics);
+        vec3 moved = vec3(0.0);
+        for (int k = 0; k < 3; ++k) {
+            moved += w[k] * vec3(unpackHalf2x16(d.vertices[k].x), unpackHalf2x16(d.vertices[k].y).x);
+        }
+        // Last frame's object-to-world linear part is previousFromCurrent's
+        // times this frame's.
+        previous += mat3(previousFromCurrent) * (inverse(hit.worldToObject) * moved);
+    }
     return previous - position;
 }
 
