@@ -69,11 +69,13 @@ struct RayGenerationSettings {
     // 0.02 ms; 0.5 lowers it further but, every rough pixel traced with one
     // ray, flickers more than the target allows.
     float roughnessCutoff = 0.3f;
-    // Perceptual roughness from which a 2x2 quad shares one ray. Glint's
-    // starting value, not a published one: at 0.1 (alpha 0.01) the lobe
-    // spans a few degrees, about what neighbouring pixels' reflections
-    // differ by anyway; the bench sweeps it.
-    float reuseRoughness = 0.1f;
+    // Perceptual roughness from which a 2x2 quad shares one ray. 0.15 from
+    // glint-bench --motion at 1080p (docs/results.md): against the starting
+    // value 0.1 (alpha 0.01, a lobe of a few degrees) it lowers FLIP in
+    // motion 2.5% on DamagedHelmet and 0.2% on the plaza and flicker 9-20%,
+    // for 0.007-0.035 ms; 1 (never shared) is a little more accurate again
+    // for twice that cost.
+    float reuseRoughness = 0.15f;
     bool reuse = true;
     // Half-rate rays on the smooth hybrid and RT pixels: on a checkerboard
     // that swaps every frame, the pixels of the off squares share their
@@ -97,8 +99,9 @@ struct RayGenerationSettings {
     // "fast cone trace for rough tiles"; SslrSettings::coneTrace turns it
     // off). Ray generation marks those rays (kRayCone) and opens SSLR's
     // pyramid passes only when it lists one, so a frame without builds no
-    // pyramid. Glint's starting value: where quads start sharing one ray
-    // (reuseRoughness).
+    // pyramid. Glint's starting value; glint-bench --motion on the plaza
+    // (docs/results.md): 1 (no cone trace) is 0.025 ms faster and as
+    // accurate in motion but flickers 20% more, 0.2 changes nothing.
     float coneRoughness = 0.1f;
     // Share of the hybrid-band pixels of a tile the feedback sends to RT that
     // stay hybrid (tried with SSLR first) this frame, so that the tile's

@@ -106,7 +106,8 @@ struct TemporalSettings {
     // Reflection motion: mirrors follow the virtual point, surfaces from
     // start to end blend towards the surface motion (a rough reflection is
     // a blur of many directions and moves with its surface). Glint's
-    // starting values around ray generation's quad-reuse roughness 0.1.
+    // starting values, set around ray generation's first quad-reuse
+    // roughness (0.1).
     float surfaceMotionRoughnessStart = 0.1f;
     float surfaceMotionRoughnessEnd = 0.3f;
     // Radiance is clamped to [0, maxRadiance] before it is accumulated: the

@@ -76,7 +76,7 @@ const std::array<ParameterSlot, 21> kParameters = {{
     // shares (1 sample per quad); 1 (above any traced roughness), none does
     // (4 per quad).
     {{"reuse_roughness", "RayGenerationSettings::reuseRoughness (samples per quad: 1 above it, 4 below)", 0.0f, 1.0f,
-      false, {0.0, 0.05, 0.15, 1.0}, {0.0}, kEveryMode},
+      false, {0.0, 0.05, 0.1, 1.0}, {0.0}, kEveryMode},
      [](ReflectionRunOptions& o) { return &o.frame.rays.reuseRoughness; }, nullptr},
     // SSLR and hybrid rays at least this rough cone-trace the lit pyramid
     // (default 0.1): noise-free but blurred by a box filter and limited to

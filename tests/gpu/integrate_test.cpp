@@ -182,7 +182,7 @@ scene::Geometry rectangle(glm::vec3 center, glm::vec3 u, glm::vec3 v, float half
 }
 
 // Roughness of the floor's three strips.
-constexpr float kSharedRoughness = 0.15f;  // >= reuseRoughness: quads share rays
+constexpr float kSharedRoughness = 0.2f;  // >= reuseRoughness: quads share rays
 constexpr float kMirrorRoughness = 0.0f;   // every pixel its own ray
 constexpr float kEnvRoughness = 0.5f;      // above the cutoff: environment only
 

@@ -435,7 +435,7 @@ TEST_CASE("rough 2x2 quads share their leader's ray, and the leader rotates with
     passes::RayGenerationSettings settings;
     Band band;
     band.sslrMinDistance = 1e9f;  // RT and hybrid only
-    const std::vector<RayFrame> frames = generate(gpu, floorScene(0.15f), {0, 1, 2, 3}, settings, band);
+    const std::vector<RayFrame> frames = generate(gpu, floorScene(0.2f), {0, 1, 2, 3}, settings, band);
     for (uint32_t frame = 0; frame < frames.size(); ++frame) {
         const RayFrame& f = frames[frame];
         const uint32_t lx = frame & 1u, ly = frame >> 1u;
