@@ -719,4 +719,9 @@ Plan Graph::compile(const CompileOptions& options) const { return rg::compile(*t
 
 Plan Graph::compile() const { return rg::compile(*this, caps_, CompileOptions{}, Plan{}); }
 
+void Graph::shareDeclaration(Plan& plan) const {
+    plan.declaration = decl_;
+    mayBeShared_.store(true, std::memory_order_relaxed);
+}
+
 } // namespace glint::rg

@@ -176,7 +176,12 @@ public:
 
 private:
     friend class Builder;
+    friend class PlanCache;
     friend Plan compile(const Graph&, const QueueCaps&, const CompileOptions&, Plan&&);
+
+    // Gives `plan` this declaration (a plan cache's reused plan), shared as
+    // compile() shares it.
+    void shareDeclaration(Plan& plan) const;
 
     // Takes the callback out of `execute`, leaving it empty: by reference,
     // so no third std::function is moved into and destroyed for every pass.

@@ -3,6 +3,7 @@
 #include "glint/graph/executor.h"
 #include "glint/graph/transfer.h"
 #include "glint/graph/graph.h"
+#include "glint/graph/plan_cache.h"
 #include "glint/graph/verify.h"
 #include "glint/scene/animation.h"
 
@@ -388,6 +389,9 @@ ReflectionRunResult runReflections(gpu::Context& ctx, scene::Scene& scene, const
     const auto start = std::chrono::steady_clock::now();
     auto lastReport = start;
     uint64_t blockingAfterFirst = 0;
+    // Frames of one shape (most of them: the first frame, the readback
+    // frames and the reference's checks differ) reuse one compiled plan.
+    rg::PlanCache planCache;
     for (uint32_t i = 0; i < options.frames; ++i) {
         // The reference stands still: one pose, one scene time; only the
         // frame index (the noise) moves.
@@ -433,7 +437,7 @@ ReflectionRunResult runReflections(gpu::Context& ctx, scene::Scene& scene, const
                                   perPass);
         }
         const auto frameStart = std::chrono::steady_clock::now();
-        const rg::Plan plan = graph.compile(executor.compileOptions());
+        const rg::Plan plan = planCache.compile(graph, executor.compileOptions());
         // Under --validate the plan's own checker runs too: the validation
         // layer does not see hazards between dispatches' shader writes or
         // around acceleration-structure builds (graph/verify.h).
@@ -509,6 +513,10 @@ ReflectionRunResult runReflections(gpu::Context& ctx, scene::Scene& scene, const
     executor.waitIdle();
     if (options.frames == 1 || !options.timeEveryFrame) collectTimings();
     result.blockingSubmits = ctx.blockingSubmits() - blockingAfterFirst;
+    result.planCompiles = planCache.misses();
+    result.planReuses = planCache.hits();
+    spdlog::info("render graph: {} of {} frames reused a compiled plan, {} compiled", result.planReuses,
+                 result.framesRun, result.planCompiles);
 
     for (const std::string& name : passOrder) {
         result.passes.push_back({name, passQueues[name], median(passTimes[name]),

@@ -120,6 +120,10 @@ struct ReflectionRunResult {
     // BVH work over all frames, and the last frame's TLAS.
     uint64_t blasBuilt = 0;
     uint64_t blasRebuilt = 0;
+    // Frames whose plan was compiled, and those that reused a cached one
+    // (rg::PlanCache).
+    uint64_t planCompiles = 0;
+    uint64_t planReuses = 0;
     uint32_t tlasInstances = 0;
     passes::GBufferStats gbuffer;  // the last frame's
     passes::RtBackend backend = passes::RtBackend::Auto;

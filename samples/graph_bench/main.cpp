@@ -2,10 +2,13 @@
 // pass, for reflection-like and random graphs of 16, 128 and 1024 passes;
 // and how much transient memory aliasing saves on the synthetic reflection
 // frame (glint/graph/synthetic.h; the real frame's saving is measured by
-// tests/gpu/reflection_frame_plan_test.cpp) at 1920x1080. The last line is machine-readable:
-//   compile_us_per_pass_1024=<number> alias_saving_1080p=<percent>
+// tests/gpu/reflection_frame_plan_test.cpp) at 1920x1080; and a steady
+// frame's cost with plan reuse (rg::PlanCache: declare, key, and the cached
+// plan copied and rebound). The last line is machine-readable:
+//   compile_us_per_pass_1024=<number> alias_saving_1080p=<percent> reuse_us_per_pass_1024=<number>
 // where the first number is the worse of the two 1024-pass shapes
-// (declare + compile, barriers and aliasing included, two-queue device).
+// (declare + compile, barriers and aliasing included, two-queue device)
+// and the last the worse of their declare + key + reuse.
 //
 //   glint-graph-bench [--runs N] [--passes P]
 // --runs N times each shape N times (default 41 at 1024 passes, 201 below);
@@ -17,6 +20,7 @@
 #include <cstdio>
 #include <cstdlib>
 #include <exception>
+#include <stdexcept>
 #include <string>
 #include <vector>
 
@@ -24,6 +28,7 @@
 
 #include "glint/graph/compile.h"
 #include "glint/graph/graph.h"
+#include "glint/graph/plan_cache.h"
 #include "glint/graph/synthetic.h"
 #include "glint/graph/verify.h"
 
@@ -35,18 +40,27 @@ using Clock = std::chrono::steady_clock;
 struct Timing {
     double declareUs; // per pass
     double compileUs; // per pass
+    double reuseUs;   // per pass: key and cache hit (plan copied and rebound)
     size_t barriers;
     size_t batches;
 };
 
+double median(std::vector<double>& v) {
+    std::nth_element(v.begin(), v.begin() + v.size() / 2, v.end());
+    return v[v.size() / 2];
+}
+
 // Median of `runs` frames. Each frame declares a new graph (replaying a
 // prepared script, so the generator's own cost stays out of the figure) and
-// compiles it into the previous frame's plan, as a frame loop would.
+// compiles it into the previous frame's plan, as a frame loop would; then
+// declares it again and takes its plan from a PlanCache (a hit after the
+// first frame: the steady state of a frame loop whose shape holds).
 Timing measure(const synthetic::Script& script, const QueueCaps& caps, int runs) {
-    std::vector<double> declare, compile;
+    std::vector<double> declare, compile, reuse;
     size_t barriers = 0, batches = 0;
     const auto passes = static_cast<double>(script.passes.size());
     Plan plan;
+    PlanCache cache;
     for (int i = 0; i < runs; ++i) {
         const auto t0 = Clock::now();
         Graph graph(caps);
@@ -60,18 +74,27 @@ Timing measure(const synthetic::Script& script, const QueueCaps& caps, int runs)
         compile.push_back(std::chrono::duration<double, std::micro>(t2 - t1).count() / passes);
         barriers = plan.barriers.size();
         batches = plan.batches.size();
+        // The same frame again through the cache: after the first run,
+        // every one is a hit.
+        Graph steady(caps);
+        steady.reserve(static_cast<uint32_t>(script.passes.size()), static_cast<uint32_t>(script.slotCount),
+                       static_cast<uint32_t>(script.passes.size() * 8));
+        synthetic::declare(steady, script);
+        const auto t4 = Clock::now();
+        const Plan reused = cache.compile(steady);
+        const auto t5 = Clock::now();
+        if (i > 0) reuse.push_back(std::chrono::duration<double, std::micro>(t5 - t4).count() / passes);
     }
-    std::nth_element(declare.begin(), declare.begin() + runs / 2, declare.end());
-    std::nth_element(compile.begin(), compile.begin() + runs / 2, compile.end());
-    return {declare[runs / 2], compile[runs / 2], barriers, batches};
+    if (cache.hits() + 1 != uint64_t(runs)) throw std::runtime_error("the plan cache missed a steady frame");
+    return {median(declare), median(compile), reuse.empty() ? 0.0 : median(reuse), barriers, batches};
 }
 
 int run(int runsOverride, uint32_t onlyPasses) {
     const QueueCaps caps = synthetic::twoQueueCaps();
     std::printf("glint-graph-bench: declare + compile per pass (median), two-queue device\n");
-    std::printf("%-16s %6s %12s %12s %12s %9s %8s\n", "shape", "passes", "declare_us", "compile_us", "total_us",
-                "barriers", "batches");
-    double worst1024 = 0;
+    std::printf("%-16s %6s %12s %12s %12s %9s %8s %10s %10s\n", "shape", "passes", "declare_us", "compile_us",
+                "total_us", "barriers", "batches", "reuse_us", "steady_us");
+    double worst1024 = 0, worstReuse1024 = 0;
     for (const uint32_t passes : {16u, 128u, 1024u}) {
         if (onlyPasses != 0 && passes != onlyPasses) continue;
         const int runs = runsOverride > 0 ? runsOverride : passes == 1024 ? 41 : 201;
@@ -82,9 +105,13 @@ int run(int runsOverride, uint32_t onlyPasses) {
         const synthetic::Script random = synthetic::randomFrame(options);
         for (const auto& [name, script] : {std::pair{"reflection-like", &reflection}, std::pair{"random", &random}}) {
             const Timing t = measure(*script, caps, runs);
-            std::printf("%-16s %6zu %12.3f %12.3f %12.3f %9zu %8zu\n", name, script->passes.size(), t.declareUs,
-                        t.compileUs, t.declareUs + t.compileUs, t.barriers, t.batches);
-            if (passes == 1024) worst1024 = std::max(worst1024, t.declareUs + t.compileUs);
+            std::printf("%-16s %6zu %12.3f %12.3f %12.3f %9zu %8zu %10.3f %10.3f\n", name, script->passes.size(),
+                        t.declareUs, t.compileUs, t.declareUs + t.compileUs, t.barriers, t.batches, t.reuseUs,
+                        t.declareUs + t.reuseUs);
+            if (passes == 1024) {
+                worst1024 = std::max(worst1024, t.declareUs + t.compileUs);
+                worstReuse1024 = std::max(worstReuse1024, t.declareUs + t.reuseUs);
+            }
         }
     }
 
@@ -103,7 +130,8 @@ int run(int runsOverride, uint32_t onlyPasses) {
     const double saving = 100.0 * (1.0 - aliased / unaliased);
     std::printf("synthetic reflection frame 1920x1080: transients %.1f MiB without aliasing, %.1f MiB with (%zu heaps)\n",
                 unaliased / mib, aliased / mib, plan.heaps.size());
-    std::printf("compile_us_per_pass_1024=%.3f alias_saving_1080p=%.1f\n", worst1024, saving);
+    std::printf("compile_us_per_pass_1024=%.3f alias_saving_1080p=%.1f reuse_us_per_pass_1024=%.3f\n", worst1024,
+                saving, worstReuse1024);
     return 0;
 }
 

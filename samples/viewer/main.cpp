@@ -24,6 +24,7 @@
 #include "glint/gpu/error.h"
 #include "glint/graph/executor.h"
 #include "glint/graph/graph.h"
+#include "glint/graph/plan_cache.h"
 #include "glint/graph/verify.h"
 #include "imgui_layer.h"
 #include "present_passes.h"
@@ -566,7 +567,8 @@ private:
         if (settings.countRays) {
             resources.bind(viewer::addCountsReadback(graph, reflections.counts, slot.counts.size()), slot.counts);
         }
-        const rg::Plan plan = graph.compile(executor_->compileOptions());
+        // A frame of an earlier frame's shape reuses that frame's plan.
+        const rg::Plan plan = planCache_.compile(graph, executor_->compileOptions());
         if (ctx_.validationEnabled()) {
             // As glint-render: the plan's own checker covers what the layer cannot see.
             const rg::VerifyReport report = rg::verify(plan);
@@ -592,6 +594,7 @@ private:
     std::vector<std::unique_ptr<FrameSlot>> slots_;
     std::unique_ptr<passes::ReflectionRenderer> renderer_;
     std::unique_ptr<rg::Executor> executor_;
+    rg::PlanCache planCache_;
     std::unique_ptr<viewer::ImGuiLayer> imgui_;
 
     scene::Camera camera_;
