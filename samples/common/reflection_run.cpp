@@ -437,7 +437,7 @@ ReflectionRunResult runReflections(gpu::Context& ctx, scene::Scene& scene, const
                                   perPass);
         }
         const auto frameStart = std::chrono::steady_clock::now();
-        const rg::Plan plan = planCache.compile(graph, executor.compileOptions());
+        const rg::Plan& plan = planCache.compile(graph, executor.compileOptions());
         // Under --validate the plan's own checker runs too: the validation
         // layer does not see hazards between dispatches' shader writes or
         // around acceleration-structure builds (graph/verify.h).

@@ -568,7 +568,7 @@ private:
             resources.bind(viewer::addCountsReadback(graph, reflections.counts, slot.counts.size()), slot.counts);
         }
         // A frame of an earlier frame's shape reuses that frame's plan.
-        const rg::Plan plan = planCache_.compile(graph, executor_->compileOptions());
+        const rg::Plan& plan = planCache_.compile(graph, executor_->compileOptions());
         if (ctx_.validationEnabled()) {
             // As glint-render: the plan's own checker covers what the layer cannot see.
             const rg::VerifyReport report = rg::verify(plan);
