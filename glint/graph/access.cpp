@@ -281,8 +281,25 @@ constexpr AccessRules kAccessRules[kAccessCount] = {
 };
 static_assert(kAccessCount == 15, "kAccessRules lists every row");
 
-constexpr ScopeLut kScopeLut = makeScopeLut();
+// Not const: tests corrupt entries (ScopeOverride) to show that the
+// verifier, which has its own rules, rejects what a wrong entry compiles.
+constinit ScopeLut kScopeLut = makeScopeLut();
 constexpr UsageLut kUsageLut = makeUsageLut();
+
+ScopeOverride::ScopeOverride(Access a, ResourceKind k, Pipeline p, const SyncScope& scope)
+    : entry_(kScopeLut.scope[static_cast<uint32_t>(a)][static_cast<uint32_t>(k)][static_cast<uint32_t>(p)]),
+      saved_(entry_),
+      access_(a),
+      kind_(k),
+      pipeline_(p) {
+    entry_ = scope;
+    refreshUseInfo(a, k, p);
+}
+
+ScopeOverride::~ScopeOverride() {
+    entry_ = saved_;
+    refreshUseInfo(access_, kind_, pipeline_);
+}
 } // namespace detail
 
 SyncScope accessScope(AccessSet set, ResourceKind k, Pipeline p) {

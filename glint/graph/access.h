@@ -150,7 +150,30 @@ namespace detail {
 struct ScopeLut {
     SyncScope scope[kAccessCount][3][3];
 };
-extern const ScopeLut kScopeLut;
+extern ScopeLut kScopeLut;
+
+// The barrier walk's own table derived from this one (barriers.cpp): one
+// entry computed again after ScopeOverride changed it.
+void refreshUseInfo(Access a, ResourceKind k, Pipeline p);
+
+// Tests only: replaces one entry of the table compile() reads (stages,
+// access mask, layout of one kind on one resource kind from one pipeline)
+// until destroyed, to check that the verifier rejects the plans a wrong
+// entry produces. Not thread-safe: nothing may compile meanwhile.
+class ScopeOverride {
+public:
+    ScopeOverride(Access a, ResourceKind k, Pipeline p, const SyncScope& scope);
+    ~ScopeOverride();
+    ScopeOverride(const ScopeOverride&) = delete;
+    ScopeOverride& operator=(const ScopeOverride&) = delete;
+
+private:
+    SyncScope& entry_;
+    SyncScope saved_;
+    Access access_;
+    ResourceKind kind_;
+    Pipeline pipeline_;
+};
 } // namespace detail
 
 inline const SyncScope& scopeOf(Access a, ResourceKind k, Pipeline p) {

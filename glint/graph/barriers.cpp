@@ -192,8 +192,9 @@ struct UseInfoTable {
 };
 
 // Built during static initialisation (from the constant-initialised access
-// table), so the lookup needs no guard.
-const UseInfoTable kUseInfo;
+// table), so the lookup needs no guard. Rebuilt entry by entry only by a
+// test's detail::ScopeOverride.
+UseInfoTable kUseInfo;
 
 const UseInfo& useInfoOf(Access a, ResourceKind k, Pipeline p) {
     return kUseInfo.info[static_cast<uint32_t>(a)][static_cast<uint32_t>(k)][static_cast<uint32_t>(p)];
@@ -1370,5 +1371,10 @@ private:
 } // namespace
 
 void placeBarriersAndBatches(CompileState& st) { Walk(st).run(); }
+
+void refreshUseInfo(Access a, ResourceKind k, Pipeline p) {
+    kUseInfo.info[static_cast<uint32_t>(a)][static_cast<uint32_t>(k)][static_cast<uint32_t>(p)] =
+        makeUseInfo(scopeOf(a, k, p));
+}
 
 } // namespace glint::rg::detail

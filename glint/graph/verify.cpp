@@ -1,7 +1,9 @@
 // The verifier: replays a Plan over several frames against a model of
 // Vulkan's synchronisation rules (see verify.h). It shares nothing with
-// barriers.cpp but the access table, which is the specification of what
-// each use needs.
+// barriers.cpp: what each use needs comes from its own rules
+// (verify_rules.h), written apart from the compiler's access table; only
+// the boundary states' concrete layouts and masks, a convention between the
+// graph and its callers, are read from that table.
 
 #include "glint/graph/verify.h"
 
@@ -12,6 +14,7 @@
 #include <string>
 
 #include "glint/graph/access.h"
+#include "glint/graph/verify_rules.h"
 
 namespace glint::rg {
 namespace {
@@ -808,13 +811,12 @@ private:
     void use(uint32_t planned, Pipeline pipeline, const ir::Use& u, uint32_t q, uint32_t f) {
         const uint32_t phys = physical(u.resource, f);
         const ir::Resource& r = d_.resources[phys];
-        const SyncScope scope = accessScope(u.kinds, r.kind, pipeline);
-        const VkPipelineStageFlags2 stages = expandStages(scope.stages);
-        const VkAccessFlags2 access = expandAccess(scope.access);
+        // The verifier's own rules (verify_rules.h), not the compiler's table.
+        const verify_rules::Need need = verify_rules::need(u.kinds, r.kind, pipeline);
+        const VkPipelineStageFlags2 stages = expandStages(need.stages);
+        const VkAccessFlags2 access = expandAccess(need.reads | need.writes);
         const VkAccessFlags2 readBits = access & kReadBits, writeBits = access & kWriteBits;
-        bool needsContents = false;
-        for (uint32_t k = 0; k < kAccessCount; ++k)
-            if ((u.kinds & (1u << k)) && accessNeedsContents(static_cast<Access>(k))) needsContents = true;
+        const bool needsContents = need.needsContents;
         const std::string who = "pass " + passName(planned);
 
         auto checkAgainst = [&](Cell& cell, uint32_t cellPhys, uint32_t c) {
@@ -843,10 +845,9 @@ private:
 
         forCells(r, u.range, [&](uint32_t c) {
             Cell& cell = cells_[c];
-            if (r.kind == ResourceKind::Texture && (cell.layoutLost || cell.layout != scope.layout))
+            if (r.kind == ResourceKind::Texture && (cell.layoutLost || !need.allows(cell.layout)))
                 fail(Kind::Layout, f,
-                     who + " uses " + cellName(phys, c) + " in layout " +
-                         std::to_string(static_cast<int>(scope.layout)) + " but it is in " +
+                     who + " uses " + cellName(phys, c) + " in a layout its access does not accept: " +
                          (cell.layoutLost ? std::string("no known layout")
                                           : std::to_string(static_cast<int>(cell.layout))));
             if (needsContents && !cell.contents)
