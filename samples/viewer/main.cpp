@@ -27,6 +27,7 @@
 #include "glint/graph/plan_cache.h"
 #include "glint/graph/verify.h"
 #include "imgui_layer.h"
+#include "plan_view.h"
 #include "present_passes.h"
 #include "glint/scene/animation.h"
 #include "glint/scene/builtin_scenes.h"
@@ -43,6 +44,7 @@
 #include <glm/gtc/matrix_transform.hpp>
 
 #include <algorithm>
+#include <cstdio>
 #include <array>
 #include <cstring>
 #include <memory>
@@ -160,6 +162,7 @@ public:
         options_.renderer.backend = options.backend;
         options_.frame.mode = options.mode;
         options_.frame.debugView = options.debugView;
+        showGraph_ = options.graphPanel;
         builtWith_ = options_.renderer;
         renderer_ = std::make_unique<passes::ReflectionRenderer>(ctx_, scene_, options_.renderer);
         executor_ = std::make_unique<rg::Executor>(ctx_, kFramesInFlight);
@@ -331,6 +334,89 @@ private:
         }
     }
 
+    // The compiled plan of the frame on screen (viewer::planView): passes per
+    // queue with their batches, waits, barriers and times; a pass's
+    // resources on click; the transient heaps and what aliases what.
+    void graphPanel() {
+        ImGui::SetNextItemOpen(showGraph_, ImGuiCond_Once);
+        showGraph_ = ImGui::CollapsingHeader("render graph");
+        if (!showGraph_) return;
+        const viewer::PlanView& v = planView_;
+        const double mib = 1024.0 * 1024.0;
+        ImGui::Text("%zu + %zu passes (%u culled); plans reused %llu, compiled %llu", v.lanes[0].size(),
+                    v.lanes[1].size(), v.culled, static_cast<unsigned long long>(planCache_.hits()),
+                    static_cast<unsigned long long>(planCache_.misses()));
+        ImGui::Text("transients %.1f MiB, %.1f MiB with aliasing", double(v.transientBytes) / mib,
+                    double(v.aliasedBytes) / mib);
+        const ImGuiTableFlags flags = ImGuiTableFlags_Borders | ImGuiTableFlags_ScrollY | ImGuiTableFlags_RowBg;
+        if (ImGui::BeginTable("queues", 2, flags, ImVec2(0.0f, 260.0f))) {
+            ImGui::TableSetupColumn("graphics");
+            ImGui::TableSetupColumn("async compute");
+            ImGui::TableHeadersRow();
+            ImGui::TableNextRow();
+            for (int q = 0; q < 2; ++q) {
+                ImGui::TableSetColumnIndex(q);
+                for (const viewer::PlanViewPass& p : v.lanes[q]) {
+                    for (const viewer::PlanViewWait& w : p.waits) {
+                        const std::string what = std::string(rg::toString(w.queue));
+                        ImGui::TextDisabled("waits for %s batch %u%s", what.c_str(), w.batch,
+                                            w.previousFrame ? " (last frame)" : "");
+                    }
+                    char label[160];
+                    std::snprintf(label, sizeof label, "%s%s  b%u, %u barriers%s", p.batchStart ? "" : "  ",
+                                  p.name.c_str(), p.batch, p.barriers, p.milliseconds ? "," : "");
+                    std::string text = label;
+                    if (p.milliseconds) {
+                        std::snprintf(label, sizeof label, " %.3f ms", *p.milliseconds);
+                        text += label;
+                    }
+                    if (ImGui::Selectable((text + "##" + p.name).c_str(), selectedPass_ == p.name)) {
+                        selectedPass_ = p.name;
+                    }
+                }
+            }
+            ImGui::EndTable();
+        }
+        for (const auto& lane : v.lanes) {
+            for (const viewer::PlanViewPass& p : lane) {
+                if (p.name != selectedPass_) continue;
+                ImGui::Text("%s uses:", p.name.c_str());
+                for (const viewer::PlanViewUse& u : p.uses) {
+                    ImGui::BulletText("%s: %s%s", u.resource.c_str(), u.access.c_str(), u.writes ? " (writes)" : "");
+                }
+            }
+        }
+        for (size_t h = 0; h < v.heaps.size(); ++h) {
+            const viewer::PlanViewHeap& heap = v.heaps[h];
+            const std::string queue(rg::toString(heap.queue));
+            if (!ImGui::TreeNode(reinterpret_cast<void*>(h), "heap %zu (%s), %.1f MiB, %zu transients", h,
+                                 queue.c_str(), double(heap.size) / mib, heap.placements.size())) {
+                continue;
+            }
+            // Each placement as a bar over the heap's bytes; its tooltip
+            // names the passes it lives through and what shares its bytes.
+            ImDrawList* draw = ImGui::GetWindowDrawList();
+            const float width = ImGui::GetContentRegionAvail().x;
+            for (const viewer::PlanViewPlacement& p : heap.placements) {
+                const ImVec2 at = ImGui::GetCursorScreenPos();
+                const float x0 = width * float(double(p.offset) / double(std::max<uint64_t>(heap.size, 1)));
+                const float x1 = width * float(double(p.offset + p.size) / double(std::max<uint64_t>(heap.size, 1)));
+                const float h1 = ImGui::GetTextLineHeight();
+                draw->AddRectFilled(ImVec2(at.x + x0, at.y), ImVec2(at.x + std::max(x1, x0 + 2.0f), at.y + h1),
+                                    p.aliases.empty() ? IM_COL32(80, 140, 220, 160) : IM_COL32(220, 150, 60, 170));
+                ImGui::Text("%s", p.resource.c_str());
+                if (ImGui::IsItemHovered()) {
+                    std::string aliases;
+                    for (const std::string& a : p.aliases) aliases += (aliases.empty() ? "" : ", ") + a;
+                    ImGui::SetTooltip("%.2f MiB at %.2f MiB, passes %u-%u\nshares bytes with: %s",
+                                      double(p.size) / mib, double(p.offset) / mib, p.firstPass, p.lastPass,
+                                      aliases.empty() ? "nothing" : aliases.c_str());
+                }
+            }
+            ImGui::TreePop();
+        }
+    }
+
     void panel() {
         ImGui::SetNextWindowPos(ImVec2(10, 10), ImGuiCond_FirstUseEver);
         ImGui::SetNextWindowSize(ImVec2(380, std::max(200.0f, float(swapchain_.extent().height) - 20.0f)),
@@ -456,6 +542,8 @@ private:
             }
         }
 
+        graphPanel();
+
         // -- BVH
         if (ImGui::CollapsingHeader("BVH", ImGuiTreeNodeFlags_DefaultOpen)) {
             if (options_.frame.mode == passes::ReflectionMode::Ssr) {
@@ -569,6 +657,7 @@ private:
         }
         // A frame of an earlier frame's shape reuses that frame's plan.
         const rg::Plan& plan = planCache_.compile(graph, executor_->compileOptions());
+        if (showGraph_) planView_ = viewer::planView(plan, timings_);
         if (ctx_.validationEnabled()) {
             // As glint-render: the plan's own checker covers what the layer cannot see.
             const rg::VerifyReport report = rg::verify(plan);
@@ -595,6 +684,11 @@ private:
     std::unique_ptr<passes::ReflectionRenderer> renderer_;
     std::unique_ptr<rg::Executor> executor_;
     rg::PlanCache planCache_;
+    // The render graph panel: its rows (built each frame while it is open)
+    // and the pass whose resources it lists.
+    bool showGraph_ = false;
+    viewer::PlanView planView_;
+    std::string selectedPass_;
     std::unique_ptr<viewer::ImGuiLayer> imgui_;
 
     scene::Camera camera_;
@@ -622,7 +716,7 @@ private:
 
 int main(int argc, char** argv) {
     return app::runMain("glint-viewer", [&] {
-        const app::Args args(argc, argv, viewer::kUsage, viewer::viewerFlags(), {});
+        const app::Args args(argc, argv, viewer::kUsage, viewer::viewerFlags(), viewer::viewerSwitches());
         const viewer::ViewerOptions options = viewer::viewerOptions(args);
 
         // The window first: without a display this fails at once, before

@@ -43,6 +43,11 @@ std::vector<app::Flag> viewerFlags() {
             {"debug-view", "the debug view the panel starts with (glint-render --list-debug-views)"}};
 }
 
+std::vector<app::Flag> viewerSwitches() {
+    return {{"graph-panel", "start with the render graph panel open (the compiled plan: passes per queue, waits, "
+                            "barriers, times, transient memory)"}};
+}
+
 ViewerOptions viewerOptions(const app::Args& args) {
     ViewerOptions o;
     o.scene = args.get("scene", o.scene);
@@ -52,6 +57,7 @@ ViewerOptions viewerOptions(const app::Args& args) {
         o.height = size.y;
     }
     o.frames = args.getUint("frames", 0);
+    o.graphPanel = args.has("graph-panel");
     try {
         o.mode = passes::parseMode(args.get("mode", "hybrid"));
         o.backend = passes::parseBackend(args.get("backend", "auto"));

@@ -31,6 +31,7 @@ struct ViewerOptions {
     passes::ReflectionMode mode = passes::ReflectionMode::Hybrid;
     passes::RtBackend backend = passes::RtBackend::Auto;
     std::string debugView = "final";
+    bool graphPanel = false;  // the render graph panel starts open
 };
 
 // "WxH" (or "N" for a square), 64..8192 each: smaller windows leave no room
@@ -41,6 +42,8 @@ ViewerOptions viewerOptions(const app::Args& args);
 // debug view the mode does not produce.
 // The flags app::Args must accept for the viewer.
 std::vector<app::Flag> viewerFlags();
+// The switches (flags without a value).
+std::vector<app::Flag> viewerSwitches();
 
 // Whether ReflectionRenderer::addFrame produces debug view `view` in
 // `mode`: the SSLR views need screen space (not rt), the ray-traced ones a

@@ -9,9 +9,11 @@
 #include "glint/graph/synthetic.h"
 #include "glint/graph/verify.h"
 #include "imgui_layer.h"
+#include "plan_view.h"
 #include "present_passes.h"
 #include "viewer_model.h"
 
+#include <algorithm>
 #include <cmath>
 #include <set>
 #include <stdexcept>
@@ -27,7 +29,7 @@ app::Args argsOf(std::vector<std::string> words) {
     static std::string program = "glint-viewer";
     argv.push_back(program.data());
     for (std::string& w : words) argv.push_back(w.data());
-    return app::Args(int(argv.size()), argv.data(), viewer::kUsage, viewer::viewerFlags(), {});
+    return app::Args(int(argv.size()), argv.data(), viewer::kUsage, viewer::viewerFlags(), viewer::viewerSwitches());
 }
 
 } // namespace
@@ -38,6 +40,8 @@ TEST_CASE("the command line gives the scene and the window size") {
     CHECK(defaults.width == 1280);
     CHECK(defaults.height == 720);
     CHECK(defaults.frames == 0);
+    CHECK_FALSE(defaults.graphPanel);
+    CHECK(viewer::viewerOptions(argsOf({"--graph-panel"})).graphPanel);
     const viewer::ViewerOptions o =
         viewer::viewerOptions(argsOf({"--scene", "hard-cases", "--size", "800x600", "--frames", "3"}));
     CHECK(o.scene == "hard-cases");
@@ -271,4 +275,71 @@ TEST_CASE("the starting mode, backend and debug view come from the command line,
                          doctest::Contains("--debug-view nope"), std::runtime_error);
     CHECK_THROWS_WITH_AS(viewer::viewerOptions(argsOf({"--mode", "ssr", "--debug-view", "rt_radiance"})),
                          doctest::Contains("not produced in mode ssr"), std::runtime_error);
+}
+
+TEST_CASE("the render graph panel shows every planned pass on its queue, the waits, barriers, times and aliasing") {
+    rg::Graph graph(rg::synthetic::twoQueueCaps());
+    rg::synthetic::declare(graph, rg::synthetic::reflectionFrame({.width = 640, .height = 360}));
+    const rg::Plan plan = graph.compile();
+    REQUIRE(plan.findPass("bvh_update") != nullptr);
+    std::vector<rg::PassTiming> timings = {{"bvh_update", rg::Queue::AsyncCompute, 0.25, 3, std::nullopt}};
+    const viewer::PlanView view = viewer::planView(plan, timings);
+
+    // Every planned pass once, on its queue, in submission order.
+    size_t rows = 0, barriers = 0, waits = 0;
+    std::set<std::string> names;
+    for (uint32_t q = 0; q < 2; ++q) {
+        uint32_t lastBatch = 0;
+        for (const viewer::PlanViewPass& p : view.lanes[q]) {
+            const rg::PlannedPass* planned = plan.findPass(p.name);
+            REQUIRE(planned != nullptr);
+            CHECK(uint32_t(planned->queue) == q);
+            CHECK(p.batch >= lastBatch);
+            lastBatch = p.batch;
+            CHECK(p.barriers == planned->barrierCount);
+            barriers += p.barriers;
+            waits += p.waits.size();
+            CHECK((p.waits.empty() || p.batchStart));
+            names.insert(p.name);
+            ++rows;
+        }
+    }
+    CHECK(rows == plan.passes.size());
+    CHECK(names.size() == rows);
+    CHECK(!view.lanes[1].empty());  // the BVH update on async compute
+    CHECK(waits == plan.waits.size());
+    size_t planned = 0;
+    for (const rg::PlannedPass& p : plan.passes) planned += p.barrierCount;
+    CHECK(barriers == planned);
+
+    // The time of a pass comes from the timing of its name.
+    const auto bvh = std::find_if(view.lanes[1].begin(), view.lanes[1].end(),
+                                  [](const viewer::PlanViewPass& p) { return p.name == "bvh_update"; });
+    REQUIRE(bvh != view.lanes[1].end());
+    REQUIRE(bvh->milliseconds.has_value());
+    CHECK(*bvh->milliseconds == doctest::Approx(0.25));
+    CHECK(!bvh->uses.empty());
+
+    // Every used transient placed once, and aliasing shown both ways.
+    size_t placements = 0, aliased = 0;
+    for (const viewer::PlanViewHeap& heap : view.heaps) {
+        for (const viewer::PlanViewPlacement& p : heap.placements) {
+            ++placements;
+            CHECK(p.offset + p.size <= heap.size);
+            if (!p.aliases.empty()) ++aliased;
+            for (const std::string& other : p.aliases) {
+                const auto it = std::find_if(heap.placements.begin(), heap.placements.end(),
+                                             [&](const viewer::PlanViewPlacement& o) { return o.resource == other; });
+                REQUIRE(it != heap.placements.end());
+                CHECK(std::count(it->aliases.begin(), it->aliases.end(), p.resource) == 1);
+            }
+        }
+    }
+    size_t transients = 0;
+    for (const rg::PlannedResource& r : plan.resources) {
+        if (r.origin == rg::ir::Origin::Transient && r.used) ++transients;
+    }
+    CHECK(placements == transients);
+    CHECK(view.aliasedBytes < view.transientBytes);
+    CHECK(aliased > 0);
 }
