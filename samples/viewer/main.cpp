@@ -384,6 +384,15 @@ private:
                 for (const viewer::PlanViewUse& u : p.uses) {
                     ImGui::BulletText("%s: %s%s", u.resource.c_str(), u.access.c_str(), u.writes ? " (writes)" : "");
                 }
+                if (!p.barrierList.empty()) ImGui::Text("barriers before it:");
+                for (const viewer::PlanViewBarrier& b : p.barrierList) {
+                    ImGui::BulletText("%s: stages 0x%llx -> 0x%llx, access 0x%llx -> 0x%llx, layout %d -> %d%s",
+                                      b.resource.c_str(), static_cast<unsigned long long>(b.srcStages),
+                                      static_cast<unsigned long long>(b.dstStages),
+                                      static_cast<unsigned long long>(b.srcAccess),
+                                      static_cast<unsigned long long>(b.dstAccess), int(b.oldLayout),
+                                      int(b.newLayout), b.aliasing ? " (aliasing)" : "");
+                }
             }
         }
         for (size_t h = 0; h < v.heaps.size(); ++h) {

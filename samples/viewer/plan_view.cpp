@@ -40,6 +40,11 @@ PlanView planView(const rg::Plan& plan, std::span<const rg::PassTiming> timings)
             }
             first = false;
             row.barriers = p.barrierCount;
+            for (const rg::Barrier& barrier : plan.barriersBefore(p)) {
+                row.barrierList.push_back({std::string(plan.resourceName(barrier.resource)), barrier.srcStages,
+                                           barrier.dstStages, barrier.srcAccess, barrier.dstAccess,
+                                           barrier.oldLayout, barrier.newLayout, barrier.aliasing});
+            }
             for (const rg::PassTiming& t : timings) {
                 if (t.name == row.name) row.milliseconds = t.milliseconds;
             }

@@ -28,12 +28,21 @@ struct PlanViewWait {
     bool previousFrame = false;
 };
 
+struct PlanViewBarrier {
+    std::string resource;
+    VkPipelineStageFlags2 srcStages = 0, dstStages = 0;
+    VkAccessFlags2 srcAccess = 0, dstAccess = 0;
+    VkImageLayout oldLayout = VK_IMAGE_LAYOUT_UNDEFINED, newLayout = VK_IMAGE_LAYOUT_UNDEFINED;
+    bool aliasing = false;  // its source accesses were made through another resource in the same bytes
+};
+
 struct PlanViewPass {
     std::string name;
     uint32_t batch = 0;                 // Plan::batches index
     bool batchStart = false;            // the first pass of its batch: the batch's waits go before it
     std::vector<PlanViewWait> waits;    // the batch's, on its first pass
     uint32_t barriers = 0;              // recorded before the pass
+    std::vector<PlanViewBarrier> barrierList;  // the same, one by one
     std::optional<double> milliseconds;  // the newest timing of a pass of this name
     std::vector<PlanViewUse> uses;
 };

@@ -297,6 +297,12 @@ TEST_CASE("the render graph panel shows every planned pass on its queue, the wai
             CHECK(p.batch >= lastBatch);
             lastBatch = p.batch;
             CHECK(p.barriers == planned->barrierCount);
+            REQUIRE(p.barrierList.size() == p.barriers);
+            for (size_t i = 0; i < p.barrierList.size(); ++i) {
+                const rg::Barrier& b = plan.barriersBefore(*planned)[i];
+                CHECK(p.barrierList[i].resource == plan.resourceName(b.resource));
+                CHECK(p.barrierList[i].newLayout == b.newLayout);
+            }
             barriers += p.barriers;
             waits += p.waits.size();
             CHECK((p.waits.empty() || p.batchStart));
