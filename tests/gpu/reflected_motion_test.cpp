@@ -121,21 +121,27 @@ Census census(const MotionFrame& f) {
 
 } // namespace
 
-TEST_CASE("a moving object's reflection carries its motion: ray-traced hits from the instance, SSLR hits from the "
-          "G-buffer") {
-    for (const passes::ReflectionMode mode : {passes::ReflectionMode::Rt, passes::ReflectionMode::Ssr}) {
-        CAPTURE(passes::modeName(mode));
-        const Census c = census(renderMoving(mode, true));
-        // The lamp's reflection covers a patch of the floor (about 5x5 pixels
-        // at this size); every other reflecting pixel holds still.
-        CHECK(c.lamp >= 12);
-        CHECK(c.still > 1000);
-        CHECK(c.other <= c.lamp / 4);
-        // The lamp moves about a pixel a frame to the right: its reflection
-        // came from about a pixel to the left.
-        CHECK(c.lampReflectionMotion.x < -0.5f);
-        CHECK(c.lampReflectionMotion.x > -2.0f);
-        CHECK(std::abs(c.lampReflectionMotion.y) < 0.5f);
+TEST_CASE("a moving object's reflection carries its motion, moved rigidly, by a joint or by a morph target: "
+          "ray-traced hits from the instance and how the BLAS's triangles moved since its last build, SSLR hits "
+          "from the G-buffer") {
+    for (const scene::MirrorMotionLamp lamp :
+         {scene::MirrorMotionLamp::Rigid, scene::MirrorMotionLamp::Skinned, scene::MirrorMotionLamp::Morphed}) {
+        CAPTURE(lamp == scene::MirrorMotionLamp::Rigid ? "rigid" : lamp == scene::MirrorMotionLamp::Skinned ? "skinned"
+                                                                                                            : "morphed");
+        for (const passes::ReflectionMode mode : {passes::ReflectionMode::Rt, passes::ReflectionMode::Ssr}) {
+            CAPTURE(passes::modeName(mode));
+            const Census c = census(renderMoving(mode, true, lamp));
+            // The lamp's reflection covers a patch of the floor (about 5x5
+            // pixels at this size); every other reflecting pixel holds still.
+            CHECK(c.lamp >= 12);
+            CHECK(c.still > 1000);
+            CHECK(c.other <= c.lamp / 4);
+            // The lamp moves about a pixel a frame to the right: its
+            // reflection came from about a pixel to the left.
+            CHECK(c.lampReflectionMotion.x < -0.5f);
+            CHECK(c.lampReflectionMotion.x > -2.0f);
+            CHECK(std::abs(c.lampReflectionMotion.y) < 0.5f);
+        }
     }
 }
 
@@ -143,23 +149,6 @@ TEST_CASE("without reflected motion the lamp's reflection is reprojected as if i
     const Census c = census(renderMoving(passes::ReflectionMode::Rt, false));
     CHECK(c.lamp >= 12);
     CHECK(std::abs(c.lampReflectionMotion.x) < 0.2f);
-}
-
-TEST_CASE("a skinned or morphed object's reflection carries its motion: ray-traced hits from how the BLAS's "
-          "triangles moved since its last build, SSLR hits from the G-buffer") {
-    for (const scene::MirrorMotionLamp lamp : {scene::MirrorMotionLamp::Skinned, scene::MirrorMotionLamp::Morphed}) {
-        CAPTURE(lamp == scene::MirrorMotionLamp::Skinned ? "skinned" : "morphed");
-        for (const passes::ReflectionMode mode : {passes::ReflectionMode::Rt, passes::ReflectionMode::Ssr}) {
-            CAPTURE(passes::modeName(mode));
-            const Census c = census(renderMoving(mode, true, lamp));
-            CHECK(c.lamp >= 12);
-            CHECK(c.still > 1000);
-            CHECK(c.other <= c.lamp / 4);
-            CHECK(c.lampReflectionMotion.x < -0.5f);
-            CHECK(c.lampReflectionMotion.x > -2.0f);
-            CHECK(std::abs(c.lampReflectionMotion.y) < 0.5f);
-        }
-    }
 }
 
 TEST_CASE("mirror-motion's lamp option names what it refuses") {
