@@ -27,7 +27,8 @@ float objectX(float seconds) {
 MirrorMotionLamp parseMirrorMotionLamp(std::string_view spec) {
     const size_t colon = spec.find(':');
     if (spec.substr(0, colon) != "mirror-motion") {
-        throw SceneError(std::string(spec), "", "not a mirror-motion scene (mirror-motion or mirror-motion:lamp=HOW)");
+        throw SceneError(std::string(spec), "",
+                         "not a mirror-motion scene (mirror-motion or mirror-motion:lamp=rigid|skinned|morphed)");
     }
     if (colon == std::string_view::npos) return MirrorMotionLamp::Rigid;
     const std::string_view option = spec.substr(colon + 1);
