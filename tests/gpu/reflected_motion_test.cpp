@@ -126,8 +126,10 @@ TEST_CASE("a moving object's reflection carries its motion, moved rigidly, by a 
           "from the G-buffer") {
     for (const scene::MirrorMotionLamp lamp :
          {scene::MirrorMotionLamp::Rigid, scene::MirrorMotionLamp::Skinned, scene::MirrorMotionLamp::Morphed}) {
-        CAPTURE(lamp == scene::MirrorMotionLamp::Rigid ? "rigid" : lamp == scene::MirrorMotionLamp::Skinned ? "skinned"
-                                                                                                            : "morphed");
+        const char* how = lamp == scene::MirrorMotionLamp::Rigid     ? "rigid"
+                          : lamp == scene::MirrorMotionLamp::Skinned ? "skinned"
+                                                                     : "morphed";
+        CAPTURE(how);
         for (const passes::ReflectionMode mode : {passes::ReflectionMode::Rt, passes::ReflectionMode::Ssr}) {
             CAPTURE(passes::modeName(mode));
             const Census c = census(renderMoving(mode, true, lamp));

@@ -65,7 +65,8 @@ Plan compileCase(const Case& c) {
             declare(g.createBuffer("b", {4096}));
             break;
         case ResourceKind::AccelStruct:
-            declare(g.importAccelStruct("tlas", {BoundaryState::of(Access::AccelRead), BoundaryState::of(Access::AccelRead)}));
+            declare(g.importAccelStruct(
+                "tlas", {BoundaryState::of(Access::AccelRead), BoundaryState::of(Access::AccelRead)}));
             break;
     }
     return compile(g, oneQueue());
