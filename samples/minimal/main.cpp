@@ -6,6 +6,7 @@
 // GLINT_VALIDATION=1 runs it under the validation layer (a message fails it).
 #include "glint/gpu/context.h"
 #include "glint/graph/executor.h"
+#include "glint/graph/plan_cache.h"
 #include "glint/graph/transfer.h"
 #include "glint/passes/reflection_frame.h"
 #include "glint/scene/animation.h"
@@ -39,6 +40,7 @@ int main(int argc, char** argv) {
         scene::Scene scene = scene::loadScene(sceneName);
         passes::ReflectionRenderer renderer(ctx, scene);
         rg::Executor executor(ctx);
+        rg::PlanCache plans;  // frames of one shape reuse one compiled plan
         const rg::HostReadback image(ctx, kWidth * kHeight * 4, "minimal.image");
 
         scene::Camera camera;
@@ -59,7 +61,7 @@ int main(int argc, char** argv) {
             rg::FrameResources resources;
             renderer.bind(resources, declared);
             if (frame + 1 == kFrames) image.copy(graph, resources, declared.output.color);
-            executor.run(graph.compile(executor.compileOptions()), resources);
+            executor.run(plans.compile(graph, executor.compileOptions()), resources);
         }
         executor.waitIdle();
         scene::writePng(out, kWidth, kHeight, image.as<uint8_t>());
