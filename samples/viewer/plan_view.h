@@ -3,7 +3,7 @@
 // frame on screen as rows to draw. Per queue, the passes in submission order
 // with their batch, barriers, cross-queue waits and GPU time; the resources
 // each pass uses; the transient heaps with each placement and what shares
-// its bytes (aliasing). Plan::toDot() stays the way to Graphviz.
+// its bytes (aliasing). For Graphviz, Plan::toDot() writes the same plan.
 
 #include "glint/graph/executor.h"
 #include "glint/graph/plan.h"
