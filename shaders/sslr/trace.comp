@@ -66,14 +66,16 @@ struct March {
 };
 
 // How far the ray at screen parameter t lies behind the depth buffer, in
-// view units (positive: behind), and whether the texel is sky.
-float behind(March m, float t, out ivec2 texel, out bool sky) {
+// view units (positive: behind), whether the texel is sky, and the depth
+// buffer's distance there (view units).
+float behind(March m, float t, out ivec2 texel, out bool sky, out float surface) {
     const vec2 pos = m.start + t * m.delta;
     texel = clamp(ivec2(floor(pos)), ivec2(0), ivec2(pc.size) - 1);
     const float depth = texelFetch(depthTexture, texel, 0).x;
     sky = depth <= 0.0;
     const float rayDistance = 1.0 / (m.k0 + t * m.dk);
-    return sky ? -1.0 : rayDistance - (-viewZ(depth));
+    surface = -viewZ(depth);
+    return sky ? -1.0 : rayDistance - surface;
 }
 
 void writeResult(ivec2 pixel, vec3 radiance, float confidence, vec2 hitUv, bool hit) {
@@ -161,6 +163,18 @@ void main() {
     float tHit = -1.0;
     ivec2 hitTexel = ivec2(0);
     float gap = 0.0;
+    // A ray passing behind a thick occluder lies behind the depth buffer at
+    // every step, and a search between two such steps finds that occluder
+    // again. So a step behind is refined only where the last step lay in
+    // front, where its own gap is thin enough to be a hit, or where the
+    // depth buffer lies farther than at the last step (another surface,
+    // which the ray may have met between the two). Each search costs
+    // refineSteps dependent reads; searching at every step behind made
+    // rays that pass behind something the pass's slowest (on the H200 at
+    // 1080p the pass took 0.164 -> 0.115 ms on the plaza, 0.097 -> 0.053
+    // on DamagedHelmet, for 0.7% more hybrid rays handed to RT).
+    bool wasBehind = false;
+    float lastSurface = 0.0;
     for (uint i = 0u; i < steps; ++i) {
         const float t = (float(i) + jitter) * step;
         // Within a pixel of the origin the ray can only find its own surface.
@@ -170,35 +184,46 @@ void main() {
         }
         ivec2 texel;
         bool sky;
-        const float d = behind(m, t, texel, sky);
+        float surface;
+        const float d = behind(m, t, texel, sky, surface);
         if (sky || d < 0.0) {
+            tFront = t;
+            wasBehind = false;
+            continue;
+        }
+        const bool sameOccluder = surface <= lastSurface * (1.0 + pc.thickness);
+        lastSurface = surface;
+        if (wasBehind && d > pc.thickness * surface && sameOccluder) {
             tFront = t;
             continue;
         }
+        wasBehind = true;
         // A crossing: refine between the last point in front and this one.
         float lo = tFront, hi = t;
         ivec2 hiTexel = texel;
         float hiGap = d;
+        float hiSurface = surface;
         for (uint j = 0u; j < pc.refineSteps; ++j) {
             const float mid = 0.5 * (lo + hi);
             ivec2 midTexel;
             bool midSky;
-            const float md = behind(m, mid, midTexel, midSky);
+            float midSurface;
+            const float md = behind(m, mid, midTexel, midSky, midSurface);
             if (midSky || md < 0.0) {
                 lo = mid;
             } else {
                 hi = mid;
                 hiTexel = midTexel;
                 hiGap = md;
+                hiSurface = midSurface;
             }
         }
         // Thickness test: the depth buffer holds only front surfaces, so a
         // ray found far behind one passed behind it; keep marching.
-        const float surfaceDistance = -viewZ(texelFetch(depthTexture, hiTexel, 0).x);
-        if (hiGap <= pc.thickness * surfaceDistance) {
+        if (hiGap <= pc.thickness * hiSurface) {
             tHit = hi;
             hitTexel = hiTexel;
-            gap = hiGap / (pc.thickness * surfaceDistance);
+            gap = hiGap / (pc.thickness * hiSurface);
             break;
         }
         tFront = t;
