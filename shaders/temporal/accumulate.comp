@@ -197,20 +197,26 @@ void loadTile() {
 }
 
 void main() {
-    loadTile();
     const ivec2 p = ivec2(gl_GlobalInvocationID.xy);
+    // This pixel's own reads go out before the tile's and its barrier, so
+    // that their latencies overlap (the edge groups' outside invocations
+    // read the last texel and write nothing).
+    const ivec2 texel = min(p, ivec2(frame.size) - 1);
+    vec2 surfaceMotion = texelFetch(motionTexture, texel, 0).xy;
+    const float depth = texelFetch(depthTexture, texel, 0).x;
+    const vec4 normalSample = texelFetch(normalTexture, texel, 0);
+    const float reflectMask = texelFetch(radianceTexture, texel, 0).a;
+    const float roughness = texelFetch(roughnessMetalTexture, texel, 0).r;
+    const float hitDistance = texelFetch(hitDistanceTexture, texel, 0).x;
+    loadTile();
     if (p.x >= int(frame.size.x) || p.y >= int(frame.size.y)) {
         return;
     }
     const vec2 size = vec2(frame.size);
     const vec2 centre = vec2(p) + 0.5;
-    vec2 surfaceMotion = texelFetch(motionTexture, p, 0).xy;
     if (!isFinite(surfaceMotion)) {
         surfaceMotion = vec2(0.0);
     }
-    const float depth = texelFetch(depthTexture, p, 0).x;
-    const vec4 normalSample = texelFetch(normalTexture, p, 0);
-    const float reflectMask = texelFetch(radianceTexture, p, 0).a;
     if (!(depth > 0.0) || !(normalSample.w > 0.0) || !(reflectMask > 0.0) || !isFinite(normalSample.xyz)) {
         writeNothing(p, surfaceMotion);
         return;
@@ -219,7 +225,7 @@ void main() {
     Pixel px;
     px.position = worldPosition(frame.inverseViewProjection, centre, size, depth);
     px.normal = normalize(normalSample.xyz);
-    px.roughness = texelFetch(roughnessMetalTexture, p, 0).r;
+    px.roughness = roughness;
     px.w = viewDepth(frame.viewProjection, px.position);
 
     // 1. This frame's radiance and its neighbourhood's statistics.
@@ -251,7 +257,6 @@ void main() {
 
     // 2. Reflection motion through the virtual point.
     const vec3 viewDir = normalize(px.position - frame.cameraPosition.xyz);
-    const float hitDistance = texelFetch(hitDistanceTexture, p, 0).x;
     vec4 clip;
     if (!(hitDistance < kMissHitDistance)) {
         // At infinity (NaN lands here too): only the direction reprojects.
