@@ -119,18 +119,22 @@ Reflection integratePixel(uvec2 pixel) {
     r.hitDistance = kMissHitDistance;
     r.hitMotion = vec3(0.0);
     r.source = kSourceSky;
+    // Every read that depends on nothing else goes out first, so that their
+    // latencies overlap rather than add up (this pass is a chain of reads:
+    // the class, the ray, its leader's traces, an SSLR hit's surface).
     const uint index = pixel.y * C.size.x + pixel.x;
+    const ivec2 p = ivec2(pixel);
     const uint pixelClass = classes[index];
+    const PackedRay ray = rays[index];
+    const float depth = texelFetch(depthTexture, p, 0).x;
+    const vec3 n = texelFetch(normalTexture, p, 0).xyz;
+    const float roughness = texelFetch(roughnessMetalTexture, p, 0).x;
     if (pixelClass == kPixelSky || pixelClass >= kPixelClassCount) {
         return r;
     }
-    const ivec2 p = ivec2(pixel);
-    const float depth = texelFetch(depthTexture, p, 0).x;
     const vec3 position = worldPosition(vec2(pixel) + 0.5, depth);
-    const vec3 n = texelFetch(normalTexture, p, 0).xyz;
     const vec3 N = n * inversesqrt(max(dot(n, n), 1e-12));
     const vec3 V = normalize(C.cameraPosition.xyz - position);
-    const float roughness = texelFetch(roughnessMetalTexture, p, 0).x;
     r.reflects = 1.0;
     // The environment map, for env pixels and for traces that found nothing.
     r.radiance = environmentRadiance(C.lighting, reflect(-V, N), roughness);
@@ -140,10 +144,26 @@ Reflection integratePixel(uvec2 pixel) {
     }
 
     // A follower's traces are its quad leader's (glint/ray_generation_shared.h).
-    const PackedRay ray = rays[index];
     const bool traced = ray.pixelFlags != kNoRay;
     const ivec2 leader = traced ? ivec2(unpackRayPixel(ray.pixelFlags)) : p;
     const bool ownRay = traced && (ray.pixelFlags & kRayReused) == 0u;
+
+    // The ray tracer's and the particle trace's outputs are read beside
+    // SSLR's, not after them; the RT ones are used only where SSLR handed
+    // the ray on.
+#if GLINT_INTEGRATE_RT
+    vec4 rtRadianceSample = vec4(0.0);
+    float rtDistanceSample = kMissHitDistance;
+    vec3 rtMotionSample = vec3(0.0);
+    if (traced && (pixelClass == kPixelRt || pixelClass == kPixelHybrid)) {
+        rtRadianceSample = texelFetch(rtRadianceTexture, leader, 0);
+        rtDistanceSample = texelFetch(rtHitDistanceTexture, leader, 0).x;
+        if (C.rtHitMotionBound != 0u) {
+            rtMotionSample = texelFetch(rtHitMotionTexture, leader, 0).xyz;
+        }
+    }
+#endif
+    const vec4 particles = traced && C.particlesBound != 0u ? texelFetch(particlesTexture, leader, 0) : vec4(0.0);
 
     float confidence = 0.0;
     vec3 sslrRadiance = vec3(0.0);
@@ -183,16 +203,15 @@ Reflection integratePixel(uvec2 pixel) {
     vec3 rtHitMotion = vec3(0.0);
 #if GLINT_INTEGRATE_RT
     if (traced && handedToRt) {
-        const vec4 radiance = texelFetch(rtRadianceTexture, leader, 0);
-        const float d = texelFetch(rtHitDistanceTexture, leader, 0).x;
+        const vec4 radiance = rtRadianceSample;
+        const float d = rtDistanceSample;
         rtTraced = radiance.a > 0.5 && isFinite(radiance.rgb);
         rtRadiance = radiance.rgb;
         // A follower takes its leader's ray length: the quad shares one ray,
         // and its origins lie a pixel apart.
         rtHitDistance = isFinite(d) ? clamp(d, 0.0, kMissHitDistance) : kMissHitDistance;
         if (C.rtHitMotionBound != 0u) {
-            const vec3 motion = texelFetch(rtHitMotionTexture, leader, 0).xyz;
-            rtHitMotion = isFinite(motion) ? motion : vec3(0.0);
+            rtHitMotion = isFinite(rtMotionSample) ? rtMotionSample : vec3(0.0);
         }
     }
 #endif
@@ -226,7 +245,6 @@ Reflection integratePixel(uvec2 pixel) {
     // partly transparent, and temporal reprojection follows what lies
     // behind them.
     if (traced && C.particlesBound != 0u) {
-        const vec4 particles = texelFetch(particlesTexture, leader, 0);
         if (isFinite(particles.rgb) && isFinite(particles.a)) {
             const float coverage = clamp(particles.a, 0.0, 1.0);
             r.radiance = max(particles.rgb, vec3(0.0)) + (1.0 - coverage) * r.radiance;
