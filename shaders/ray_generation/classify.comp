@@ -200,7 +200,9 @@ void main() {
             const uint base = atomicAdd(sslrArgs[kRayListCountOffset], sharedSslrCount);
             sharedSslrBase = base;
             const uint end = base + sharedSslrCount;
-            atomicMax(sslrArgs[kRayListDispatchOffset], (end + kRayListGroupSize - 1u) / kRayListGroupSize);
+            if (rayListOpensGroup(base, end)) {
+                atomicMax(sslrArgs[kRayListDispatchOffset], (end + kRayListGroupSize - 1u) / kRayListGroupSize);
+            }
         }
         // A ray that cone-traces needs SSLR's colour pyramid: its two passes'
         // dispatches get their z (glint/ray_generation_shared.h).
@@ -212,7 +214,9 @@ void main() {
             const uint base = atomicAdd(rtArgs[kRayListCountOffset], sharedRtCount);
             sharedRtBase = base;
             const uint end = base + sharedRtCount;
-            atomicMax(rtArgs[kRayListDispatchOffset], (end + kRayListGroupSize - 1u) / kRayListGroupSize);
+            if (rayListOpensGroup(base, end)) {
+                atomicMax(rtArgs[kRayListDispatchOffset], (end + kRayListGroupSize - 1u) / kRayListGroupSize);
+            }
         }
     }
     barrier();

@@ -278,6 +278,8 @@ void main() {
         PackedRay handed = ray;
         handed.pixelFlags &= ~kRayCone;  // a mark for SSLR alone
         rtRays[slot] = handed;
-        atomicMax(rtArgs[kRayListDispatchOffset], slot / kRayListGroupSize + 1u);
+        if (rayListOpensGroup(slot, slot + 1u)) {
+            atomicMax(rtArgs[kRayListDispatchOffset], slot / kRayListGroupSize + 1u);
+        }
     }
 }

@@ -26,6 +26,7 @@
 #include <array>
 #include <cmath>
 #include <cstring>
+#include <random>
 #include <set>
 #include <string>
 #include <vector>
@@ -290,6 +291,34 @@ TEST_CASE("the noise is deterministic and walks a different sample every frame")
     CHECK(shader::ggxNoise({3, 5}, 9) == shader::ggxNoise({3, 5}, 9));
     CHECK(shader::ggxNoise({3, 5}, 9) != shader::ggxNoise({3, 5}, 10));
     CHECK(shader::ggxNoise({3, 5}, 9) != shader::ggxNoise({5, 3}, 9));
+}
+
+TEST_CASE("appenders that open a group set the list's group count, in any order and for any range sizes") {
+    // Appenders of 0 to 100 slots reserve their ranges in turn; only those
+    // whose range holds a group's first slot raise the count
+    // (rayListOpensGroup), in a shuffled order as atomics would land.
+    std::mt19937 rng(7);
+    for (int trial = 0; trial < 2000; ++trial) {
+        const int appenders = 1 + int(rng() % 40);
+        uint32_t total = 0;
+        std::vector<uint32_t> raises;
+        for (int a = 0; a < appenders; ++a) {
+            const uint32_t count = rng() % 101;
+            const uint32_t begin = total;
+            total += count;
+            if (count != 0 && shader::rayListOpensGroup(begin, total)) {
+                raises.push_back((total + shader::kRayListGroupSize - 1) / shader::kRayListGroupSize);
+            }
+        }
+        std::shuffle(raises.begin(), raises.end(), rng);
+        uint32_t groups = 0;
+        for (uint32_t r : raises) groups = std::max(groups, r);
+        REQUIRE(groups == (total + shader::kRayListGroupSize - 1) / shader::kRayListGroupSize);
+    }
+    CHECK(shader::rayListOpensGroup(0, 1));
+    CHECK(!shader::rayListOpensGroup(1, 64));
+    CHECK(shader::rayListOpensGroup(63, 65));
+    CHECK(!shader::rayListOpensGroup(64, 64));
 }
 
 TEST_CASE("a mirror floor (roughness 0) gives exactly the reflected view direction in every floor pixel") {

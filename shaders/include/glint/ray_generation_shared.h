@@ -71,8 +71,12 @@ GLINT_CONST uint kModeRt = 2u;
 //              (compute, kRayListGroupSize invocations per group)
 //   words 3-5  VkTraceRaysIndirectCommandKHR {count, 1, 1} (RT pipeline);
 //              word kRayListCountOffset is the list's length
-// Appenders reserve slots with atomicAdd on the count and raise the group
-// count with atomicMax, so both commands stay consistent.
+// Appenders reserve slots with atomicAdd on the count; one whose slots
+// include a group's first slot raises the group count to its end's with
+// atomicMax (rayListOpensGroup), so both commands stay consistent: the
+// appender of the last group's first slot sets the final count. (Every
+// appender raising it put tens of thousands of atomics a frame on one
+// word.)
 GLINT_CONST uint kRayListGroupSize = 64u;
 GLINT_CONST uint kRayListDispatchOffset = 0u;
 GLINT_CONST uint kRayListCountOffset = 3u;
@@ -128,6 +132,12 @@ static_assert(sizeof(glint::shader::RayGenerationConstants) == 128);
 GLINT_BEGIN
 
 GLINT_CONST float kSnorm16Max = 32767.0f;
+
+// Whether slots [begin, end) of a ray list include the first slot of a
+// group of kRayListGroupSize.
+GLINT_FUNC bool rayListOpensGroup(uint begin, uint end) {
+    return (begin + kRayListGroupSize - 1u) / kRayListGroupSize < (end + kRayListGroupSize - 1u) / kRayListGroupSize;
+}
 
 GLINT_FUNC uint encodeSnorm16(float x) {
     return uint(int(floor(clamp(x, -1.0f, 1.0f) * kSnorm16Max + 0.5f))) & 0xFFFFu;
