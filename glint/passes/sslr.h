@@ -3,8 +3,9 @@
 // One compute pass, dispatched indirectly over ray generation's SSLR ray
 // list (one invocation per ray: no work for an empty list), traces each ray
 // leader of the SSLR and hybrid pixels across the depth buffer: a linear march of large steps with a per-pixel
-// random start offset, then binary refinement (Far Cry 6 talk
-// section 3). It writes the lit colour at the hit and a confidence in
+// random start offset, then binary refinement where the ray may have met a
+// surface (Far Cry 6 talk section 3; not at every step of a ray passing
+// behind an occluder, shaders/sslr/trace.comp says when). It writes the lit colour at the hit and a confidence in
 // [0, 1], and lists the hybrid rays below the confidence threshold, with
 // indirect args, for the ray-traced pass: it appends them to ray
 // generation's RT ray list. The rays ray generation marks for the cone
