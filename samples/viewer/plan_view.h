@@ -3,7 +3,8 @@
 // frame on screen as rows to draw. Per queue, the passes in submission order
 // with their batch, barriers, cross-queue waits and GPU time; the resources
 // each pass uses; the transient heaps with each placement and what shares
-// its bytes (aliasing). For Graphviz, Plan::toDot() writes the same plan.
+// its bytes (aliasing). Plan::toDot() writes the same plan as a Graphviz
+// graph.
 
 #include "glint/graph/executor.h"
 #include "glint/graph/plan.h"

@@ -171,8 +171,9 @@ void main() {
     // which the ray may have met between the two). Each search costs
     // refineSteps dependent reads; searching at every step behind made
     // rays that pass behind something the pass's slowest (on the H200 at
-    // 1080p the pass took 0.164 -> 0.115 ms on the plaza, 0.097 -> 0.053
-    // on DamagedHelmet, for 0.7% more hybrid rays handed to RT).
+    // 1080p the pass took 0.165 -> 0.116 ms on the plaza, 0.096 -> 0.055
+    // on DamagedHelmet, for 0.7% more hybrid rays handed to RT;
+    // docs/results.md, third round).
     bool wasBehind = false;
     float lastSurface = 0.0;
     for (uint i = 0u; i < steps; ++i) {
