@@ -7,6 +7,7 @@
 #include "glint/feedback_shared.h"
 #include "glint/ray_generation_shared.h"
 
+#include <cmath>
 #include <vector>
 
 namespace glint::passes {
@@ -39,15 +40,22 @@ FeedbackOutputs addFeedbackPass(rg::Graph& graph, FeedbackPipelines& pipelines, 
                             std::to_string(settings.sslrMissFraction) + ", " + std::to_string(settings.rtHitFraction) +
                             ")");
     }
+    if (!fraction(settings.sslrMinHitShare) || settings.sslrProbeInterval == 0) {
+        throw gpu::GpuError("addFeedbackPass: sslrMinHitShare must lie in [0, 1] and sslrProbeInterval be at least 1 "
+                            "(got " + std::to_string(settings.sslrMinHitShare) + ", " +
+                            std::to_string(settings.sslrProbeInterval) + ")");
+    }
     FeedbackOutputs out;
     out.tilesX = (gbuf.width + shader::kTileSize - 1) / shader::kTileSize;
     out.tilesY = (gbuf.height + shader::kTileSize - 1) / shader::kTileSize;
     const uint32_t tiles = out.tilesX * out.tilesY;
     const uint64_t tileBytes = uint64_t(tiles) * sizeof(uint32_t);
-    // A resize keeps the pair (the executor finds it by name); the shaders
-    // bound their indices by the buffer's own length, and the counters,
-    // mismatched for one frame, only steer which pass traces.
-    out.counters = graph.createHistoryBuffer(kFeedbackHistoryName, {tileBytes});
+    out.minFrameHits =
+        uint32_t(std::ceil(double(settings.sslrMinHitShare) * double(gbuf.width) * double(gbuf.height)));
+    // The tiles' counters and the frame's sum of hits. A resize starts the
+    // pair afresh (zeroed); the shaders still bound their indices by the
+    // buffer's own length.
+    out.counters = graph.createHistoryBuffer(kFeedbackHistoryName, {tileBytes + sizeof(uint32_t)});
 
     shader::FeedbackConstants constants{};
     constants.size = {gbuf.width, gbuf.height};
@@ -59,6 +67,8 @@ FeedbackOutputs addFeedbackPass(rg::Graph& graph, FeedbackPipelines& pipelines, 
     constants.rtHitFraction = settings.rtHitFraction;
     constants.adaptive = settings.adaptive ? 1u : 0u;
     constants.resetHistory = inputs.resetHistory ? 1u : 0u;
+    constants.minFrameHits = out.minFrameHits;
+    constants.probeInterval = settings.sslrProbeInterval;
 
     struct ReprojectData {
         rg::Texture motion;
@@ -71,6 +81,8 @@ FeedbackOutputs addFeedbackPass(rg::Graph& graph, FeedbackPipelines& pipelines, 
             d.motion = b.read(gbuf.motion, rg::Access::SampledRead);
             d.previous = b.read(out.counters.previous, rg::Access::StorageRead);
             d.out = out;
+            // Starts the frame's sum of hits; integrate writes the rest.
+            d.out.counters.current = b.write(out.counters.current, rg::Access::StorageWrite);
             d.out.reprojected =
                 b.write(b.createBuffer("feedback.reprojected", {tileBytes}), rg::Access::StorageWrite);
             d.out.tileModes = b.write(b.createBuffer("feedback.tile_modes", {tileBytes}), rg::Access::StorageWrite);
@@ -83,6 +95,7 @@ FeedbackOutputs addFeedbackPass(rg::Graph& graph, FeedbackPipelines& pipelines, 
                 .storageBuffer("Previous", pc.buffer(d.previous))
                 .storageBuffer("Reprojected", pc.buffer(d.out.reprojected))
                 .storageBuffer("TileModes", pc.buffer(d.out.tileModes))
+                .storageBuffer("Current", pc.buffer(d.out.counters.current))
                 .push(pipelines.ctx_, pc.cmd());
             pipeline.pushConstants(pc.cmd(), constants);
             pc.dispatch(pipeline, (tiles + kGroupSize - 1) / kGroupSize);

@@ -10,10 +10,18 @@
 //     pseudo-random pixel per tile, new every frame ("reprojected"; content
 //     from off screen gets 0);
 //   - decides each tile's mode from the two frames of counts it carried
-//     ("tileModes": kTileMode*, read by ray generation).
+//     ("tileModes": kTileMode*, read by ray generation);
+//   - but first whether SSLR pays at all this frame: where last frame's
+//     SSLR hits, summed over the frame, fall short of sslrMinHitShare of the
+//     pixels, every tile sends its hybrid pixels straight to RT
+//     (kTileModeRtOnly, no pixel kept hybrid), so that SSLR's passes run no
+//     groups, except on one probe frame in sslrProbeInterval, which tries
+//     SSLR everywhere again. The SSLR pass costs a floor (its longest
+//     march, the pyramid) at any ray count; on a scene where it resolves a
+//     few rays, the rays it saves cost less than that floor.
 // Integrate (passes/integrate.h) writes this frame's counts into the
 // history's `current` half, rotating the reprojected counter's counts into
-// the previous half.
+// the previous half, and adds the frame's hits to the sum after the tiles.
 //
 //   passes::FeedbackPipelines feedbackPipelines(ctx);   // once
 //   each frame, after the G-buffer:
@@ -55,17 +63,38 @@ struct FeedbackSettings {
     // fraction tolerates a stray ray (Glint's knob, tuned by the bench).
     float sslrMissFraction = 0.0f;
     float rtHitFraction = 0.0f;
+    // SSLR is tried on hybrid pixels only while last frame's SSLR hits
+    // (rays at or above the confidence threshold, over the whole frame)
+    // reach this share of the pixels; below it the frame's hybrid pixels go
+    // straight to RT. 0: SSLR is always tried. Glint's knob, not the talk's:
+    // on the H200 at 1080p (docs/results.md) the SSLR pass and its pyramid
+    // cost 0.08 ms at any ray count, about what tracing 5% of the pixels
+    // costs there; the scenes where SSLR helps resolve 12-21% of the pixels
+    // (the plaza, the city) and those where it does not 0.1-0.4%
+    // (DamagedHelmet, CornellBox-Vinc3r).
+    float sslrMinHitShare = 0.02f;
+    // While SSLR does not pay, one frame in this many (feedbackProbeFrame:
+    // at a pseudo-random place in each block) tries it on every hybrid
+    // pixel again, so that the frame comes back to SSLR when it starts to
+    // hit. 1: every frame.
+    uint32_t sslrProbeInterval = 8;
     // Off: every tile hybrid, as if there were no feedback (the bench's
     // baseline); the counters are still carried.
     bool adaptive = true;
 };
 
 struct FeedbackOutputs {
-    rg::HistoryBuffer counters;  // u32 per tile; previous: last frame's; current: written by integrate
+    // u32 per tile, then the frame's SSLR hits (glint/feedback_shared.h);
+    // previous: last frame's; current: written by integrate.
+    rg::HistoryBuffer counters;
     rg::Buffer reprojected;      // u32 per tile: last frame's counter carried to this tile
     rg::Buffer tileModes;        // u32 per tile, shader::kTileMode*
     uint32_t tilesX = 0;
     uint32_t tilesY = 0;
+    // The frame's hits that make SSLR pay (sslrMinHitShare of the pixels,
+    // rounded up; 0 when the share is 0): integrate stops adding to the sum
+    // once it reaches them.
+    uint32_t minFrameHits = 0;
 };
 
 // The pipeline and the sampler the pass records with; created once.

@@ -98,6 +98,7 @@ IntegrateOutputs addIntegratePass(rg::Graph& graph, IntegratePipelines& pipeline
     constants.particlesBound = hasParticles ? 1u : 0u;
     constants.rtMissesTrusted = settings.rtMissesTrusted ? 1u : 0u;
     constants.rtHitMotionBound = inputs.rtHitMotion.valid() ? 1u : 0u;
+    constants.minFrameHits = hasFeedback ? feedback.minFrameHits : 0u;
 
     // The constants outgrow push constants (glint/integrate_shared.h); a
     // transfer inside the frame keeps their lifetime the graph's.
@@ -149,7 +150,9 @@ IntegrateOutputs addIntegratePass(rg::Graph& graph, IntegratePipelines& pipeline
             d.out.sourceDebug = texture("integrate.source_debug", kReflectionSourceDebugFormat);
             if (hasFeedback) {
                 d.reprojected = b.read(feedback.reprojected, rg::Access::StorageRead);
-                d.out.counters = b.write(feedback.counters.current, rg::Access::StorageWrite);
+                // The tiles' counters, and the frame's sum of hits added to
+                // the start the feedback pass wrote.
+                d.out.counters = b.write(feedback.counters.current, rg::Access::StorageReadWrite);
             }
         },
         [&pipelines, variant](const IntegrateData& d, rg::PassContext& pc) {

@@ -373,6 +373,7 @@ int main(int argc, char** argv) {
             row.width = width;
             row.height = height;
             row.reflectionMs = result.reflectionMs;
+            row.reflectionMeanMs = result.reflectionMeanMs;
             row.totalMs = result.totalMs;
             row.frameWallMs = result.frameWallMs;
             row.sslrRays = result.sslrRays;

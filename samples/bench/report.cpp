@@ -78,7 +78,7 @@ std::string toCsv(std::span<const Row> rows) {
         out += scene + ',' + r.mode + ',' + r.param + ',' + formatValue(r.value) + ',' + std::to_string(r.width) +
                ',' + std::to_string(r.height) + ',' + number(r.reflectionMs) + ',' + number(r.totalMs) + ',' +
                std::to_string(r.rtRays) + ',' + number(r.image.flipMean) + ',' + number(r.image.relMse) + ',' +
-               number(r.image.psnr) + ',' + number(r.image.ssim) + '\n';
+               number(r.image.psnr) + ',' + number(r.image.ssim) + ',' + number(r.reflectionMeanMs) + '\n';
     }
     return out;
 }
@@ -115,6 +115,7 @@ std::string toJson(const RunInfo& info, std::span<const Row> rows) {
         row["width"] = r.width;
         row["height"] = r.height;
         row["reflection_ms"] = jsonNumber(r.reflectionMs);
+        row["reflection_mean_ms"] = jsonNumber(r.reflectionMeanMs);
         row["total_ms"] = jsonNumber(r.totalMs);
         row["frame_wall_ms"] = jsonNumber(r.frameWallMs);
         row["rt_rays"] = r.rtRays;
@@ -194,7 +195,8 @@ std::string toScaleCsv(std::span<const ScaleRow> rows) {
         out += scene + ',' + r.mode + ',' + std::to_string(r.instances) + ',' + std::to_string(r.triangles) + ',' +
                std::to_string(r.width) + ',' + std::to_string(r.height) + ',' + number(r.reflectionMs) + ',' +
                number(r.reflectionSpanMs) + ',' + number(r.totalMs) + ',' + std::to_string(r.rtRays) + ',' +
-               std::to_string(r.sslrRays) + ',' + number(r.flipMean) + '\n';
+               std::to_string(r.sslrRays) + ',' + number(r.flipMean) + ',' + number(r.reflectionMeanMs) + ',' +
+               number(r.reflectionSpanMeanMs) + '\n';
     }
     return out;
 }
@@ -216,6 +218,8 @@ std::string toScaleJson(const RunInfo& info, std::span<const ScaleRow> rows) {
                         {"height", r.height},
                         {"reflection_ms", optional(r.reflectionMs)},
                         {"reflection_span_ms", optional(r.reflectionSpanMs)},
+                        {"reflection_mean_ms", optional(r.reflectionMeanMs)},
+                        {"reflection_span_mean_ms", optional(r.reflectionSpanMeanMs)},
                         {"total_ms", optional(r.totalMs)},
                         {"rt_rays", r.rtRays},
                         {"sslr_rays", r.sslrRays},

@@ -19,7 +19,7 @@ namespace glint::bench {
 // The CSV header, column for column (docs/results.md reads these files). The metric columns
 // are the final image's; the reflection term's go to the JSON only.
 inline constexpr std::string_view kCsvHeader =
-    "scene,mode,param,value,width,height,reflection_ms,total_ms,rt_rays,flip_mean,relmse,psnr,ssim";
+    "scene,mode,param,value,width,height,reflection_ms,total_ms,rt_rays,flip_mean,relmse,psnr,ssim,reflection_mean_ms";
 
 // The baseline row of each mode has this as its param (and no value).
 inline constexpr std::string_view kDefaultParam = "default";
@@ -41,6 +41,9 @@ struct Row {
     uint32_t width = 0;
     uint32_t height = 0;
     std::optional<double> reflectionMs;  // median GPU time of the reflection passes
+    // Their mean: work done on some frames only (the hybrid's SSLR probe
+    // frames, passes/feedback.h) counts here and not in the median.
+    std::optional<double> reflectionMeanMs;
     std::optional<double> totalMs;       // median GPU time of all passes
     std::optional<double> frameWallMs;   // median host time of a frame (a CPU device's real cost)
     uint64_t sslrRays = 0;               // last frame
@@ -158,7 +161,7 @@ void writePlot(const std::filesystem::path& path, std::span<const PlotPoint> poi
 // The CSV header of the scale run, column for column.
 inline constexpr std::string_view kScaleCsvHeader =
     "scene,mode,instances,triangles,width,height,reflection_ms,reflection_span_ms,total_ms,rt_rays,sslr_rays,"
-    "flip_mean";
+    "flip_mean,reflection_mean_ms,reflection_span_mean_ms";
 
 // One mode at one size of the city.
 struct ScaleRow {
@@ -170,6 +173,8 @@ struct ScaleRow {
     uint32_t height = 0;
     std::optional<double> reflectionMs;      // median sum of the reflection passes' times
     std::optional<double> reflectionSpanMs;  // median of the chain timed as one span
+    std::optional<double> reflectionMeanMs;      // means of both (Row::reflectionMeanMs)
+    std::optional<double> reflectionSpanMeanMs;
     std::optional<double> totalMs;
     uint64_t rtRays = 0;
     uint64_t sslrRays = 0;

@@ -68,6 +68,8 @@ std::vector<ScaleRow> runScale(gpu::Context& ctx, const ScaleSettings& settings)
             row.height = options.height;
             row.reflectionMs = result.reflectionMs;
             row.reflectionSpanMs = result.reflectionSpanMs;
+            row.reflectionMeanMs = result.reflectionMeanMs;
+            row.reflectionSpanMeanMs = result.reflectionSpanMeanMs;
             row.totalMs = result.totalMs;
             row.rtRays = result.rtRays;
             row.sslrRays = result.sslrRays;

@@ -36,6 +36,13 @@ double median(std::vector<double> values) {
     return n % 2 ? values[n / 2] : 0.5 * (values[n / 2 - 1] + values[n / 2]);
 }
 
+double mean(const std::vector<double>& values) {
+    if (values.empty()) return 0.0;
+    double sum = 0.0;
+    for (const double v : values) sum += v;
+    return sum / double(values.size());
+}
+
 // Each parameter: its name, the field, and where it lives.
 struct ParameterSlot {
     Parameter parameter;
@@ -52,7 +59,7 @@ constexpr std::array<bool, 3> kEveryMode{true, true, true};
 
 // The one table of parameters: name, field, the viewer's range, the
 // bench's sweep, and where the value lives.
-const std::array<ParameterSlot, 21> kParameters = {{
+const std::array<ParameterSlot, 23> kParameters = {{
     // A confidence; the talk's 0.9 (default) bracketed from "trust SSLR
     // often" to "almost never".
     {{"sslr_threshold", "ReflectionFrameSettings::confidenceThreshold", 0.0f, 1.0f, false, {0.5, 0.7, 0.8, 0.95, 0.99},
@@ -106,6 +113,14 @@ const std::array<ParameterSlot, 21> kParameters = {{
     {{"feedback_rt_hit_fraction", "FeedbackSettings::rtHitFraction", 0.0f, 1.0f, false, {0.05, 0.1, 0.25}, {0.1},
       kHybrid},
      [](ReflectionRunOptions& o) { return &o.frame.feedback.rtHitFraction; }, nullptr},
+    // SSLR is tried on the hybrid pixels only while last frame's SSLR hits
+    // reach this share of the pixels (default 0.02); 0: always.
+    {{"feedback_sslr_min_hit_share", "FeedbackSettings::sslrMinHitShare", 0.0f, 1.0f, false, {0, 0.01, 0.05, 0.1},
+      {0}, kHybrid},
+     [](ReflectionRunOptions& o) { return &o.frame.feedback.sslrMinHitShare; }, nullptr},
+    // While SSLR does not pay, one frame in this many tries it again (default 8).
+    {{"feedback_sslr_probe_interval", "FeedbackSettings::sslrProbeInterval", 1.0f, 64.0f, true, {4, 16}, {}, kHybrid},
+     nullptr, [](ReflectionRunOptions& o) { return &o.frame.feedback.sslrProbeInterval; }},
     // Particles drawn before SSLR, which reflects them where it resolves
     // the ray; the particle trace only where it does not (default off:
     // every particle traced).
@@ -519,14 +534,18 @@ ReflectionRunResult runReflections(gpu::Context& ctx, scene::Scene& scene, const
                  result.framesRun, result.planCompiles);
 
     for (const std::string& name : passOrder) {
-        result.passes.push_back({name, passQueues[name], median(passTimes[name]),
+        result.passes.push_back({name, passQueues[name], median(passTimes[name]), mean(passTimes[name]),
                                  passCpuTimes.count(name) ? std::optional(median(passCpuTimes[name])) : std::nullopt});
     }
     result.framesTimed = uint32_t(totalTimes.size());
     if (!wallTimes.empty()) result.frameWallMs = median(wallTimes);
-    if (!spanTimes.empty()) result.reflectionSpanMs = median(spanTimes);
+    if (!spanTimes.empty()) {
+        result.reflectionSpanMs = median(spanTimes);
+        result.reflectionSpanMeanMs = mean(spanTimes);
+    }
     if (!totalTimes.empty()) {
         result.reflectionMs = median(reflectionTimes);
+        result.reflectionMeanMs = mean(reflectionTimes);
         if (!reflectionCpuTimes.empty()) result.reflectionCpuMs = median(reflectionCpuTimes);
         result.totalMs = median(totalTimes);
     }
@@ -568,7 +587,8 @@ std::string statsJson(const gpu::Context& ctx, const ReflectionRunOptions& optio
     for (const PassTime& p : r.passes) {
         passList.push_back({{"name", p.name},
                             {"queue", p.queue == rg::Queue::AsyncCompute ? "async_compute" : "graphics"},
-                            {"gpu_ms", p.milliseconds}});
+                            {"gpu_ms", p.milliseconds},
+                            {"gpu_mean_ms", p.meanMilliseconds}});
         if (p.cpuMilliseconds) passList.back()["cpu_ms"] = *p.cpuMilliseconds;
     }
     j["passes"] = passList;
@@ -579,6 +599,10 @@ std::string statsJson(const gpu::Context& ctx, const ReflectionRunOptions& optio
     // The same chain timed as one span, in the other half of the frames,
     // with no per-pass timestamps.
     j["reflection_span_ms"] = r.reflectionSpanMs ? json(*r.reflectionSpanMs) : json(nullptr);
+    // Means of both: work that runs on some frames only (the hybrid's SSLR
+    // probe frames) counts here and not in the medians.
+    j["reflection_mean_ms"] = r.reflectionMeanMs ? json(*r.reflectionMeanMs) : json(nullptr);
+    j["reflection_span_mean_ms"] = r.reflectionSpanMeanMs ? json(*r.reflectionSpanMeanMs) : json(nullptr);
     if (r.reflectionCpuMs) j["reflection_cpu_ms"] = *r.reflectionCpuMs;
     j["total_ms"] = r.totalMs ? json(*r.totalMs) : json(nullptr);
     j["frame_wall_ms"] = r.frameWallMs ? json(*r.frameWallMs) : json(nullptr);

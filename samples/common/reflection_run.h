@@ -75,6 +75,7 @@ struct PassTime {
     std::string name;
     rg::Queue queue = rg::Queue::Graphics;
     double milliseconds = 0.0;  // median over the frames measured
+    double meanMilliseconds = 0.0;  // mean over them (work that runs on some frames only shows here)
     std::optional<double> cpuMilliseconds;  // host-serial timing only: median process CPU time
 };
 
@@ -105,6 +106,11 @@ struct ReflectionRunResult {
     // Median of the reflection chain (its first pass to its last) timed as
     // one span with no per-pass timestamps: the other half of the frames.
     std::optional<double> reflectionSpanMs;
+    // Means of the same: the hybrid's SSLR probe frames (passes/feedback.h)
+    // and other work that runs on some frames only count here, not in the
+    // medians.
+    std::optional<double> reflectionMeanMs;
+    std::optional<double> reflectionSpanMeanMs;
     std::optional<double> totalMs;       // median per-frame sum of all passes
     std::optional<double> reflectionCpuMs;  // host-serial timing only: as reflectionMs, in process CPU time
     uint32_t framesTimed = 0;

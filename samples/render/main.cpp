@@ -197,9 +197,9 @@ int main(int argc, char** argv) {
         if (result.reflectionMs) {
             const std::string span =
                 result.reflectionSpanMs ? fmt::format(" ({:.3f} ms as one span)", *result.reflectionSpanMs) : "";
-            spdlog::info("reflections {:.3f} ms{}, frame {:.3f} ms {}, {:.3f} ms wall (median of {} frames); rays: {} "
-                         "SSLR, {} RT",
-                         *result.reflectionMs, span, *result.totalMs,
+            spdlog::info("reflections {:.3f} ms{} (mean {:.3f}), frame {:.3f} ms {}, {:.3f} ms wall (median of {} "
+                         "frames); rays: {} SSLR, {} RT",
+                         *result.reflectionMs, span, result.reflectionMeanMs.value_or(0.0), *result.totalMs,
                          result.passTimer == rg::PassTimer::HostSerial ? "host (passes submitted alone)" : "GPU",
                          result.frameWallMs.value_or(0.0), result.framesTimed,
                          result.sslrRays, result.rtRays);

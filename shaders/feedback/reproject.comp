@@ -4,7 +4,10 @@
 // following the motion of one pseudo-random pixel of the tile (the Far Cry
 // 6 talk's "random motion vector of the tile"; a new pixel every frame), and
 // decides the tile's mode (SSLR, hybrid, RT) from the two frames of counts
-// the carried counter holds (glint/feedback_shared.h).
+// the carried counter holds (glint/feedback_shared.h), unless last frame's
+// SSLR hits, summed over the frame, say that SSLR does not pay: then every
+// tile goes to RT with no pixel kept hybrid (kTileModeRtOnly), except on
+// probe frames. Starts this frame's sum for integrate to add to.
 #extension GL_GOOGLE_include_directive : require
 #extension GL_EXT_scalar_block_layout : require
 
@@ -16,6 +19,9 @@ layout(set = 0, binding = 0) uniform sampler2D motionTexture;
 layout(set = 0, binding = 1, scalar) readonly buffer Previous { uint previous[]; };
 layout(set = 0, binding = 2, scalar) writeonly buffer Reprojected { uint reprojected[]; };
 layout(set = 0, binding = 3, scalar) writeonly buffer TileModes { uint tileModes[]; };
+// This frame's counters (integrate writes the tiles): only the total word
+// after the tiles is written here.
+layout(set = 0, binding = 4, scalar) writeonly buffer Current { uint current[]; };
 
 layout(push_constant, scalar) uniform Constants { FeedbackConstants pc; };
 
@@ -26,9 +32,18 @@ bool isFinite(vec2 v) {
 
 void main() {
     const uint tileIndex = gl_GlobalInvocationID.x;
-    if (tileIndex >= pc.tiles.x * pc.tiles.y) {
+    const uint tiles = pc.tiles.x * pc.tiles.y;
+    if (tileIndex == 0u && tiles < uint(current.length())) {
+        current[tiles] = kFeedbackFrameHitsStart;
+    }
+    if (tileIndex >= tiles) {
         return;
     }
+    // The frame's gate: one word every invocation reads (length(): the
+    // history pair keeps its size if the image is resized).
+    const uint lastFrameWord = tiles < uint(previous.length()) ? previous[tiles] : 0u;
+    const bool pays = sslrPays(lastFrameWord, pc.minFrameHits, feedbackProbeFrame(pc.frame, pc.probeInterval),
+                               pc.resetHistory != 0u);
     const uvec2 tile = uvec2(tileIndex % pc.tiles.x, tileIndex / pc.tiles.x);
     const uvec2 probe = feedbackProbePixel(tile, pc.frame, pc.size);
     // glint/gbuffer_shared.h: history lookup = pixel + motion.
@@ -45,7 +60,7 @@ void main() {
         counter = lastIndex < uint(previous.length()) ? previous[lastIndex] : 0u;
     }
     reprojected[tileIndex] = counter;
-    tileModes[tileIndex] = pc.adaptive != 0u
-                               ? decideTileMode(counter, pc.minRays, pc.sslrMissFraction, pc.rtHitFraction)
-                               : kTileModeHybrid;
+    tileModes[tileIndex] = pc.adaptive == 0u ? kTileModeHybrid
+                           : !pays          ? kTileModeRtOnly
+                                            : decideTileMode(counter, pc.minRays, pc.sslrMissFraction, pc.rtHitFraction);
 }

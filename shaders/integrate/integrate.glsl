@@ -37,7 +37,8 @@ layout(set = 0, binding = 18) uniform writeonly image2D hitMotionImage;
 layout(set = 0, binding = 19) uniform sampler2D motionTexture;
 #if GLINT_INTEGRATE_FEEDBACK
 layout(set = 0, binding = 9, scalar) readonly buffer Reprojected { uint reprojected[]; };
-layout(set = 0, binding = 10, scalar) writeonly buffer Counters { uint counters[]; };
+// The tiles' counters, then the frame's sum of SSLR hits (added to).
+layout(set = 0, binding = 10, scalar) buffer Counters { uint counters[]; };
 #endif
 #if GLINT_INTEGRATE_SSLR
 layout(set = 0, binding = 11) uniform sampler2D sslrRadianceTexture;
@@ -277,12 +278,20 @@ void main() {
 #if GLINT_INTEGRATE_FEEDBACK
     // This frame's counts and, rotated into the previous half, the counts
     // the feedback pass carried here from last frame (glint/feedback_shared.h).
-    // length(): the history pair keeps its size if the image is resized.
+    // length(): the buffers are bound whole, whatever the image's size.
     if (lane == 0u) {
         const uint tile = gl_WorkGroupID.y * C.tiles.x + gl_WorkGroupID.x;
         const uint carried = tile < uint(reprojected.length()) ? reprojected[tile] : 0u;
         if (tile < uint(counters.length())) {
             counters[tile] = rotateFeedback(carried, sharedHits, sharedMisses);
+        }
+        // The frame's sum, which next frame's feedback compares with
+        // minFrameHits: once it holds that many the answer is known, and
+        // the tiles stop adding (one atomic on one word per tile would
+        // queue up behind each other).
+        const uint total = C.tiles.x * C.tiles.y;
+        if (sharedHits != 0u && total < uint(counters.length()) && counters[total] < kFeedbackFrameHitsStart + C.minFrameHits) {
+            atomicAdd(counters[total], sharedHits);
         }
     }
 #endif

@@ -51,7 +51,8 @@ const vec4 kClassColours[5] = vec4[5](vec4(0.0, 0.0, 0.0, 1.0), vec4(0.5, 0.5, 0
 // every traced pixel one way; in hybrid mode the middle band follows its
 // tile's feedback (Far Cry 6 talk), except that a
 // random share of an RT tile's pixels stays hybrid, so SSLR keeps being
-// tried there and the tile can come back to it when SSLR starts to hit.
+// tried there and the tile can come back to it when SSLR starts to hit;
+// in a frame where SSLR does not pay (kTileModeRtOnly) none does.
 uint applyMode(uint pixelClass, uvec2 pixel) {
     const uint mode = pc.flags & kRayGenModeMask;
     if (mode == kModeSsr) {
@@ -72,6 +73,11 @@ uint applyMode(uint pixelClass, uvec2 pixel) {
     const uint tileMode = tileModes[(pixel.y / kTileSize) * pc.tilesX + pixel.x / kTileSize];
     if (tileMode == kTileModeSslr) {
         return kPixelSslr;
+    }
+    // The frame's SSLR does not pay (passes/feedback.h): no pixel stays
+    // hybrid, so that the SSLR list stays empty.
+    if (tileMode == kTileModeRtOnly) {
+        return kPixelRt;
     }
     if (tileMode == kTileModeRt) {
         // A dimension of its own (glint/sampling.glsl): the pixels kept

@@ -46,6 +46,7 @@ Row makeRow(const std::string& mode, const std::string& param, std::optional<dou
     r.width = 64;
     r.height = 48;
     r.reflectionMs = ms;
+    r.reflectionMeanMs = ms * 1.1;
     r.totalMs = ms * 3.0;
     r.frameWallMs = ms * 10.0;
     r.rtRays = 1234;
@@ -63,10 +64,10 @@ TEST_CASE("the CSV has the stated header and one parseable row per configuration
                                    makeRow("hybrid", "sslr_steps", 32.0, 0.9, 0.055)};
     const std::vector<std::string> out = lines(toCsv(rows));
     REQUIRE(out.size() == rows.size() + 1);
-    CHECK(out[0] == "scene,mode,param,value,width,height,reflection_ms,total_ms,rt_rays,flip_mean,relmse,psnr,ssim");
+    CHECK(out[0] == "scene,mode,param,value,width,height,reflection_ms,total_ms,rt_rays,flip_mean,relmse,psnr,ssim,reflection_mean_ms");
     for (size_t i = 0; i < rows.size(); ++i) {
         const std::vector<std::string> cells = split(out[i + 1], ',');
-        REQUIRE(cells.size() == 13);
+        REQUIRE(cells.size() == 14);
         CHECK(cells[0] == "plaza");
         CHECK(cells[1] == rows[i].mode);
         CHECK(cells[2] == rows[i].param);
@@ -103,7 +104,7 @@ TEST_CASE("the CSV writes a missing time as an empty cell and identical images' 
     r.reflectionMs.reset();
     r.image.psnr = std::numeric_limits<double>::infinity();
     const std::vector<std::string> cells = split(lines(toCsv(std::vector<Row>{r}))[1], ',');
-    REQUIRE(cells.size() == 13);
+    REQUIRE(cells.size() == 14);
     CHECK(cells[6].empty());
     CHECK(cells[11] == "inf");
     CHECK(std::isinf(std::stod(cells[11])));
@@ -225,6 +226,8 @@ TEST_CASE("the scale CSV has its header and a row per size and mode; the plot pu
             r.height = 1080;
             r.reflectionMs = std::string(mode) == "rt" ? 0.3 + 0.1 * std::log2(double(n)) : 0.4;
             r.reflectionSpanMs = *r.reflectionMs * 0.9;
+            r.reflectionMeanMs = *r.reflectionMs * 1.1;
+            r.reflectionSpanMeanMs = *r.reflectionMs;
             r.totalMs = 5.0;
             r.rtRays = 1000;
             r.sslrRays = 2000;

@@ -40,6 +40,7 @@
 #include <map>
 #include <memory>
 #include <optional>
+#include <set>
 #include <string>
 #include <span>
 #include <vector>
@@ -393,7 +394,8 @@ struct Frame {
     std::vector<glm::vec4> radiance;
     std::vector<float> hitDistance;
     std::vector<glm::u8vec4> source;
-    std::vector<uint32_t> counters;     // integrate's new counters
+    std::vector<uint32_t> counters;     // integrate's new counters, one per tile
+    uint32_t frameHitsWord = 0;         // the counters' word after the tiles (glint/feedback_shared.h)
     std::vector<uint32_t> reprojected;  // the feedback pass's
     std::vector<uint32_t> tileModes;
     Traces sslr;  // the SSLR inputs integrate read (its sslr* fields)
@@ -508,6 +510,7 @@ struct RunOptions {
     bool followTileModes = false;
     // Runs the real SSLR pass instead of uploading traces.sslr*.
     passes::SslrPipelines* realSslr = nullptr;
+    passes::FeedbackSettings feedback;
 };
 
 // One scene, one executor (the history persists across frames), the real
@@ -536,7 +539,7 @@ public:
         const passes::GBufferOutputs gbuf = passes::addGBufferPass(graph, renderer_, {camera});
         std::optional<passes::FeedbackOutputs> feedback;
         if (present.feedback) {
-            feedback = passes::addFeedbackPass(graph, feedbackPipelines_, {gbuf, frameIndex});
+            feedback = passes::addFeedbackPass(graph, feedbackPipelines_, {gbuf, frameIndex}, options.feedback);
         }
         passes::RayGenerationInputs rayInputs{gbuf, frameIndex, camera};
         rayInputs.sslrMinDistance = options.sslrMinDistance;
@@ -593,7 +596,7 @@ public:
         }
         if (feedback) {
             const uint64_t bytes = uint64_t(kTiles) * kTiles * 4;
-            counters = transfers_.readBuffer(graph, resources, out.counters, bytes);
+            counters = transfers_.readBuffer(graph, resources, out.counters, bytes + 4);
             reprojected = transfers_.readBuffer(graph, resources, feedback->reprojected, bytes);
             modes = transfers_.readBuffer(graph, resources, feedback->tileModes, bytes);
         }
@@ -627,6 +630,8 @@ public:
         f.source = transfers_.get<glm::u8vec4>(source);
         if (feedback) {
             f.counters = transfers_.get<uint32_t>(counters);
+            f.frameHitsWord = f.counters.back();
+            f.counters.pop_back();
             f.reprojected = transfers_.get<uint32_t>(reprojected);
             f.tileModes = transfers_.get<uint32_t>(modes);
         }
@@ -634,7 +639,9 @@ public:
     }
 
     // A frame of the G-buffer and the feedback pass alone, whose counters'
-    // current half is written with `counters` (standing in for integrate).
+    // current half is written with `counters` (standing in for integrate):
+    // one per tile, then the frame's word of hits, which is 1 + the tiles'
+    // hits where `counters` has none.
     struct FeedbackFrame {
         std::vector<uint32_t> reprojected;
         std::vector<uint32_t> tileModes;
@@ -649,7 +656,13 @@ public:
             passes::addFeedbackPass(graph, feedbackPipelines_, {gbuf, frameIndex, resetHistory}, settings);
         REQUIRE(feedback.tilesX == kTiles);
         REQUIRE(feedback.tilesY == kTiles);
-        transfers_.uploadBuffer(graph, resources, "counters", feedback.counters.current, counters);
+        std::vector<uint32_t> written = counters;
+        if (written.size() == size_t(kTiles) * kTiles) {
+            uint32_t hits = 0;
+            for (const uint32_t c : counters) hits += shader::feedbackHits(c);
+            written.push_back(shader::kFeedbackFrameHitsStart + hits);
+        }
+        transfers_.uploadBuffer(graph, resources, "counters", feedback.counters.current, written);
         const uint64_t bytes = uint64_t(kTiles) * kTiles * 4;
         const size_t reprojected = transfers_.readBuffer(graph, resources, feedback.reprojected, bytes);
         const size_t modes = transfers_.readBuffer(graph, resources, feedback.tileModes, bytes);
@@ -1079,6 +1092,116 @@ TEST_CASE("tile modes follow the carried counts and the feedback settings") {
     }
 }
 
+TEST_CASE("SSLR probe frames: one per block of the interval, on both parities, at most 2 x interval - 1 apart") {
+    for (const uint32_t interval : {2u, 8u, 13u}) {
+        INFO("interval " << interval);
+        std::optional<uint32_t> last;
+        std::array<uint32_t, 2> parity{};
+        std::set<uint32_t> offsets;
+        for (uint32_t block = 0; block < 200; ++block) {
+            uint32_t probes = 0;
+            for (uint32_t k = 0; k < interval; ++k) {
+                const uint32_t frame = block * interval + k;
+                if (!shader::feedbackProbeFrame(frame, interval)) continue;
+                ++probes;
+                ++parity[frame % 2];
+                offsets.insert(k);
+                if (last) CHECK(frame - *last <= 2 * interval - 1);
+                last = frame;
+            }
+            CHECK(probes == 1);
+        }
+        // Not tied to the frame's parity (the samples time alternate
+        // frames) nor to one place in the block.
+        CHECK(parity[0] > 20);
+        CHECK(parity[1] > 20);
+        CHECK(offsets.size() == interval);
+    }
+    for (uint32_t frame = 0; frame < 16; ++frame) CHECK(shader::feedbackProbeFrame(frame, 1));
+}
+
+TEST_CASE("SSLR pays with enough of last frame's hits, on probe frames, and without evidence") {
+    const uint32_t start = shader::kFeedbackFrameHitsStart;
+    CHECK(shader::sslrPays(0u, 100u, false, false));  // a new pair: no frame wrote the word
+    CHECK(!shader::sslrPays(start + 99u, 100u, false, false));
+    CHECK(shader::sslrPays(start + 100u, 100u, false, false));
+    CHECK(shader::sslrPays(start, 100u, true, false));   // a probe frame
+    CHECK(shader::sslrPays(start, 100u, false, true));   // a reset
+    CHECK(shader::sslrPays(start, 0u, false, false));    // the gate off
+}
+
+TEST_CASE("a frame after one whose SSLR hits fell short sends every tile RT-only, except on probe frames") {
+    test::GpuTest gpu;
+    Harness harness(gpu, wallScene());
+    const scene::Camera camera = testCamera();  // still: every tile carries its own counter
+    // Every tile's own counts say SSLR; only the frame's sum decides.
+    const std::vector<uint32_t> tiles(kTiles * kTiles, shader::packFeedback(5, 0, 0, 0));
+    const passes::FeedbackSettings settings;
+    const uint32_t minHits = uint32_t(std::ceil(double(settings.sslrMinHitShare) * kSize * kSize));
+    REQUIRE(minHits > 1);
+    const auto withHits = [&](uint32_t hits) {
+        std::vector<uint32_t> c = tiles;
+        c.push_back(shader::kFeedbackFrameHitsStart + hits);
+        return c;
+    };
+    std::vector<uint64_t> probes, others;
+    for (uint64_t frame = 1; probes.size() < 2 || others.size() < 6; ++frame) {
+        (shader::feedbackProbeFrame(uint32_t(frame), settings.sslrProbeInterval) ? probes : others).push_back(frame);
+    }
+    const auto all = [&](uint32_t mode) { return std::vector<uint32_t>(tiles.size(), mode); };
+    // Each call's modes follow what the call before it left as last frame's counters.
+    harness.runFeedback(camera, 0, withHits(minHits - 1), settings);
+    CHECK(harness.runFeedback(camera, others[0], withHits(minHits), settings).tileModes ==
+          all(shader::kTileModeRtOnly));
+    CHECK(harness.runFeedback(camera, others[1], withHits(minHits - 1), settings).tileModes ==
+          all(shader::kTileModeSslr));
+    CHECK(harness.runFeedback(camera, probes[0], withHits(0), settings).tileModes == all(shader::kTileModeSslr));
+    CHECK(harness.runFeedback(camera, others[2], withHits(minHits - 1), settings).tileModes ==
+          all(shader::kTileModeRtOnly));
+    // A reset carries no counters and no evidence: hybrid, not RT.
+    CHECK(harness.runFeedback(camera, others[3], withHits(minHits - 1), settings, true).tileModes ==
+          all(shader::kTileModeHybrid));
+    // The gate off (share 0), and the feedback off.
+    passes::FeedbackSettings always = settings;
+    always.sslrMinHitShare = 0.0f;
+    CHECK(harness.runFeedback(camera, others[4], withHits(minHits - 1), always).tileModes ==
+          all(shader::kTileModeSslr));
+    passes::FeedbackSettings off = settings;
+    off.adaptive = false;
+    CHECK(harness.runFeedback(camera, others[5], withHits(0), off).tileModes == all(shader::kTileModeHybrid));
+}
+
+TEST_CASE("integrate sums the frame's SSLR hits after the tiles' counters, up to what decides") {
+    test::GpuTest gpu;
+    Harness harness(gpu, floorScene());
+    const Presence all;
+    const scene::Camera camera = testCamera();
+    const Traces traces = makeTraces(0, false);
+    const auto hitsOf = [](const Frame& f) {
+        uint32_t hits = 0;
+        for (const uint32_t c : f.counters) hits += shader::feedbackHits(c);
+        return hits;
+    };
+    // A share of 1 decides only at every pixel: the whole sum.
+    RunOptions whole;
+    whole.feedback.sslrMinHitShare = 1.0f;
+    const Frame f = harness.run(camera, 0, traces, all, whole);
+    const uint32_t hits = hitsOf(f);
+    REQUIRE(hits > 50);
+    CHECK(f.frameHitsWord == shader::kFeedbackFrameHitsStart + hits);
+    // A small share: the tiles stop adding once the sum decides (the
+    // atomics of tiles already past the test still land).
+    RunOptions small;
+    small.feedback.sslrMinHitShare = 10.0f / float(kSize * kSize);
+    const Frame g = harness.run(camera, 1, traces, all, small);
+    CHECK(g.frameHitsWord >= shader::kFeedbackFrameHitsStart + 10);
+    CHECK(g.frameHitsWord <= shader::kFeedbackFrameHitsStart + hitsOf(g));
+    // The gate off: the word stays where the feedback pass started it.
+    RunOptions off;
+    off.feedback.sslrMinHitShare = 0.0f;
+    CHECK(harness.run(camera, 2, traces, all, off).frameHitsWord == shader::kFeedbackFrameHitsStart);
+}
+
 TEST_CASE("feedback refuses hit and miss fractions outside [0, 1]") {
     test::GpuTest gpu;
     Harness harness(gpu, wallScene());
@@ -1091,6 +1214,14 @@ TEST_CASE("feedback refuses hit and miss fractions outside [0, 1]") {
     settings.sslrMissFraction = -0.1f;
     CHECK_THROWS_WITH_AS(harness.runFeedback(testCamera(), 0, counters, settings),
                          doctest::Contains("(got -0.1"), gpu::GpuError);
+    settings.sslrMissFraction = 0.0f;
+    settings.sslrMinHitShare = 2.0f;
+    CHECK_THROWS_WITH_AS(harness.runFeedback(testCamera(), 0, counters, settings),
+                         doctest::Contains("sslrMinHitShare must lie in [0, 1]"), gpu::GpuError);
+    settings.sslrMinHitShare = 0.02f;
+    settings.sslrProbeInterval = 0;
+    CHECK_THROWS_WITH_AS(harness.runFeedback(testCamera(), 0, counters, settings),
+                         doctest::Contains("sslrProbeInterval be at least 1"), gpu::GpuError);
 }
 
 TEST_CASE("integrate refuses an RT radiance without its hit distance") {

@@ -581,7 +581,7 @@ TEST_CASE("the ssr and rt modes send every traced pixel one way, and the RT list
     }
 }
 
-TEST_CASE("hybrid pixels follow their tile's mode, and an RT tile keeps the configured share hybrid") {
+TEST_CASE("hybrid pixels follow their tile's mode, an RT tile keeps the configured share hybrid, an RT-only tile none") {
     test::GpuTest gpu;
     passes::RayGenerationSettings settings;
     Band band;
@@ -589,13 +589,13 @@ TEST_CASE("hybrid pixels follow their tile's mode, and an RT tile keeps the conf
     band.sslrMinDistance = 1e9f;  // no SSLR band: every floor pixel is hybrid before the feedback
     settings.rtToHybridShare = 0.25f;
     constexpr uint32_t kTiles = kSize / shader::kTileSize;
-    // Columns of tiles: SSLR, hybrid, RT, repeating.
+    // Columns of tiles: SSLR, hybrid, RT, RT-only, repeating.
     std::vector<uint32_t> modes(kTiles * kTiles);
     for (uint32_t t = 0; t < modes.size(); ++t) {
-        const uint32_t tx = t % kTiles;
-        modes[t] = tx % 3 == 0 ? shader::kTileModeSslr : tx % 3 == 1 ? shader::kTileModeHybrid : shader::kTileModeRt;
+        modes[t] = std::array{shader::kTileModeSslr, shader::kTileModeHybrid, shader::kTileModeRt,
+                              shader::kTileModeRtOnly}[(t % kTiles) % 4];
     }
-    uint64_t rtTilePixels = 0, keptHybrid = 0;
+    uint64_t rtTilePixels = 0, keptHybrid = 0, rtOnlyPixels = 0;
     const std::vector<RayFrame> frames =
         generate(gpu, floorScene(0.05f), {0, 1, 2, 3, 4, 5, 6, 7}, settings, band, modes);
     for (const RayFrame& f : frames) {
@@ -608,6 +608,10 @@ TEST_CASE("hybrid pixels follow their tile's mode, and an RT tile keeps the conf
                     REQUIRE(c == shader::kPixelSslr);
                 } else if (mode == shader::kTileModeHybrid) {
                     REQUIRE(c == shader::kPixelHybrid);
+                } else if (mode == shader::kTileModeRtOnly) {
+                    // The frame's SSLR does not pay: nothing stays hybrid.
+                    REQUIRE(c == shader::kPixelRt);
+                    ++rtOnlyPixels;
                 } else {
                     REQUIRE((c == shader::kPixelRt || c == shader::kPixelHybrid));
                     ++rtTilePixels;
@@ -616,9 +620,10 @@ TEST_CASE("hybrid pixels follow their tile's mode, and an RT tile keeps the conf
             }
         }
     }
-    // 8 frames x ~700 pixels: the binomial standard deviation of the share
-    // is ~0.006, so 0.03 is a five-sigma bound.
-    REQUIRE(rtTilePixels > 4000);
+    // 8 frames x 512 pixels of the RT columns' floor: the binomial standard
+    // deviation of the share is ~0.007, so 0.03 is a four-sigma bound.
+    REQUIRE(rtTilePixels > 3000);
+    REQUIRE(rtOnlyPixels > 3000);
     const double share = double(keptHybrid) / double(rtTilePixels);
     CHECK(std::abs(share - 0.25) < 0.03);
 }

@@ -19,7 +19,7 @@ foreach(f bench.csv bench.json bench.png bench.svg bench.plot.json bench.plot.py
 endforeach()
 file(STRINGS ${OUT}/bench.csv lines)
 list(GET lines 0 header)
-set(expected "scene,mode,param,value,width,height,reflection_ms,total_ms,rt_rays,flip_mean,relmse,psnr,ssim")
+set(expected "scene,mode,param,value,width,height,reflection_ms,total_ms,rt_rays,flip_mean,relmse,psnr,ssim,reflection_mean_ms")
 if(NOT header STREQUAL expected)
   message(FATAL_ERROR "${OUT}/bench.csv: header '${header}', expected '${expected}'")
 endif()

@@ -13,6 +13,13 @@
 //   bits 24-31  SSLR misses of the previous frame
 // Integrate writes this frame's counts in the low half and moves the
 // reprojected counter's low half (last frame's counts) into the high half.
+//
+// The counters buffer holds one word more, after the tiles: 1 + the
+// frame's SSLR hits summed over every tile (the feedback pass sets it to 1
+// at the start of the frame; integrate adds each tile's hits until the sum
+// reaches FeedbackConstants::minFrameHits). 0 says no frame wrote it (a new
+// pair): no evidence. Next frame's feedback pass reads it to decide whether
+// SSLR pays at all (sslrPays).
 #ifndef GLINT_FEEDBACK_SHARED_H
 #define GLINT_FEEDBACK_SHARED_H
 
@@ -29,6 +36,10 @@ GLINT_BEGIN
 GLINT_CONST uint kTileModeSslr = 0u;
 GLINT_CONST uint kTileModeHybrid = 1u;
 GLINT_CONST uint kTileModeRt = 2u;
+// Straight to RT with no pixel kept hybrid: the whole frame's SSLR hits
+// were too few for the SSLR pass to pay for itself, and this frame is not
+// a probe frame (feedbackProbeFrame).
+GLINT_CONST uint kTileModeRtOnly = 3u;
 
 GLINT_CONST uint kFeedbackCountMax = 255u;
 
@@ -76,6 +87,33 @@ GLINT_FUNC uint decideTileMode(uint counter, uint minRays, float sslrMissFractio
     return kTileModeHybrid;
 }
 
+// Whether SSLR is tried this frame whatever last frame's hits: one frame in
+// each block of `interval` frames, at a pseudo-random place in the block,
+// so that the probes do not fall on one parity or one quad-leader corner
+// of the frame index (ray generation rotates the leader every frame; the
+// samples' timing alternates frame by frame). At most 2 * interval - 1
+// frames apart. Interval 0 or 1: every frame.
+GLINT_FUNC bool feedbackProbeFrame(uint frame, uint interval) {
+    if (interval <= 1u) {
+        return true;
+    }
+    return frame % interval == pcgHash(frame / interval) % interval;
+}
+
+// The counters' word after the tiles at the start of a frame, before
+// integrate adds the frame's hits.
+GLINT_CONST uint kFeedbackFrameHitsStart = 1u;
+
+// Whether SSLR pays this frame: last frame's SSLR hits (`lastFrameWord`,
+// the counters' word after the tiles) reached minFrameHits, or this is a
+// probe frame, or there is no evidence (a new pair, a reset). Otherwise
+// every tile's hybrid pixels go straight to RT (kTileModeRtOnly), the SSLR
+// list stays empty and SSLR's passes run no groups.
+GLINT_FUNC bool sslrPays(uint lastFrameWord, uint minFrameHits, bool probeFrame, bool reset) {
+    const bool noEvidence = reset || lastFrameWord < kFeedbackFrameHitsStart;
+    return noEvidence || probeFrame || lastFrameWord - kFeedbackFrameHitsStart >= minFrameHits;
+}
+
 // The pixel of `tile` whose motion carries the tile's counter this frame:
 // a new pseudo-random one every frame (the talk's "random motion vector of
 // the tile"), so over frames the whole tile votes, not one corner. Inside
@@ -89,7 +127,7 @@ GLINT_FUNC uvec2 feedbackProbePixel(uvec2 tile, uint frame, uvec2 size) {
     return uvec2(x0 + (h & 0xFFFFu) % w, y0 + (h >> 16u) % hgt);
 }
 
-// Push constants of reproject.comp (40 bytes).
+// Push constants of reproject.comp (48 bytes).
 struct FeedbackConstants {
     uvec2 size;   // pixels
     uvec2 tiles;  // tiles in x and y
@@ -99,12 +137,14 @@ struct FeedbackConstants {
     float rtHitFraction;
     uint adaptive;      // 0: every tile hybrid
     uint resetHistory;  // 1: carry nothing (a camera cut): every tile starts without evidence
+    uint minFrameHits;  // SSLR hits of last frame below which SSLR does not pay (sslrPays); 0: it always does
+    uint probeInterval; // feedbackProbeFrame's interval
 };
 
 GLINT_END
 
 #ifdef __cplusplus
-static_assert(sizeof(glint::shader::FeedbackConstants) == 40);
+static_assert(sizeof(glint::shader::FeedbackConstants) == 48);
 #endif
 
 #endif

@@ -95,12 +95,15 @@ struct IntegrateConstants {
     uint particlesBound;         // 1: composite the particle trace (passes/particles.h) over the reflection
     uint rtMissesTrusted;        // 0 while the BVH builds objects in range (IntegrateSettings::rtMissesTrusted)
     uint rtHitMotionBound;       // 1: the ray tracer's hit motion is bound (else its hits count as still)
+    // The feedback's minFrameHits (passes/feedback.h): tiles stop adding
+    // their hits to the frame's sum once it holds this many.
+    uint minFrameHits;
 };
 
 GLINT_END
 
 #ifdef __cplusplus
-static_assert(sizeof(glint::shader::IntegrateConstants) == 496);
+static_assert(sizeof(glint::shader::IntegrateConstants) == 500);
 #endif
 
 #endif
