@@ -427,6 +427,11 @@ void Executor::prepareHistory(const Plan& plan) {
                                       VK_PIPELINE_STAGE_2_ALL_COMMANDS_BIT,
                                       VK_ACCESS_2_MEMORY_READ_BIT | VK_ACCESS_2_MEMORY_WRITE_BIT);
                 } else {
+                    // From every earlier command, as for images: the new
+                    // buffer may sit in memory an earlier frame's buffer read.
+                    gpu::bufferBarrier(cmd, *h->buffers[k], VK_PIPELINE_STAGE_2_ALL_COMMANDS_BIT,
+                                       VK_ACCESS_2_MEMORY_READ_BIT | VK_ACCESS_2_MEMORY_WRITE_BIT,
+                                       VK_PIPELINE_STAGE_2_CLEAR_BIT, VK_ACCESS_2_TRANSFER_WRITE_BIT);
                     vkCmdFillBuffer(cmd, h->buffers[k]->handle(), 0, VK_WHOLE_SIZE, 0);
                     gpu::bufferBarrier(cmd, *h->buffers[k], VK_PIPELINE_STAGE_2_CLEAR_BIT,
                                        VK_ACCESS_2_TRANSFER_WRITE_BIT, VK_PIPELINE_STAGE_2_ALL_COMMANDS_BIT,
