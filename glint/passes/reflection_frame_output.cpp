@@ -56,7 +56,10 @@ const std::array<ViewRow, 24> kViews = {{
      [](const ViewSources& s) { return s.f.gbuffer.lit; }},
     {{"ray_classes", "ray generation: sky black, env grey, SSLR blue, hybrid purple, RT red", kAll}, K::Raw, 0, 1,
      [](const ViewSources& s) { return s.f.rays.classDebug; }},
-    {{"tile_modes", "feedback: the tile decisions ray generation used", kHybridOnly}, K::Raw, 0, 1,
+    {{"tile_modes",
+      "feedback: the tile decisions ray generation used (blue SSLR, purple hybrid, red RT, dark red RT-only)",
+      kHybridOnly},
+     K::Raw, 0, 1,
      [](const ViewSources& s) {
          return s.f.feedback ? s.tiles(s.f.feedback->tileModes, shader::kTileViewModes) : rg::Texture{};
      }},

@@ -23,9 +23,12 @@ void main() {
     const uint value = tiles[(pixel.y / kTileSize) * pc.tilesX + pixel.x / kTileSize];
     vec3 colour;
     if (pc.what == kTileViewModes) {
+        // Blue SSLR, purple hybrid, red RT, dark red RT-only (the frame's
+        // SSLR does not pay: passes/feedback.h).
         colour = value == kTileModeSslr     ? vec3(0.1, 0.3, 1.0)
                  : value == kTileModeHybrid ? vec3(0.7, 0.2, 0.9)
-                                            : vec3(1.0, 0.15, 0.1);
+                 : value == kTileModeRt     ? vec3(1.0, 0.15, 0.1)
+                                            : vec3(0.45, 0.05, 0.05);
     } else {
         // A tile holds at most 64 pixels per frame: two frames' hits (green)
         // and misses (red) on a 0..128 scale.
