@@ -40,7 +40,7 @@ void main() {
         return;
     }
     // The frame's gate: one word every invocation reads (length(): the
-    // history pair keeps its size if the image is resized).
+    // buffers are bound whole).
     const uint lastFrameWord = tiles < uint(previous.length()) ? previous[tiles] : 0u;
     const bool pays = sslrPays(lastFrameWord, pc.minFrameHits, feedbackProbeFrame(pc.frame, pc.probeInterval),
                                pc.resetHistory != 0u);
@@ -56,7 +56,7 @@ void main() {
         all(lessThan(last, vec2(pc.size)))) {
         const uvec2 lastTile = uvec2(last) / kTileSize;
         const uint lastIndex = lastTile.y * pc.tiles.x + lastTile.x;
-        // length(): the history pair keeps its size if the image is resized.
+        // length(): the buffers are bound whole.
         counter = lastIndex < uint(previous.length()) ? previous[lastIndex] : 0u;
     }
     reprojected[tileIndex] = counter;

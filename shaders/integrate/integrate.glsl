@@ -290,7 +290,8 @@ void main() {
         // the tiles stop adding (one atomic on one word per tile would
         // queue up behind each other).
         const uint total = C.tiles.x * C.tiles.y;
-        if (sharedHits != 0u && total < uint(counters.length()) && counters[total] < kFeedbackFrameHitsStart + C.minFrameHits) {
+        if (sharedHits != 0u && total < uint(counters.length()) &&
+            counters[total] < kFeedbackFrameHitsStart + C.minFrameHits) {
             atomicAdd(counters[total], sharedHits);
         }
     }
