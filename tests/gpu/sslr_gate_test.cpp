@@ -1,0 +1,65 @@
+// The hybrid's SSLR gate through the whole reflection frame
+// (passes/feedback.h; run as glint-render runs it): on DamagedHelmet, a
+// close-up whose reflections mostly leave the screen, SSLR resolves far
+// fewer than sslrMinHitShare of the pixels, so after the first frames the
+// hybrid traces exactly what rt mode traces and lists no SSLR ray, except
+// on probe frames; with the gate off it keeps trying SSLR every frame.
+#include "support/gpu_test.h"
+
+#include "common/reflection_run.h"
+#include "glint/scene/builtin_scenes.h"
+
+#include "glint/feedback_shared.h"
+
+#include <filesystem>
+
+using namespace glint;
+
+namespace {
+
+constexpr uint32_t kSize = 128;
+
+app::ReflectionRunResult run(test::GpuTest& gpu, passes::ReflectionMode mode, uint32_t frames,
+                             float minHitShare = passes::FeedbackSettings{}.sslrMinHitShare) {
+    const std::filesystem::path file = std::filesystem::path(GLINT_SCENES_DIR) / "DamagedHelmet" / "DamagedHelmet.gltf";
+    REQUIRE_MESSAGE(std::filesystem::exists(file), "shared scene missing: " << file.string());
+    scene::Scene scene = scene::loadScene(file.string());
+    app::ReflectionRunOptions options;
+    options.width = kSize;
+    options.height = kSize;
+    options.frames = frames;
+    options.timeEveryFrame = false;
+    options.frame.mode = mode;
+    options.frame.feedback.sslrMinHitShare = minHitShare;
+    return app::runReflections(gpu.ctx(), scene, options);
+}
+
+// The smallest frame count from `least` on whose last frame (index
+// count - 1) is, or is not, a probe frame.
+uint32_t framesEndingOn(bool probe, uint32_t least) {
+    const uint32_t interval = passes::FeedbackSettings{}.sslrProbeInterval;
+    uint32_t frames = least;
+    while (shader::feedbackProbeFrame(frames - 1, interval) != probe) ++frames;
+    return frames;
+}
+
+} // namespace
+
+TEST_CASE("the hybrid stops trying SSLR where it resolves too little, and tries it again on probe frames") {
+    test::GpuTest gpu;
+    // The last frame gated: no SSLR ray, and rt mode's rays exactly (the
+    // helmet has no pixel beyond the reach, where only SSLR could go).
+    const uint32_t gated = framesEndingOn(false, 6);
+    const app::ReflectionRunResult hybrid = run(gpu, passes::ReflectionMode::Hybrid, gated);
+    const app::ReflectionRunResult rt = run(gpu, passes::ReflectionMode::Rt, gated);
+    REQUIRE(rt.rtRays > 500);
+    CHECK(hybrid.sslrRays == 0);
+    CHECK(hybrid.rtRays == rt.rtRays);
+    // With the gate off the same frame tries SSLR on its hybrid pixels.
+    const app::ReflectionRunResult always = run(gpu, passes::ReflectionMode::Hybrid, gated, 0.0f);
+    CHECK(always.sslrRays > 100);
+    CHECK(always.rtRays < rt.rtRays);
+    // A probe frame tries SSLR on every hybrid pixel again.
+    const app::ReflectionRunResult probe = run(gpu, passes::ReflectionMode::Hybrid, framesEndingOn(true, gated));
+    CHECK(probe.sslrRays > always.sslrRays);
+}
