@@ -20,6 +20,7 @@
 #include <cmath>
 #include <cstring>
 #include <limits>
+#include <optional>
 #include <string>
 
 namespace glint::passes {
@@ -255,6 +256,7 @@ GBufferRenderer::GBufferRenderer(gpu::Context& ctx, const scene::Scene& scene, u
     white_ = gpu::createSampledImageWithMips(
         ctx, {.width = 1, .height = 1, .format = VK_FORMAT_R8G8B8A8_UNORM, .name = "gbuffer.white"}, white.data());
 
+    createOcclusionPipelines();
     loadAssets();
     for (uint32_t i = 0; i < framesInFlight_; ++i) {
         slots_.push_back(std::make_unique<FrameSlot>());
@@ -323,6 +325,26 @@ std::shared_ptr<GBufferRenderer::FrameWork> GBufferRenderer::prepare(const GBuff
         work->instances.push_back(gi);
         work->meshes.push_back(inst.mesh);
     }
+    // The draws, in the order record() issues them: opaque geometry, then
+    // alpha-tested (blended geometry is the transparent pass's).
+    for (const bool masked : {false, true}) {
+        for (size_t i = 0; i < work->instances.size(); ++i) {
+            if (!work->visible[i]) continue;
+            for (const DrawRange& range : meshDraws_.at(work->meshes[i])) {
+                if (range.indexCount == 0 || range.coverage != (masked ? Coverage::Masked : Coverage::Opaque)) {
+                    continue;
+                }
+                work->draws.push_back({uint32_t(i), &range, masked});
+            }
+        }
+    }
+    for (const uint32_t mesh : work->meshes) {
+        for (const DrawRange& range : meshDraws_.at(mesh)) {
+            work->drawCapacity += range.indexCount != 0 && range.coverage != Coverage::Blended ? 1u : 0u;
+        }
+    }
+    work->occlusionCulling = settings.occlusionCulling;
+    if (work->occlusionCulling) prepareOcclusion(*work);
     work->joints = scene_.jointMatrices;
     work->previousJoints = scene_.previousJointMatrices;
     // Before the first advanceScene the previous palette may be missing:
@@ -363,6 +385,13 @@ int64_t GBufferRenderer::appendMorphed(const scene::Instance& inst, std::vector<
     return first;
 }
 
+void GBufferRenderer::uploadOnce(const FrameWork& work) {
+    // Whichever of the frame's passes records first (the shadow map, or
+    // the occlusion cull's early phase, which share no resource) fills the
+    // buffers they all read.
+    std::call_once(work.uploaded, [&] { upload(work); });
+}
+
 void GBufferRenderer::upload(const FrameWork& work) {
     FrameSlot& slot = *slots_[work.slot];
     ensureCapacity(slot.morphedVertices,
@@ -391,6 +420,22 @@ void GBufferRenderer::upload(const FrameWork& work) {
         std::memcpy(slot.previousJoints.mapped(), work.previousJoints.data(),
                     work.previousJoints.size() * sizeof(glm::mat4));
     }
+    if (work.occlusionCulling) {
+        ensureCapacity(slot.occlusionInstances,
+                       std::max<size_t>(work.occlusionInstances.size(), 1) * sizeof(shader::OcclusionInstance),
+                       "gbuffer.occlusion_instances");
+        ensureCapacity(slot.occlusionDraws,
+                       std::max<size_t>(work.occlusionDraws.size(), 1) * sizeof(shader::OcclusionDraw),
+                       "gbuffer.occlusion_draws");
+        if (!work.occlusionInstances.empty()) {
+            std::memcpy(slot.occlusionInstances.mapped(), work.occlusionInstances.data(),
+                        work.occlusionInstances.size() * sizeof(shader::OcclusionInstance));
+        }
+        if (!work.occlusionDraws.empty()) {
+            std::memcpy(slot.occlusionDraws.mapped(), work.occlusionDraws.data(),
+                        work.occlusionDraws.size() * sizeof(shader::OcclusionDraw));
+        }
+    }
 }
 
 std::pair<const gpu::Buffer*, int32_t> GBufferRenderer::vertexSource(const FrameWork& work, size_t instance,
@@ -402,9 +447,7 @@ std::pair<const gpu::Buffer*, int32_t> GBufferRenderer::vertexSource(const Frame
 }
 
 void GBufferRenderer::recordShadowMap(const FrameWork& work, rg::PassContext& pc, rg::Texture shadowMap) {
-    // The frame's first pass (always declared; the G-buffer reads its
-    // output, so it records first) fills the buffers both passes read.
-    upload(work);
+    uploadOnce(work);
     const VkCommandBuffer cmd = pc.cmd();
     FrameSlot& slot = *slots_[work.slot];
     const uint32_t size = pc.image(shadowMap).desc().width;
@@ -523,12 +566,15 @@ void GBufferRenderer::pushSurfaceBindings(const gpu::Pipeline& pipeline, rg::Pas
 }
 
 void GBufferRenderer::record(const FrameWork& work, rg::PassContext& pc, const GBufferOutputs& targets,
-                             rg::Texture environment) {
+                             rg::Texture environment, SurfacePhase phase, rg::Buffer args) {
+    uploadOnce(work);
     const VkCommandBuffer cmd = pc.cmd();
     FrameSlot& slot = *slots_[work.slot];
 
     // Load-op clears: depth 0 is the reversed-Z far plane; zero normal w and
-    // albedo mark "no surface" for the passes that read them.
+    // albedo mark "no surface" for the passes that read them. The late
+    // phase draws over what the early one left.
+    const VkAttachmentLoadOp load = phase == SurfacePhase::Late ? VK_ATTACHMENT_LOAD_OP_LOAD : VK_ATTACHMENT_LOAD_OP_CLEAR;
     const std::array<rg::Texture, 5> colorTargets = {targets.normal, targets.albedo, targets.roughnessMetal,
                                                      targets.motion, targets.lit};
     std::array<VkRenderingAttachmentInfo, 5> colors{};
@@ -537,14 +583,14 @@ void GBufferRenderer::record(const FrameWork& work, rg::PassContext& pc, const G
         a.sType = VK_STRUCTURE_TYPE_RENDERING_ATTACHMENT_INFO;
         a.imageView = pc.view(colorTargets[i]);
         a.imageLayout = VK_IMAGE_LAYOUT_ATTACHMENT_OPTIMAL;
-        a.loadOp = VK_ATTACHMENT_LOAD_OP_CLEAR;
+        a.loadOp = load;
         a.storeOp = VK_ATTACHMENT_STORE_OP_STORE;
         a.clearValue.color = {{0.0f, 0.0f, 0.0f, 0.0f}};
     }
     VkRenderingAttachmentInfo depth{VK_STRUCTURE_TYPE_RENDERING_ATTACHMENT_INFO};
     depth.imageView = pc.view(targets.depth);
     depth.imageLayout = VK_IMAGE_LAYOUT_ATTACHMENT_OPTIMAL;
-    depth.loadOp = VK_ATTACHMENT_LOAD_OP_CLEAR;
+    depth.loadOp = load;
     depth.storeOp = VK_ATTACHMENT_STORE_OP_STORE;
     depth.clearValue.depthStencil = {0.0f, 0};
 
@@ -570,53 +616,66 @@ void GBufferRenderer::record(const FrameWork& work, rg::PassContext& pc, const G
         pushSurfaceBindings(pipeline, pc, slot, vertices, textures, targets.shadowMap, environment);
     };
 
-    stats_.draws = 0;
-    stats_.triangles = 0;
-    stats_.normalMappedDraws = 0;
-    stats_.texturedDraws = 0;
-    stats_.maskedDraws = 0;
+    // Counted once a frame, by the pass that records every draw first.
+    const bool counts = phase != SurfacePhase::Late;
+    if (counts) {
+        stats_.draws = 0;
+        stats_.triangles = 0;
+        stats_.normalMappedDraws = 0;
+        stats_.texturedDraws = 0;
+        stats_.maskedDraws = 0;
+    }
+    const VkBuffer indirect = phase == SurfacePhase::Direct ? VK_NULL_HANDLE : pc.buffer(args).handle();
     vkCmdBindIndexBuffer(cmd, indices_.handle(), 0, VK_INDEX_TYPE_UINT32);
     Facing facing;
     // Opaque draws first, then the alpha-tested ones with their own
     // pipeline: the discard costs early depth testing only where it exists,
     // and the opaque depth already rejects what the cutouts hide behind.
-    for (const bool masked : {false, true}) {
-        const gpu::Pipeline& pipeline = masked ? surfaceMaskedPipeline_ : surfacePipeline_;
-        pipeline.bind(cmd);
-        facing.bind(cmd);
-        const gpu::Buffer* boundVertices = &vertices_;
-        MaterialTextures boundTextures = fallbacks;
-        pushBindings(pipeline, *boundVertices, boundTextures);
-        for (size_t i = 0; i < work.instances.size(); ++i) {
-            if (!work.visible[i]) continue;
-            const auto [vertices, vertexShift] = vertexSource(work, i, slot);
-            for (const DrawRange& range : meshDraws_.at(work.meshes[i])) {
-                // Blended surfaces are drawn by the transparent pass.
-                if (range.indexCount == 0 || range.coverage != (masked ? Coverage::Masked : Coverage::Opaque)) {
-                    continue;
-                }
-                facing.set(cmd, work.mirrored[i] != 0, range.doubleSided);
-                MaterialTextures textures = boundTextures;
-                const bool textured = rangeTextures(range, textures);
-                stats_.normalMappedDraws += range.material.normalMap != 0 ? 1u : 0u;
-                stats_.texturedDraws += textured ? 1u : 0u;
-                stats_.maskedDraws += masked ? 1u : 0u;
-                if (vertices != boundVertices || textures != boundTextures) {
-                    boundVertices = vertices;
-                    boundTextures = textures;
-                    pushBindings(pipeline, *boundVertices, boundTextures);
-                }
-                shader::GBufferDraw draw = range.material;
-                draw.instance = uint32_t(i);
-                draw.doubleSided = range.doubleSided ? 1u : 0u;
-                pipeline.pushConstants(cmd, draw);
-                vkCmdDrawIndexed(cmd, range.indexCount, 1, range.firstIndex, range.vertexOffset + vertexShift, 0);
-                ++stats_.draws;
-                stats_.triangles += range.indexCount / 3;
-            }
+    const gpu::Pipeline* bound = nullptr;
+    const gpu::Buffer* boundVertices = nullptr;
+    MaterialTextures boundTextures = fallbacks;
+    for (size_t d = 0; d < work.draws.size(); ++d) {
+        const SurfaceDraw& draw = work.draws[d];
+        const DrawRange& range = *draw.range;
+        const gpu::Pipeline& pipeline = draw.masked ? surfaceMaskedPipeline_ : surfacePipeline_;
+        if (&pipeline != bound) {
+            bound = &pipeline;
+            pipeline.bind(cmd);
+            facing.bind(cmd);
+            boundVertices = &vertices_;
+            boundTextures = fallbacks;
+            pushBindings(pipeline, *boundVertices, boundTextures);
+        }
+        const auto [vertices, vertexShift] = vertexSource(work, draw.instance, slot);
+        facing.set(cmd, work.mirrored[draw.instance] != 0, range.doubleSided);
+        MaterialTextures textures = boundTextures;
+        const bool textured = rangeTextures(range, textures);
+        if (vertices != boundVertices || textures != boundTextures) {
+            boundVertices = vertices;
+            boundTextures = textures;
+            pushBindings(pipeline, *boundVertices, boundTextures);
+        }
+        shader::GBufferDraw constants = range.material;
+        constants.instance = draw.instance;
+        constants.doubleSided = range.doubleSided ? 1u : 0u;
+        pipeline.pushConstants(cmd, constants);
+        if (phase == SurfacePhase::Direct) {
+            vkCmdDrawIndexed(cmd, range.indexCount, 1, range.firstIndex, range.vertexOffset + vertexShift, 0);
+        } else {
+            // The cull's command for this draw: the same range, with 0 or 1
+            // instances.
+            vkCmdDrawIndexedIndirect(cmd, indirect, d * sizeof(VkDrawIndexedIndirectCommand), 1,
+                                     sizeof(VkDrawIndexedIndirectCommand));
+        }
+        if (counts) {
+            stats_.normalMappedDraws += range.material.normalMap != 0 ? 1u : 0u;
+            stats_.texturedDraws += textured ? 1u : 0u;
+            stats_.maskedDraws += draw.masked ? 1u : 0u;
+            ++stats_.draws;
+            stats_.triangles += range.indexCount / 3;
         }
     }
-    if (work.drawSky) {
+    if (work.drawSky && phase != SurfacePhase::Early) {
         skyPipeline_.bind(cmd);
         pushBindings(skyPipeline_, vertices_, fallbacks);
         skyPipeline_.pushConstants(cmd, shader::GBufferDraw{});
@@ -657,31 +716,58 @@ GBufferOutputs addGBufferPass(rg::Graph& graph, GBufferRenderer& renderer, const
         },
         [&renderer, work](const ShadowData& d, rg::PassContext& pc) { renderer.recordShadowMap(*work, pc, d.map); });
 
-    const GBufferOutputs& out = graph.addPass<GBufferOutputs>(
-        "gbuffer", rg::Queue::Graphics,
-        [&](rg::Builder& b, GBufferOutputs& d) {
-            b.setPipeline(rg::Pipeline::Raster);
-            const auto target = [&](const char* name, VkFormat format, rg::Access access) {
-                return b.write(b.createTexture(name, {.width = width, .height = height, .format = format}), access);
-            };
-            d.depth = target("gbuffer.depth", kGBufferDepthFormat, rg::Access::DepthWrite);
-            d.normal = target("gbuffer.normal", kGBufferNormalFormat, rg::Access::ColorAttachment);
-            d.albedo = target("gbuffer.albedo", kGBufferAlbedoFormat, rg::Access::ColorAttachment);
-            d.roughnessMetal =
-                target("gbuffer.roughness_metal", kGBufferRoughnessMetalFormat, rg::Access::ColorAttachment);
-            d.motion = target("gbuffer.motion", kGBufferMotionFormat, rg::Access::ColorAttachment);
-            d.lit = target("gbuffer.lit", kGBufferLitFormat, rg::Access::ColorAttachment);
-            d.shadowMap = b.read(shadow.map, rg::Access::SampledRead);
-            if (inputs.environment.valid()) {
-                b.read(inputs.environment, rg::Access::SampledRead);
-            }
-            d.width = width;
-            d.height = height;
-            d.shadowResolution = shadowSize;
-        },
-        [&renderer, work, environment = inputs.environment](const GBufferOutputs& d, rg::PassContext& pc) {
-            renderer.record(*work, pc, d, environment);
-        });
+    // With occlusion culling: the early cull before the G-buffer, then the
+    // depth pyramid, the late cull and the late G-buffer pass after it.
+    std::optional<GBufferRenderer::OcclusionHandles> occlusion;
+    if (work->occlusionCulling) occlusion = renderer.addEarlyCull(graph, work);
+    using Phase = GBufferRenderer::SurfacePhase;
+    struct SurfaceData {
+        GBufferOutputs out;
+        rg::Buffer args;
+    };
+    // Both G-buffer passes: the first creates the targets, the late one
+    // draws over them.
+    const auto addSurfacePass = [&](const char* name, Phase phase, const GBufferOutputs* early, rg::Buffer args) {
+        return graph.addPass<SurfaceData>(
+            name, rg::Queue::Graphics,
+            [&](rg::Builder& b, SurfaceData& d) {
+                b.setPipeline(rg::Pipeline::Raster);
+                const auto target = [&](rg::Texture previous, const char* targetName, VkFormat format,
+                                        rg::Access access) {
+                    if (early) return b.write(previous, access);
+                    return b.write(b.createTexture(targetName, {.width = width, .height = height, .format = format}),
+                                   access);
+                };
+                GBufferOutputs& o = d.out;
+                const GBufferOutputs none;
+                const GBufferOutputs& from = early ? *early : none;
+                o.depth = target(from.depth, "gbuffer.depth", kGBufferDepthFormat, rg::Access::DepthWrite);
+                o.normal = target(from.normal, "gbuffer.normal", kGBufferNormalFormat, rg::Access::ColorAttachment);
+                o.albedo = target(from.albedo, "gbuffer.albedo", kGBufferAlbedoFormat, rg::Access::ColorAttachment);
+                o.roughnessMetal = target(from.roughnessMetal, "gbuffer.roughness_metal",
+                                          kGBufferRoughnessMetalFormat, rg::Access::ColorAttachment);
+                o.motion = target(from.motion, "gbuffer.motion", kGBufferMotionFormat, rg::Access::ColorAttachment);
+                o.lit = target(from.lit, "gbuffer.lit", kGBufferLitFormat, rg::Access::ColorAttachment);
+                o.shadowMap = b.read(shadow.map, rg::Access::SampledRead);
+                if (inputs.environment.valid()) {
+                    b.read(inputs.environment, rg::Access::SampledRead);
+                }
+                if (args.valid()) d.args = b.read(args, rg::Access::IndirectArgs);
+                o.width = width;
+                o.height = height;
+                o.shadowResolution = shadowSize;
+            },
+            [&renderer, work, phase, environment = inputs.environment](const SurfaceData& d, rg::PassContext& pc) {
+                renderer.record(*work, pc, d.out, environment, phase, d.args);
+            });
+    };
+    const SurfaceData& first =
+        addSurfacePass("gbuffer", occlusion ? Phase::Early : Phase::Direct, nullptr,
+                       occlusion ? occlusion->earlyArgs : rg::Buffer{});
+    if (!occlusion) return first.out;
+    const rg::Buffer lateArgs = renderer.addLateCull(graph, work, first.out, *occlusion);
+    GBufferOutputs out = addSurfacePass("gbuffer.late", Phase::Late, &first.out, lateArgs).out;
+    out.occlusionStats = occlusion->stats;
     return out;
 }
 

@@ -1,8 +1,10 @@
 #pragma once
-// Pass 1 of the reflection pipeline: the G-buffer. One raster pass on the
-// graphics queue draws every instance of a scene::Scene (mesh LOD 0) whose
-// bounds meet the view frustum (GBufferSettings::frustumCulling), less
-// their blended geometries (glTF alphaMode BLEND: the transparent pass
+// Pass 1 of the reflection pipeline: the G-buffer. Raster on the graphics
+// queue of every instance of a scene::Scene (mesh LOD 0) whose bounds meet
+// the view frustum (GBufferSettings::frustumCulling) and are not hidden
+// behind what is drawn (GBufferSettings::occlusionCulling: two raster
+// passes around a GPU cull, passes/gbuffer_occlusion.cpp), less their
+// blended geometries (glTF alphaMode BLEND: the transparent pass
 // draws those, passes/transparent.h), into reversed-Z depth, world normal, albedo, roughness/metallic,
 // motion (camera, rigid and skinned motion) and the lit colour of the
 // opaque scene that SSLR samples; a sky triangle fills what no geometry
@@ -133,6 +135,16 @@ struct GBufferSettings {
     // the CPU per instance. Off: every instance is drawn in both (the
     // image is the same; only the raster work differs).
     bool frustumCulling = true;
+    // Occlusion culling on the GPU, in two phases (glint/occlusion_shared.h):
+    // the instances visible last frame are drawn first ("gbuffer"), a depth
+    // pyramid of them is built ("gbuffer.hiz"), every instance in the
+    // frustum is tested against it ("gbuffer.cull_late") and those newly
+    // visible are drawn over ("gbuffer.late"). An instance is skipped only
+    // where its bounds lie wholly behind what is drawn, so the image is the
+    // same as without; only the raster work differs. It tests what the
+    // frustum test leaves (every instance with frustumCulling off); the
+    // shadow map is not occlusion culled.
+    bool occlusionCulling = true;
 };
 
 struct GBufferOutputs {
@@ -148,11 +160,18 @@ struct GBufferOutputs {
     uint32_t width = 0;
     uint32_t height = 0;
     uint32_t shadowResolution = 0;
+    // With occlusion culling, the frame's counts (shader::kOcclusionStat*,
+    // u32 words, glint/occlusion_shared.h), final after "gbuffer.cull_late";
+    // else invalid.
+    rg::Buffer occlusionStats;
 };
 
 struct GBufferStats {
     uint64_t frame = 0;           // addGBufferPass calls so far
-    uint32_t draws = 0;           // this frame: vkCmdDrawIndexed calls
+    // this frame: the draws recorded (those of the instances in the
+    // frustum; with occlusion culling each is an indirect draw, recorded in
+    // both phases, that the GPU may give no instance: see occlusionStats)
+    uint32_t draws = 0;
     uint64_t triangles = 0;       // this frame
     uint32_t shadowDraws = 0;     // this frame, into the shadow map
     uint32_t instancesCulled = 0;        // this frame: outside the camera's frustum, not drawn
@@ -196,6 +215,7 @@ private:
     friend GBufferOutputs addGBufferPass(rg::Graph&, GBufferRenderer&, const GBufferInputs&, const GBufferSettings&);
     friend TransparentOutputs addTransparentPass(rg::Graph&, GBufferRenderer&, const TransparentInputs&);
     struct DrawRange;
+    struct SurfaceDraw;
     struct FrameSlot;
     struct FrameWork;
     struct TransparentDraw;
@@ -213,7 +233,25 @@ private:
     // first, calls it.
     void upload(const FrameWork& work);
     void recordShadowMap(const FrameWork& work, rg::PassContext& pc, rg::Texture shadowMap);
-    void record(const FrameWork& work, rg::PassContext& pc, const GBufferOutputs& targets, rg::Texture environment);
+    // Which draws a G-buffer pass records: all of them, direct (no
+    // occlusion culling); indirect from the early or the late cull's
+    // commands. Early clears the targets, late loads them; the sky comes
+    // last (Direct and Late).
+    enum class SurfacePhase : uint8_t { Direct, Early, Late };
+    void record(const FrameWork& work, rg::PassContext& pc, const GBufferOutputs& targets, rg::Texture environment,
+                SurfacePhase phase, rg::Buffer args);
+    // passes/gbuffer_occlusion.cpp: the cull's pipelines, the frame's cull
+    // inputs (in prepare), and its passes around the G-buffer's.
+    void createOcclusionPipelines();
+    void prepareOcclusion(FrameWork& work) const;
+    struct OcclusionHandles {
+        rg::HistoryBuffer visibility;
+        rg::Buffer earlyArgs, lateArgs, stats;
+    };
+    OcclusionHandles addEarlyCull(rg::Graph& graph, const std::shared_ptr<FrameWork>& work);
+    rg::Buffer addLateCull(rg::Graph& graph, const std::shared_ptr<FrameWork>& work, const GBufferOutputs& early,
+                           OcclusionHandles& handles);
+    void uploadOnce(const FrameWork& work);
     // passes/transparent.cpp: the blended geometries of the instances `work`
     // draws, farthest first; then their draws into `layer` (cleared) over
     // the G-buffer's depth.
@@ -253,6 +291,12 @@ private:
     gpu::Pipeline skyPipeline_;
     gpu::Pipeline shadowPipeline_;
     gpu::Pipeline shadowMaskedPipeline_;   // the same test in the shadow map (shadow_masked.frag)
+    // Occlusion culling (passes/gbuffer_occlusion.cpp): the depth pyramid's
+    // two passes and the cull's two phases.
+    gpu::Pipeline hizBasePipeline_;
+    gpu::Pipeline hizDownPipeline_;
+    gpu::Pipeline cullEarlyPipeline_;
+    gpu::Pipeline cullLatePipeline_;
     // glTF alphaMode BLEND, forward-lit and blended (transparent.frag);
     // created with the first blended geometry.
     gpu::Pipeline transparentPipeline_;

@@ -11,10 +11,12 @@
 #include "glint/scene/scene.h"
 
 #include "glint/gbuffer_shared.h"
+#include "glint/occlusion_shared.h"
 
 #include <array>
 #include <cstdint>
 #include <limits>
+#include <mutex>
 #include <vector>
 
 namespace glint::passes::gbuffer_detail {
@@ -136,6 +138,18 @@ struct GBufferRenderer::FrameSlot {
     gpu::Buffer instances;
     gpu::Buffer joints;
     gpu::Buffer previousJoints;
+    // The occlusion cull's inputs (FrameWork::occlusionInstances, ::draws).
+    gpu::Buffer occlusionInstances;
+    gpu::Buffer occlusionDraws;
+};
+
+// One draw of the G-buffer: an opaque or alpha-tested geometry of an
+// instance in the frustum. Recorded in this order, opaque ones first; with
+// occlusion culling it is also the index of its indirect command.
+struct GBufferRenderer::SurfaceDraw {
+    uint32_t instance = 0;
+    const DrawRange* range = nullptr;
+    bool masked = false;
 };
 
 // What one frame draws, copied from the scene and camera at declaration.
@@ -160,6 +174,18 @@ struct GBufferRenderer::FrameWork {
     // shared vertex buffer).
     std::vector<shader::GBufferVertex> morphedVertices;
     std::vector<int64_t> morphedFirstVertex;
+    // What the G-buffer draws, in order (opaque, then alpha-tested).
+    std::vector<SurfaceDraw> draws;
+    // Occlusion culling (GBufferSettings::occlusionCulling): per instance
+    // its grown bounds and whether it has draws; per draw its index range.
+    bool occlusionCulling = false;
+    // Draws the scene would have with every instance in the frustum: the
+    // size of the cull's command buffers, the same every frame.
+    uint32_t drawCapacity = 0;
+    std::vector<shader::OcclusionInstance> occlusionInstances;
+    std::vector<shader::OcclusionDraw> occlusionDraws;
+    // The first pass to record uploads the host buffers (upload()).
+    mutable std::once_flag uploaded;
 };
 
 } // namespace glint::passes

@@ -227,6 +227,7 @@ std::string toScaleJson(const RunInfo& info, std::span<const ScaleRow> rows) {
                         {"passes", passes},
                         {"draws", r.draws},
                         {"triangles_drawn", r.trianglesDrawn},
+                        {"instances_occluded", r.instancesOccluded},
                         {"tlas_instances", r.tlasInstances},
                         {"reference_frames", r.referenceFrames}});
     }

@@ -182,7 +182,10 @@ struct ScaleRow {
     // JSON only: per-pass times (median, ms) and the raster work culling left.
     std::vector<std::pair<std::string, double>> passes;
     uint32_t draws = 0;
+    // Triangles the G-buffer drew (with occlusion culling: what the GPU's
+    // cull left), and the instances in the frustum it found hidden.
     uint64_t trianglesDrawn = 0;
+    uint32_t instancesOccluded = 0;
     uint32_t tlasInstances = 0;
     uint32_t referenceFrames = 0;
 };

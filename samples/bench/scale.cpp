@@ -3,6 +3,8 @@
 #include "bench/measure.h"
 #include "glint/scene/error.h"
 
+#include "glint/occlusion_shared.h"
+
 #include <spdlog/spdlog.h>
 
 #include <algorithm>
@@ -77,6 +79,10 @@ std::vector<ScaleRow> runScale(gpu::Context& ctx, const ScaleSettings& settings)
             for (const app::PassTime& p : result.passes) row.passes.emplace_back(p.name, p.milliseconds);
             row.draws = result.gbuffer.draws;
             row.trianglesDrawn = result.gbuffer.triangles;
+            if (!result.occlusion.empty()) {
+                row.trianglesDrawn = result.occlusion[shader::kOcclusionStatTriangles];
+                row.instancesOccluded = result.occlusion[shader::kOcclusionStatOccluded];
+            }
             row.tlasInstances = result.tlasInstances;
             row.referenceFrames = reference.result.framesRun;
             spdlog::info("  {}: reflections {:.3f} ms (span {:.3f} ms), total {:.2f} ms, {} RT rays, FLIP {:.4f} "

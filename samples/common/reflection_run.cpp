@@ -7,6 +7,7 @@
 #include "glint/graph/verify.h"
 #include "glint/scene/animation.h"
 
+#include "glint/occlusion_shared.h"
 #include "glint/reflection_frame_shared.h"
 
 #include <nlohmann/json.hpp>
@@ -59,7 +60,7 @@ constexpr std::array<bool, 3> kEveryMode{true, true, true};
 
 // The one table of parameters: name, field, the viewer's range, the
 // bench's sweep, and where the value lives.
-const std::array<ParameterSlot, 23> kParameters = {{
+const std::array<ParameterSlot, 24> kParameters = {{
     // A confidence; the talk's 0.9 (default) bracketed from "trust SSLR
     // often" to "almost never".
     {{"sslr_threshold", "ReflectionFrameSettings::confidenceThreshold", 0.0f, 1.0f, false, {0.5, 0.7, 0.8, 0.95, 0.99},
@@ -104,6 +105,8 @@ const std::array<ParameterSlot, 23> kParameters = {{
      [](ReflectionRunOptions& o) { return &o.frame.reach; }, nullptr},
     {{"frustum_culling", "GBufferSettings::frustumCulling (0 or 1)", 0.0f, 1.0f, true, {}, {}, {}}, nullptr, nullptr,
      [](ReflectionRunOptions& o) { return &o.frame.gbuffer.frustumCulling; }},
+    {{"occlusion_culling", "GBufferSettings::occlusionCulling (0 or 1)", 0.0f, 1.0f, true, {}, {}, {}}, nullptr,
+     nullptr, [](ReflectionRunOptions& o) { return &o.frame.gbuffer.occlusionCulling; }},
     // Half-rate RT on a checkerboard (default off).
     {{"rt_checkerboard", "RayGenerationSettings::checkerboard (0 or 1)", 0.0f, 1.0f, true, {1}, {1}, kTraced}, nullptr,
      nullptr, [](ReflectionRunOptions& o) { return &o.frame.rays.checkerboard; }},
@@ -341,6 +344,8 @@ ReflectionRunResult runReflections(gpu::Context& ctx, scene::Scene& scene, const
     const uint32_t w = options.width, h = options.height;
     const rg::HostReadback image(ctx, VkDeviceSize(w) * h * 4, "readback.output");
     const rg::HostReadback counts(ctx, shader::kReflectionCountWords * 4u, "readback.counts");
+    const rg::HostReadback occlusion(ctx, shader::kOcclusionStatWords * 4u, "readback.occlusion");
+    bool occlusionRead = false;
     std::optional<rg::HostReadback> resolved, roughness;
     const bool captures = !options.captureFrames.empty();
     if (reference || options.readResolved || captures) {
@@ -433,6 +438,8 @@ ReflectionRunResult runReflections(gpu::Context& ctx, scene::Scene& scene, const
         if (last) {
             image.copy(graph, resources, frame.output.color);
             counts.copy(graph, resources, frame.counts);
+            occlusionRead = frame.gbuffer.occlusionStats.valid();
+            if (occlusionRead) occlusion.copy(graph, resources, frame.gbuffer.occlusionStats);
         }
         if (check || (last && options.readResolved) || capture) {
             resolved->copy(graph, resources, frame.temporal.resolved);
@@ -562,6 +569,10 @@ ReflectionRunResult runReflections(gpu::Context& ctx, scene::Scene& scene, const
     result.rtRays = words[shader::kCountRtRays];
     result.tlasInstances = result.mode == passes::ReflectionMode::Ssr ? 0 : renderer.bvhGpuStats().tlasInstances;
     result.gbuffer = renderer.gbufferStats();
+    if (occlusionRead) {
+        const auto cull = occlusion.as<uint32_t>();
+        result.occlusion.assign(cull.begin(), cull.begin() + shader::kOcclusionStatWords);
+    }
     return result;
 }
 
@@ -622,6 +633,16 @@ std::string statsJson(const gpu::Context& ctx, const ReflectionRunOptions& optio
                    {"instances_culled", r.gbuffer.instancesCulled},
                    {"shadow_draws", r.gbuffer.shadowDraws},
                    {"shadow_instances_culled", r.gbuffer.shadowInstancesCulled}};
+    // With occlusion culling (GBufferSettings::occlusionCulling), what the
+    // GPU drew of those draws: instances drawn early (visible last frame)
+    // and late (newly visible), those in the frustum drawn in neither, and
+    // the triangles drawn.
+    if (!r.occlusion.empty()) {
+        j["raster"]["occlusion"] = {{"instances_early", r.occlusion[shader::kOcclusionStatEarly]},
+                                    {"instances_late", r.occlusion[shader::kOcclusionStatLate]},
+                                    {"instances_occluded", r.occlusion[shader::kOcclusionStatOccluded]},
+                                    {"triangles_drawn", r.occlusion[shader::kOcclusionStatTriangles]}};
+    }
     return j.dump(2) + "\n";
 }
 

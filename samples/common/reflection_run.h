@@ -132,6 +132,9 @@ struct ReflectionRunResult {
     uint64_t planReuses = 0;
     uint32_t tlasInstances = 0;
     passes::GBufferStats gbuffer;  // the last frame's
+    // The last frame's occlusion cull (shader::kOcclusionStat* words;
+    // empty with occlusion culling off).
+    std::vector<uint32_t> occlusion;
     passes::RtBackend backend = passes::RtBackend::Auto;
     // The mode the frames were declared in: the options' own, or ssr on a
     // device without ray tracing (passes::ReflectionRenderer::tracesRays).
