@@ -343,7 +343,12 @@ std::shared_ptr<GBufferRenderer::FrameWork> GBufferRenderer::prepare(const GBuff
             work->drawCapacity += range.indexCount != 0 && range.coverage != Coverage::Blended ? 1u : 0u;
         }
     }
-    work->occlusionCulling = settings.occlusionCulling;
+    // One instance in view cannot be hidden by another: then the cull's
+    // passes would cost and skip nothing (a single glTF model).
+    const bool severalInstances =
+        std::any_of(work->draws.begin(), work->draws.end(),
+                    [&](const SurfaceDraw& d) { return d.instance != work->draws.front().instance; });
+    work->occlusionCulling = settings.occlusionCulling && severalInstances;
     if (work->occlusionCulling) prepareOcclusion(*work);
     work->joints = scene_.jointMatrices;
     work->previousJoints = scene_.previousJointMatrices;

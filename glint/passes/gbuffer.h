@@ -142,8 +142,9 @@ struct GBufferSettings {
     // visible are drawn over ("gbuffer.late"). An instance is skipped only
     // where its bounds lie wholly behind what is drawn, so the image is the
     // same as without; only the raster work differs. It tests what the
-    // frustum test leaves (every instance with frustumCulling off); the
-    // shadow map is not occlusion culled.
+    // frustum test leaves (every instance with frustumCulling off), and
+    // runs only where that is two instances or more (one cannot hide
+    // behind itself); the shadow map is not occlusion culled.
     bool occlusionCulling = true;
 };
 

@@ -90,7 +90,7 @@ private:
 // Runs the G-buffer over `frames` (one frame each, waiting for each) and
 // returns the last frame's targets; `stats` gets the renderer's counts and
 // `occlusion` the last frame's occlusion cull counts (shader::kOcclusionStat*;
-// left as it is with occlusion culling off).
+// empty where the cull did not run).
 inline GBufferImage render(test::GpuTest& gpu, const scene::Scene& scene, const std::vector<scene::Camera>& frames,
                            passes::GBufferStats* stats = nullptr, const passes::GBufferSettings& settings = {},
                            std::vector<uint32_t>* occlusion = nullptr) {
@@ -99,12 +99,14 @@ inline GBufferImage render(test::GpuTest& gpu, const scene::Scene& scene, const 
     passes::GBufferRenderer renderer(ctx, scene);
     Readback readback(ctx, frames.front().resolution.x, frames.front().resolution.y);
     const rg::HostReadback occlusionCounts(ctx, shader::kOcclusionStatWords * 4u, "gbuffer_test.occlusion");
+    bool culled = false;  // the last frame ran the occlusion cull
     for (const scene::Camera& camera : frames) {
         rg::Graph graph(executor.queueCaps());
         rg::FrameResources resources;
         const passes::GBufferOutputs gbuf = passes::addGBufferPass(graph, renderer, {camera}, settings);
         readback.add(graph, gbuf, resources);
-        if (gbuf.occlusionStats.valid()) occlusionCounts.copy(graph, resources, gbuf.occlusionStats);
+        culled = gbuf.occlusionStats.valid();
+        if (culled) occlusionCounts.copy(graph, resources, gbuf.occlusionStats);
         const rg::Plan plan = graph.compile(executor.compileOptions());
         const auto report = rg::verify(plan);
         REQUIRE_MESSAGE(report.ok(), report.text());
@@ -113,8 +115,9 @@ inline GBufferImage render(test::GpuTest& gpu, const scene::Scene& scene, const 
     }
     if (stats) *stats = renderer.stats();
     if (occlusion) {
+        occlusion->clear();
         const auto words = occlusionCounts.as<uint32_t>();
-        occlusion->assign(words.begin(), words.begin() + shader::kOcclusionStatWords);
+        if (culled) occlusion->assign(words.begin(), words.begin() + shader::kOcclusionStatWords);
     }
     return readback.decode();
 }

@@ -148,3 +148,22 @@ TEST_CASE("a box that comes out from behind the wall is drawn the frame it does"
     const gbuffer_test::GBufferImage empty = gbuffer_test::render(gpu, without, path, nullptr, withCull(true));
     CHECK(culled.depth != empty.depth);
 }
+
+TEST_CASE("with one instance in view the cull does not run: nothing could hide behind it") {
+    test::GpuTest gpu;
+    scene::Scene scene = wallScene();
+    scene.instances.resize(2);  // the floor and the wall
+    scene::prepareScene(scene);
+    std::vector<uint32_t> counts;
+    // Looking 45 degrees up from 3 m, only the wall's top is in view.
+    scene::Camera camera = test::testCamera({0.0f, 3.0f, 0.0f});
+    camera.reset({{0.0f, 3.0f, 0.0f}, {0.0f, 4.0f, -1.0f}, {0, 1, 0}}, 0);
+    passes::GBufferStats stats;
+    gbuffer_test::render(gpu, scene, {camera, camera}, &stats, withCull(true), &counts);
+    CHECK(stats.instancesCulled == 1u);
+    CHECK(counts.empty());
+    // Both in view: it runs.
+    gbuffer_test::render(gpu, scene, {test::testCamera({0.0f, 1.0f, 0.0f})}, &stats, withCull(true), &counts);
+    CHECK(stats.instancesCulled == 0u);
+    CHECK(counts.size() == shader::kOcclusionStatWords);
+}
