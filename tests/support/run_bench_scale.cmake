@@ -1,8 +1,8 @@
 # Runs glint-bench --scale (BENCH) small: two sizes of a coarse city, tiny
 # and short, validation on, writing CSV, JSON and plot under OUT. Checks the
 # exit code, the files, the CSV header, a row per size and mode with both
-# reflection times, the instanced triangles growing with the size, and the
-# JSON's per-pass times.
+# reflection times, the instanced triangles growing with the size, the
+# JSON's per-pass times and the occlusion cull's counts.
 cmake_policy(SET CMP0054 NEW)
 file(REMOVE ${OUT}/scale.csv ${OUT}/scale.json ${OUT}/scale.png)
 execute_process(COMMAND ${BENCH} --validate --scale 16,32 --scene city:triangles=2000 --size 64x36 --frames 3
@@ -52,4 +52,15 @@ string(JSON ms ERROR_VARIABLE err GET "${json}" rows 0 passes gbuffer)
 if(err)
   message(FATAL_ERROR "${OUT}/scale.json: no per-pass times: ${err}")
 endif()
-message(STATUS "glint-bench --scale: ${small} and ${large} instanced triangles")
+# The G-buffer's occlusion cull ran: the triangles it drew are counted on
+# the GPU, and they are no more than the instanced triangles.
+string(JSON drawn ERROR_VARIABLE err GET "${json}" rows 5 triangles_drawn)
+string(JSON occluded ERROR_VARIABLE err2 GET "${json}" rows 5 instances_occluded)
+if(err OR err2)
+  message(FATAL_ERROR "${OUT}/scale.json: no occlusion counts: ${err} ${err2}")
+endif()
+if(drawn GREATER large)
+  message(FATAL_ERROR "${OUT}/scale.json: ${drawn} triangles drawn of ${large}")
+endif()
+message(STATUS "glint-bench --scale: ${small} and ${large} instanced triangles, ${drawn} drawn at 32 instances "
+               "(${occluded} instances occluded)")
