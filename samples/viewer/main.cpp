@@ -34,6 +34,7 @@
 #include "swapchain.h"
 #include "viewer_model.h"
 
+#include "glint/occlusion_shared.h"
 #include "glint/reflection_frame_shared.h"
 
 #define GLFW_INCLUDE_NONE
@@ -139,6 +140,8 @@ struct RayCounts {
     uint32_t sslrRays = 0;
     uint32_t rtRays = 0;
     bool valid = false;
+    // The G-buffer's occlusion cull (shader::kOcclusionStat*), where it ran.
+    std::optional<std::array<uint32_t, shader::kOcclusionStatWords>> occlusion;
 };
 
 // Per frame in flight: the acquire semaphore and the count readback.
@@ -148,7 +151,9 @@ struct FrameSlot {
     // after the executor was replaced (the device was idle then).
     std::optional<rg::SubmittedFrame> submitted;
     gpu::Buffer counts;
+    gpu::Buffer occlusion;
     bool countsPending = false;
+    bool occlusionPending = false;
 };
 
 class Viewer {
@@ -175,6 +180,8 @@ public:
             ctx_.setName(semaphore, VK_OBJECT_TYPE_SEMAPHORE, "viewer.acquired" + std::to_string(i));
             slot->counts = gpu::Buffer(ctx_, {shader::kReflectionCountWords * 4u, VK_BUFFER_USAGE_TRANSFER_DST_BIT,
                                               gpu::MemoryUsage::Readback, "viewer.counts" + std::to_string(i)});
+            slot->occlusion = gpu::Buffer(ctx_, {shader::kOcclusionStatWords * 4u, VK_BUFFER_USAGE_TRANSFER_DST_BIT,
+                                                 gpu::MemoryUsage::Readback, "viewer.occlusion" + std::to_string(i)});
             slots_.push_back(std::move(slot));
         }
         imgui_ = std::make_unique<viewer::ImGuiLayer>(ctx_, window_.handle(), swapchain_.copyFormat(),
@@ -255,6 +262,11 @@ private:
         counts_.sslrRays = words[shader::kCountSslrRays];
         counts_.rtRays = words[shader::kCountRtRays];
         counts_.valid = true;
+        counts_.occlusion.reset();
+        if (slot.occlusionPending) {
+            counts_.occlusion.emplace();
+            std::memcpy(counts_.occlusion->data(), slot.occlusion.mapped(), sizeof *counts_.occlusion);
+        }
     }
 
     void recreateSwapchain(VkExtent2D size) {
@@ -548,6 +560,11 @@ private:
                 for (uint32_t c = 0; c < shader::kPixelClassCount; ++c) {
                     ImGui::Text("  %-7s %5.1f %%", names[c], 100.0 * counts_.pixelClasses[c] / pixels);
                 }
+                if (const auto& o = counts_.occlusion) {
+                    ImGui::Text("G-buffer: %u instances drawn early, %u late, %u occluded; %u triangles",
+                                (*o)[shader::kOcclusionStatEarly], (*o)[shader::kOcclusionStatLate],
+                                (*o)[shader::kOcclusionStatOccluded], (*o)[shader::kOcclusionStatTriangles]);
+                }
             }
         }
 
@@ -663,6 +680,13 @@ private:
         if (viewerPasses.compose.valid()) resources.bind(viewerPasses.compose, *compose_);
         if (settings.countRays) {
             resources.bind(viewer::addCountsReadback(graph, reflections.counts, slot.counts.size()), slot.counts);
+        }
+        const rg::Buffer occlusion = reflections.gbuffer.occlusionStats;
+        slot.occlusionPending = settings.countRays && occlusion.valid();
+        if (slot.occlusionPending) {
+            resources.bind(
+                viewer::addCountsReadback(graph, occlusion, slot.occlusion.size(), "viewer.occlusion_counts"),
+                slot.occlusion);
         }
         // A frame of an earlier frame's shape reuses that frame's plan.
         const rg::Plan& plan = planCache_.compile(graph, executor_->compileOptions());

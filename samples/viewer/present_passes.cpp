@@ -91,9 +91,9 @@ ViewerPasses addViewerPasses(rg::Graph& graph, const ViewerPassesInputs& in) {
     return out;
 }
 
-rg::Buffer addCountsReadback(rg::Graph& graph, rg::Buffer counts, uint64_t bytes) {
-    const rg::Buffer imported = graph.importBuffer(
-        "viewer.counts", {{bytes}, rg::BoundaryState::of(rg::Access::TransferDst), kHostRead});
+rg::Buffer addCountsReadback(rg::Graph& graph, rg::Buffer counts, uint64_t bytes, std::string_view name) {
+    const rg::Buffer imported =
+        graph.importBuffer(name, {{bytes}, rg::BoundaryState::of(rg::Access::TransferDst), kHostRead});
     struct CopyData {
         rg::Buffer source, target;
     };

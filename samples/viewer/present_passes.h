@@ -22,6 +22,7 @@
 #include <vulkan/vulkan.h>
 
 #include <functional>
+#include <string_view>
 
 namespace glint::viewer {
 
@@ -49,9 +50,11 @@ struct ViewerPasses {
 
 ViewerPasses addViewerPasses(rg::Graph& graph, const ViewerPassesInputs& in);
 
-// Copies `counts` (ReflectionFrame::counts) into an imported host-visible
-// buffer of `bytes`, readable on the host once the frame is complete.
-// Returns the import, for FrameResources::bind.
-rg::Buffer addCountsReadback(rg::Graph& graph, rg::Buffer counts, uint64_t bytes);
+// Copies `counts` (ReflectionFrame::counts, or the G-buffer's occlusion
+// counts) into an imported host-visible buffer of `bytes` named `name`,
+// readable on the host once the frame is complete. Returns the import, for
+// FrameResources::bind.
+rg::Buffer addCountsReadback(rg::Graph& graph, rg::Buffer counts, uint64_t bytes,
+                             std::string_view name = "viewer.counts");
 
 } // namespace glint::viewer
