@@ -119,7 +119,6 @@ GBufferRenderer::OcclusionHandles GBufferRenderer::addEarlyCull(rg::Graph& graph
     shader::OcclusionConstants constants{};
     constants.drawCount = draws;
     constants.instanceCount = instances;
-    constants.phase = shader::kOcclusionPhaseEarly;
     const CullBuffers& early = graph.addPass<CullBuffers>(
         "gbuffer.cull_early", rg::Queue::Graphics,
         [&](rg::Builder& b, CullBuffers& d) {
@@ -155,7 +154,6 @@ rg::Buffer GBufferRenderer::addLateCull(rg::Graph& graph, const std::shared_ptr<
         const uint32_t end = std::min(mips, first + shader::kHizLevelsPerPass);
         shader::HizConstants constants{};
         const uint32_t sourceLevel = first - 1;  // pass > 0
-        constants.sourceSize = pass == 0 ? screen : shader::hizLevelSize(base, sourceLevel);
         constants.sourceValid = pass == 0 ? screen : shader::hizValidSize(screen, sourceLevel);
         constants.outputs = end - first;
         for (uint32_t o = 0; o < constants.outputs; ++o) constants.outputSize[o] = shader::hizLevelSize(base, first + o);
@@ -208,11 +206,9 @@ rg::Buffer GBufferRenderer::addLateCull(rg::Graph& graph, const std::shared_ptr<
     shader::OcclusionConstants constants{};
     constants.viewProjection = work->frame.jitteredViewProjection;
     constants.screenSize = screen;
-    constants.hizSize = base;
     constants.hizMips = mips;
     constants.drawCount = uint32_t(work->occlusionDraws.size());
     constants.instanceCount = uint32_t(work->occlusionInstances.size());
-    constants.phase = shader::kOcclusionPhaseLate;
     const uint64_t argsBytes = uint64_t(std::max(work->drawCapacity, 1u)) * sizeof(VkDrawIndexedIndirectCommand);
     struct LateData : CullBuffers {
         rg::Texture hiz;

@@ -14,7 +14,7 @@
 
 #include "glint/occlusion_shared.h"
 
-layout(local_size_x = 64) in;
+layout(local_size_x = kOcclusionGroupSize) in;
 
 layout(set = 0, binding = 0, scalar) readonly buffer Draws { OcclusionDraw draws[]; };
 layout(set = 0, binding = 1, scalar) readonly buffer Previous { uint previous[]; };
@@ -70,8 +70,11 @@ bool visible(OcclusionInstance inst) {
     const vec2 pixelHi = (hi * 0.5 + 0.5) * size;
     // Wholly beside the screen (a pixel of margin): it covers no pixel centre.
     if (pixelHi.x < -1.0 || pixelHi.y < -1.0 || pixelLo.x > size.x + 1.0 || pixelLo.y > size.y + 1.0) return false;
-    const uvec2 first = uvec2(clamp(floor(pixelLo), vec2(0.0), size - 1.0));
-    const uvec2 last = uvec2(clamp(floor(pixelHi), vec2(0.0), size - 1.0));
+    // The pixels whose centres the rectangle holds, and half a pixel more
+    // on each side: the rasterizer snaps vertices to its own sub-pixel
+    // grid, and a pixel the test did not look at could show the box.
+    const uvec2 first = uvec2(clamp(floor(pixelLo - 0.5), vec2(0.0), size - 1.0));
+    const uvec2 last = uvec2(clamp(floor(pixelHi + 0.5), vec2(0.0), size - 1.0));
     const uint level = hizTestLevel(first, last, pc.hizMips);
     if (level >= pc.hizMips) return true;
     const uint shift = level + 1u;

@@ -54,23 +54,22 @@ struct OcclusionDraw {
     int vertexOffset;
 };
 
-// Push constants of occlusion_cull.comp (96 bytes).
+// Push constants of occlusion_early.comp and occlusion_late.comp (88
+// bytes; the early phase reads only the counts).
 struct OcclusionConstants {
     mat4 viewProjection;  // the jittered one the G-buffer draws with
     uvec2 screenSize;
-    uvec2 hizSize;        // level 0
     uint hizMips;
     uint drawCount;
     uint instanceCount;
-    uint phase;           // kOcclusionPhaseEarly or kOcclusionPhaseLate
+    uint pad;
 };
-GLINT_CONST uint kOcclusionPhaseEarly = 0u;
-GLINT_CONST uint kOcclusionPhaseLate = 1u;
 
-// Push constants of hiz.comp (64 bytes).
+// Push constants of hiz_base.comp and hiz_down.comp (56 bytes).
 struct HizConstants {
-    uvec2 sourceSize;   // texels of the source (the depth, or a level)
-    uvec2 sourceValid;  // of them, those the screen covers; the rest read as 1
+    // Texels of the source (the depth, or level 4) that the screen
+    // reaches; the rest read as 1.
+    uvec2 sourceValid;
     uvec2 outputSize[5];
     uint outputs;       // levels written (the rest of the bindings are stand-ins)
     uint pad;
@@ -119,8 +118,8 @@ GLINT_END
 #ifdef __cplusplus
 static_assert(sizeof(glint::shader::OcclusionInstance) == 32);
 static_assert(sizeof(glint::shader::OcclusionDraw) == 16);
-static_assert(sizeof(glint::shader::OcclusionConstants) == 96);
-static_assert(sizeof(glint::shader::HizConstants) == 64);
+static_assert(sizeof(glint::shader::OcclusionConstants) == 88);
+static_assert(sizeof(glint::shader::HizConstants) == 56);
 #endif
 
 #endif
