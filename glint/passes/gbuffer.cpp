@@ -304,8 +304,13 @@ std::shared_ptr<GBufferRenderer::FrameWork> GBufferRenderer::prepare(const GBuff
         // Culled instances keep their slot (the shaders index instances by
         // scene order), they only get no draws.
         bool drawn = true, casts = f.shadow.enabled != 0;
+        // The frustum test and the occlusion cull share one bounds per
+        // instance (skinned ones span their whole palette).
+        if (settings.frustumCulling || settings.occlusionCulling) {
+            work->bounds.push_back(scene::instanceBounds(scene_, inst));
+        }
         if (settings.frustumCulling) {
-            const scene::Aabb bounds = scene::instanceBounds(scene_, inst);
+            const scene::Aabb& bounds = work->bounds.back();
             drawn = view.intersects(bounds);
             casts = casts && sun.intersects(bounds);
             stats_.instancesCulled += drawn ? 0u : 1u;
@@ -326,21 +331,17 @@ std::shared_ptr<GBufferRenderer::FrameWork> GBufferRenderer::prepare(const GBuff
         work->meshes.push_back(inst.mesh);
     }
     // The draws, in the order record() issues them: opaque geometry, then
-    // alpha-tested (blended geometry is the transparent pass's).
+    // alpha-tested (blended geometry is the transparent pass's); those of
+    // instances outside the frustum count towards the capacity only.
     for (const bool masked : {false, true}) {
         for (size_t i = 0; i < work->instances.size(); ++i) {
-            if (!work->visible[i]) continue;
             for (const DrawRange& range : meshDraws_.at(work->meshes[i])) {
                 if (range.indexCount == 0 || range.coverage != (masked ? Coverage::Masked : Coverage::Opaque)) {
                     continue;
                 }
-                work->draws.push_back({uint32_t(i), &range, masked});
+                ++work->drawCapacity;
+                if (work->visible[i]) work->draws.push_back({uint32_t(i), &range, masked});
             }
-        }
-    }
-    for (const uint32_t mesh : work->meshes) {
-        for (const DrawRange& range : meshDraws_.at(mesh)) {
-            work->drawCapacity += range.indexCount != 0 && range.coverage != Coverage::Blended ? 1u : 0u;
         }
     }
     // One instance in view cannot be hidden by another: then the cull's

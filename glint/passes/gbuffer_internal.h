@@ -162,6 +162,9 @@ struct GBufferRenderer::FrameWork {
     // Per instance: drawn into the G-buffer (its bounds meet the camera's
     // frustum) and into the shadow map (they meet the map's box).
     std::vector<uint8_t> visible;
+    // Per instance its world bounds, where frustum or occlusion culling
+    // asked for them (else empty).
+    std::vector<scene::Aabb> bounds;
     std::vector<uint8_t> castsShadow;
     // Per instance: its transform mirrors (a negative determinant), so its
     // front faces wind clockwise on screen (glTF: the determinant sets the

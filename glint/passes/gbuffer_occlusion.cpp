@@ -79,16 +79,16 @@ void GBufferRenderer::prepareOcclusion(FrameWork& work) const {
     work.occlusionDraws.reserve(work.draws.size());
     for (const SurfaceDraw& draw : work.draws) {
         hasDraws[draw.instance] = 1;
-        const int64_t first = work.morphedFirstVertex[draw.instance];
-        // A morphing instance draws from its own copy of the vertices
-        // (vertexSource): the command carries the same shift.
-        const int32_t shift = first < 0 ? 0 : int32_t(first) - meshFirstVertex_[work.meshes[draw.instance]];
+        // A morphing instance draws from its own copy of the vertices: the
+        // command carries the shift into it (the shift is the same whatever
+        // the slot).
+        const int32_t shift = vertexSource(work, draw.instance, *slots_[work.slot]).second;
         work.occlusionDraws.push_back(
             {draw.instance, draw.range->indexCount, draw.range->firstIndex, draw.range->vertexOffset + shift});
     }
     for (size_t i = 0; i < count; ++i) {
         if (!hasDraws[i]) continue;  // boundsMin.w = 0: no draws, never visible
-        const scene::Aabb bounds = scene::instanceBounds(scene_, scene_.instances[i]);
+        const scene::Aabb& bounds = work.bounds[i];
         shader::OcclusionInstance& out = work.occlusionInstances[i];
         if (bounds.empty()) {
             // Nothing to bound by: a box around everything, which the cull
