@@ -429,11 +429,15 @@ void Executor::prepareHistory(const Plan& plan) {
                 } else {
                     // From every earlier command, as for images: the new
                     // buffer may sit in memory an earlier frame's buffer read.
+                    // The fill's stage is ALL_TRANSFER: the spec puts
+                    // vkCmdFillBuffer in CLEAR, the validation layer 1.3.239
+                    // in COPY (a barrier to CLEAR alone left a WRITE_AFTER_READ
+                    // on the H200); ALL_TRANSFER holds both.
                     gpu::bufferBarrier(cmd, *h->buffers[k], VK_PIPELINE_STAGE_2_ALL_COMMANDS_BIT,
                                        VK_ACCESS_2_MEMORY_READ_BIT | VK_ACCESS_2_MEMORY_WRITE_BIT,
-                                       VK_PIPELINE_STAGE_2_CLEAR_BIT, VK_ACCESS_2_TRANSFER_WRITE_BIT);
+                                       VK_PIPELINE_STAGE_2_ALL_TRANSFER_BIT, VK_ACCESS_2_TRANSFER_WRITE_BIT);
                     vkCmdFillBuffer(cmd, h->buffers[k]->handle(), 0, VK_WHOLE_SIZE, 0);
-                    gpu::bufferBarrier(cmd, *h->buffers[k], VK_PIPELINE_STAGE_2_CLEAR_BIT,
+                    gpu::bufferBarrier(cmd, *h->buffers[k], VK_PIPELINE_STAGE_2_ALL_TRANSFER_BIT,
                                        VK_ACCESS_2_TRANSFER_WRITE_BIT, VK_PIPELINE_STAGE_2_ALL_COMMANDS_BIT,
                                        VK_ACCESS_2_MEMORY_READ_BIT | VK_ACCESS_2_MEMORY_WRITE_BIT);
                 }
