@@ -340,6 +340,7 @@ void Context::createDevice(const ContextOptions& options) {
     caps_.driverVersion = props.driverVersion;
     caps_.timestampPeriodNs = props.limits.timestampPeriod;
     caps_.bufferImageGranularity = props.limits.bufferImageGranularity;
+    caps_.maxDrawIndirectCount = props.limits.maxDrawIndirectCount;
 
     VkPhysicalDeviceAccelerationStructureFeaturesKHR asFeatures{
         VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_ACCELERATION_STRUCTURE_FEATURES_KHR};
@@ -383,6 +384,10 @@ void Context::createDevice(const ContextOptions& options) {
     require(f12.hostQueryReset, "hostQueryReset");
     require(f13.synchronization2, "synchronization2");
     require(f13.dynamicRendering, "dynamicRendering");
+    // The G-buffer draws runs of instances with one multi-draw each, the
+    // instance in each command's firstInstance (passes/gbuffer.cpp).
+    require(features.features.multiDrawIndirect, "multiDrawIndirect");
+    require(features.features.drawIndirectFirstInstance, "drawIndirectFirstInstance");
 
     caps_.accelerationStructure = hasAs && asFeatures.accelerationStructure;
     caps_.rayQuery = hasRq && rqFeatures.rayQuery && caps_.accelerationStructure;
@@ -403,7 +408,8 @@ void Context::createDevice(const ContextOptions& options) {
     enable.features.fragmentStoresAndAtomics = features.features.fragmentStoresAndAtomics;
     enable.features.shaderStorageImageWriteWithoutFormat = features.features.shaderStorageImageWriteWithoutFormat;
     enable.features.shaderStorageImageReadWithoutFormat = features.features.shaderStorageImageReadWithoutFormat;
-    enable.features.multiDrawIndirect = features.features.multiDrawIndirect;
+    enable.features.multiDrawIndirect = VK_TRUE;
+    enable.features.drawIndirectFirstInstance = VK_TRUE;
     enable.features.depthClamp = features.features.depthClamp;
     enable.features.fillModeNonSolid = features.features.fillModeNonSolid;
 

@@ -53,6 +53,17 @@ float quantiseExtent(float extent) {
     return std::ceil(extent / step) * step;
 }
 
+// What a draw binds beyond its ranges: the pipeline (alpha-tested or not),
+// the range's state (material and textures), the vertex buffer (a morphing
+// instance's own copy, or the shared one) and the winding. Draws with the
+// same key are one run, recorded as one multi-draw.
+uint64_t runKey(bool masked, uint32_t state, bool morphed, bool mirrored) {
+    return uint64_t(masked) << 33 | uint64_t(state) << 2 | uint64_t(morphed) << 1 | uint64_t(mirrored);
+}
+
+// Draws fit in the bits below a sort key's run key.
+constexpr uint32_t kDrawIndexBits = 28;
+
 // Colour attachments in the order of the fragment shaders' outputs.
 constexpr std::array<VkFormat, 5> kColorFormats = {kGBufferNormalFormat, kGBufferAlbedoFormat,
                                                    kGBufferRoughnessMetalFormat, kGBufferMotionFormat,
@@ -330,20 +341,31 @@ std::shared_ptr<GBufferRenderer::FrameWork> GBufferRenderer::prepare(const GBuff
         work->instances.push_back(gi);
         work->meshes.push_back(inst.mesh);
     }
-    // The draws, in the order record() issues them: opaque geometry, then
-    // alpha-tested (blended geometry is the transparent pass's); those of
-    // instances outside the frustum count towards the capacity only.
-    for (const bool masked : {false, true}) {
-        for (size_t i = 0; i < work->instances.size(); ++i) {
-            for (const DrawRange& range : meshDraws_.at(work->meshes[i])) {
-                if (range.indexCount == 0 || range.coverage != (masked ? Coverage::Masked : Coverage::Opaque)) {
-                    continue;
-                }
-                ++work->drawCapacity;
-                if (work->visible[i]) work->draws.push_back({uint32_t(i), &range, masked});
-            }
+    // The draws: opaque and alpha-tested geometry (blended geometry is the
+    // transparent pass's); those of instances outside the frustum count
+    // towards the capacity only.
+    std::vector<SurfaceDraw> draws;
+    for (size_t i = 0; i < work->instances.size(); ++i) {
+        for (const DrawRange& range : meshDraws_.at(work->meshes[i])) {
+            if (range.indexCount == 0 || range.coverage == Coverage::Blended) continue;
+            ++work->drawCapacity;
+            if (!work->visible[i]) continue;
+            const bool masked = range.coverage == Coverage::Masked;
+            draws.push_back({uint32_t(i), &range, masked,
+                             runKey(masked, range.state, work->morphedFirstVertex[i] >= 0, work->mirrored[i] != 0)});
         }
     }
+    // In the order record() issues them: by run key (opaque before
+    // alpha-tested), then as found.
+    if (draws.size() >= (size_t(1) << kDrawIndexBits)) {
+        throw gpu::GpuError("G-buffer: " + std::to_string(draws.size()) + " draws in view; at most " +
+                            std::to_string((size_t(1) << kDrawIndexBits) - 1) + " are supported");
+    }
+    std::vector<uint64_t> order(draws.size());
+    for (size_t d = 0; d < draws.size(); ++d) order[d] = draws[d].run << kDrawIndexBits | d;
+    std::sort(order.begin(), order.end());
+    work->draws.reserve(draws.size());
+    for (const uint64_t o : order) work->draws.push_back(draws[o & ((uint64_t(1) << kDrawIndexBits) - 1)]);
     // One instance in view cannot be hidden by another: then the cull's
     // passes would cost and skip nothing (a single glTF model).
     const bool severalInstances =
@@ -516,14 +538,14 @@ void GBufferRenderer::recordShadowMap(const FrameWork& work, rg::PassContext& pc
                         push.push(ctx_, cmd);
                     }
                     shader::GBufferDraw draw{};
-                    draw.instance = uint32_t(i);
                     if (masked) {
                         draw.alphaCutoff = range.material.alphaCutoff;
                         draw.baseColorMap = range.material.baseColorMap;
                         draw.baseColorUvTransform = range.material.baseColorUvTransform;
                     }
                     pipeline.pushConstants(cmd, draw);
-                    vkCmdDrawIndexed(cmd, range.indexCount, 1, range.firstIndex, range.vertexOffset + vertexShift, 0);
+                    vkCmdDrawIndexed(cmd, range.indexCount, 1, range.firstIndex, range.vertexOffset + vertexShift,
+                                     uint32_t(i));
                     ++stats_.shadowDraws;
                 }
             }
@@ -626,6 +648,7 @@ void GBufferRenderer::record(const FrameWork& work, rg::PassContext& pc, const G
     const bool counts = phase != SurfacePhase::Late;
     if (counts) {
         stats_.draws = 0;
+        stats_.runs = 0;
         stats_.triangles = 0;
         stats_.normalMappedDraws = 0;
         stats_.texturedDraws = 0;
@@ -640,10 +663,14 @@ void GBufferRenderer::record(const FrameWork& work, rg::PassContext& pc, const G
     const gpu::Pipeline* bound = nullptr;
     const gpu::Buffer* boundVertices = nullptr;
     MaterialTextures boundTextures = fallbacks;
-    for (size_t d = 0; d < work.draws.size(); ++d) {
-        const SurfaceDraw& draw = work.draws[d];
-        const DrawRange& range = *draw.range;
-        const gpu::Pipeline& pipeline = draw.masked ? surfaceMaskedPipeline_ : surfacePipeline_;
+    const uint32_t maxCommands = std::max(ctx_.caps().maxDrawIndirectCount, 1u);
+    for (size_t begin = 0; begin < work.draws.size();) {
+        // One run: the draws that bind what its first one binds.
+        const SurfaceDraw& first = work.draws[begin];
+        size_t end = begin + 1;
+        while (end < work.draws.size() && work.draws[end].run == first.run) ++end;
+        const DrawRange& range = *first.range;
+        const gpu::Pipeline& pipeline = first.masked ? surfaceMaskedPipeline_ : surfacePipeline_;
         if (&pipeline != bound) {
             bound = &pipeline;
             pipeline.bind(cmd);
@@ -652,8 +679,8 @@ void GBufferRenderer::record(const FrameWork& work, rg::PassContext& pc, const G
             boundTextures = fallbacks;
             pushBindings(pipeline, *boundVertices, boundTextures);
         }
-        const auto [vertices, vertexShift] = vertexSource(work, draw.instance, slot);
-        facing.set(cmd, work.mirrored[draw.instance] != 0, range.doubleSided);
+        const gpu::Buffer* vertices = vertexSource(work, first.instance, slot).first;
+        facing.set(cmd, work.mirrored[first.instance] != 0, range.doubleSided);
         MaterialTextures textures = boundTextures;
         const bool textured = rangeTextures(range, textures);
         if (vertices != boundVertices || textures != boundTextures) {
@@ -661,25 +688,35 @@ void GBufferRenderer::record(const FrameWork& work, rg::PassContext& pc, const G
             boundTextures = textures;
             pushBindings(pipeline, *boundVertices, boundTextures);
         }
-        shader::GBufferDraw constants = range.material;
-        constants.instance = draw.instance;
-        constants.doubleSided = range.doubleSided ? 1u : 0u;
-        pipeline.pushConstants(cmd, constants);
+        pipeline.pushConstants(cmd, range.material);
         if (phase == SurfacePhase::Direct) {
-            vkCmdDrawIndexed(cmd, range.indexCount, 1, range.firstIndex, range.vertexOffset + vertexShift, 0);
+            for (size_t d = begin; d < end; ++d) {
+                const SurfaceDraw& draw = work.draws[d];
+                const int32_t vertexShift = vertexSource(work, draw.instance, slot).second;
+                vkCmdDrawIndexed(cmd, draw.range->indexCount, 1, draw.range->firstIndex,
+                                 draw.range->vertexOffset + vertexShift, draw.instance);
+            }
         } else {
-            // The cull's command for this draw: the same range, with 0 or 1
-            // instances.
-            vkCmdDrawIndexedIndirect(cmd, indirect, d * sizeof(VkDrawIndexedIndirectCommand), 1,
-                                     sizeof(VkDrawIndexedIndirectCommand));
+            // The cull's commands for these draws: the same ranges, with 0
+            // or 1 instances.
+            for (size_t d = begin; d < end; d += maxCommands) {
+                vkCmdDrawIndexedIndirect(cmd, indirect, d * sizeof(VkDrawIndexedIndirectCommand),
+                                         uint32_t(std::min<size_t>(end - d, maxCommands)),
+                                         sizeof(VkDrawIndexedIndirectCommand));
+            }
         }
         if (counts) {
-            stats_.normalMappedDraws += range.material.normalMap != 0 ? 1u : 0u;
-            stats_.texturedDraws += textured ? 1u : 0u;
-            stats_.maskedDraws += draw.masked ? 1u : 0u;
-            ++stats_.draws;
-            stats_.triangles += range.indexCount / 3;
+            ++stats_.runs;
+            for (size_t d = begin; d < end; ++d) {
+                const DrawRange& r = *work.draws[d].range;
+                stats_.normalMappedDraws += r.material.normalMap != 0 ? 1u : 0u;
+                stats_.texturedDraws += textured ? 1u : 0u;
+                stats_.maskedDraws += first.masked ? 1u : 0u;
+                ++stats_.draws;
+                stats_.triangles += r.indexCount / 3;
+            }
         }
+        begin = end;
     }
     if (work.drawSky && phase != SurfacePhase::Early) {
         skyPipeline_.bind(cmd);

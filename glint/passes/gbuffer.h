@@ -173,6 +173,10 @@ struct GBufferStats {
     // frustum; with occlusion culling each is an indirect draw, recorded in
     // both phases, that the GPU may give no instance: see occlusionStats)
     uint32_t draws = 0;
+    // this frame: the runs they were recorded in (draws binding the same
+    // pipeline, material, textures, vertices and winding: one multi-draw
+    // each with occlusion culling, one push of constants without)
+    uint32_t runs = 0;
     uint64_t triangles = 0;       // this frame
     uint32_t shadowDraws = 0;     // this frame, into the shadow map
     uint32_t instancesCulled = 0;        // this frame: outside the camera's frustum, not drawn

@@ -91,6 +91,7 @@ void GBufferRenderer::loadAssets() {
                 return true;
             };
             shader::GBufferDraw& draw = range.material;
+            draw.doubleSided = range.doubleSided ? 1u : 0u;
             draw.alphaCutoff = range.coverage == Coverage::Masked ? material.alphaCutoff : -1.0f;
             if (useSlot(kNormalSlot, material.normalTexture, VK_FORMAT_R8G8B8A8_UNORM, "normal_map",
                         g.tangents.size() == g.vertexCount(), draw.normalMap, draw.normalUvTransform)) {
@@ -148,6 +149,18 @@ void GBufferRenderer::loadAssets() {
             // Kept for the per-frame morphed copies: materials and skins stay,
             // positions, normals and tangents are replaced.
             morphBaseVertices_[m].assign(vertices.begin() + meshFirstVertex_[m], vertices.end());
+        }
+    }
+    // Ranges that bind the same: one state, drawn together (the frame's
+    // draws are sorted by it; FrameWork::draws).
+    std::map<std::string, uint32_t> states;
+    for (std::vector<DrawRange>& ranges : meshDraws_) {
+        for (DrawRange& range : ranges) {
+            std::string key(reinterpret_cast<const char*>(&range.material), sizeof(range.material));
+            key.append(reinterpret_cast<const char*>(range.image.data()), sizeof(range.image));
+            key.append(reinterpret_cast<const char*>(range.sampler.data()), sizeof(range.sampler));
+            key.push_back(char(range.coverage));
+            range.state = states.emplace(std::move(key), uint32_t(states.size())).first->second;
         }
     }
     // Vulkan buffers cannot be empty; an empty scene still binds something.

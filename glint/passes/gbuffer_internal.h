@@ -112,13 +112,16 @@ struct GBufferRenderer::DrawRange {
     // The geometry's bounds in its mesh's space (the transparent pass sorts
     // by their centres).
     scene::Aabb bounds;
-    // The draw's push constants less the instance; per MaterialSlot the
-    // image (kNoImage: the slot's fallback) and sampler it binds.
+    // The draw's push constants; per MaterialSlot the image (kNoImage: the
+    // slot's fallback) and sampler it binds.
     shader::GBufferDraw material{};
     std::array<size_t, gbuffer_detail::kMaterialSlots> image{gbuffer_detail::kNoImage, gbuffer_detail::kNoImage,
                                                              gbuffer_detail::kNoImage, gbuffer_detail::kNoImage};
     std::array<size_t, gbuffer_detail::kMaterialSlots> sampler{};
     static_assert(gbuffer_detail::kMaterialSlots == kMaterialTextureSlots);
+    // Ranges with equal coverage, material and textures share the number:
+    // the scene's distinct binding states, counted from 0.
+    uint32_t state = 0;
 };
 
 // A blended geometry of one instance, with its distance from the camera
@@ -144,12 +147,16 @@ struct GBufferRenderer::FrameSlot {
 };
 
 // One draw of the G-buffer: an opaque or alpha-tested geometry of an
-// instance in the frustum. Recorded in this order, opaque ones first; with
-// occlusion culling it is also the index of its indirect command.
+// instance in the frustum. FrameWork::draws holds them sorted by `run`, the
+// key of what they bind (gbuffer.cpp, runKey: pipeline, material and
+// textures, vertex buffer, winding), opaque ones first; draws of one key are
+// one run. With occlusion culling its place is also the index of its
+// indirect command, so a run's commands are contiguous: one multi-draw.
 struct GBufferRenderer::SurfaceDraw {
     uint32_t instance = 0;
     const DrawRange* range = nullptr;
     bool masked = false;
+    uint64_t run = 0;
 };
 
 // What one frame draws, copied from the scene and camera at declaration.
@@ -177,7 +184,7 @@ struct GBufferRenderer::FrameWork {
     // shared vertex buffer).
     std::vector<shader::GBufferVertex> morphedVertices;
     std::vector<int64_t> morphedFirstVertex;
-    // What the G-buffer draws, in order (opaque, then alpha-tested).
+    // What the G-buffer draws, in order (SurfaceDraw: by run).
     std::vector<SurfaceDraw> draws;
     // Occlusion culling (GBufferSettings::occlusionCulling): per instance
     // its grown bounds and whether it has draws; per draw its index range.

@@ -90,11 +90,8 @@ void GBufferRenderer::recordTransparent(const FrameWork& work, const std::vector
                 boundTextures = textures;
                 pushSurfaceBindings(pipeline, pc, slot, *boundVertices, boundTextures, gbuf.shadowMap, environment);
             }
-            shader::GBufferDraw draw = range.material;
-            draw.instance = d.instance;
-            draw.doubleSided = range.doubleSided ? 1u : 0u;
-            pipeline.pushConstants(cmd, draw);
-            vkCmdDrawIndexed(cmd, range.indexCount, 1, range.firstIndex, range.vertexOffset + vertexShift, 0);
+            pipeline.pushConstants(cmd, range.material);
+            vkCmdDrawIndexed(cmd, range.indexCount, 1, range.firstIndex, range.vertexOffset + vertexShift, d.instance);
         }
     }
     vkCmdEndRendering(cmd);

@@ -629,6 +629,7 @@ std::string statsJson(const gpu::Context& ctx, const ReflectionRunOptions& optio
     j["bvh"] = {{"blas_built", r.blasBuilt}, {"blas_rebuilt", r.blasRebuilt}, {"tlas_instances", r.tlasInstances}};
     // The last frame's raster work: what frustum culling left to draw.
     j["raster"] = {{"draws", r.gbuffer.draws},
+                   {"runs", r.gbuffer.runs},
                    {"triangles", r.gbuffer.triangles},
                    {"instances_culled", r.gbuffer.instancesCulled},
                    {"shadow_draws", r.gbuffer.shadowDraws},

@@ -587,7 +587,8 @@ private:
                             double(g.poolBytes) / 1048576.0);
             }
             const passes::GBufferStats& gb = renderer_->gbufferStats();
-            ImGui::Text("G-buffer: %u draws, %llu triangles", gb.draws, static_cast<unsigned long long>(gb.triangles));
+            ImGui::Text("G-buffer: %u draws in %u runs, %llu triangles", gb.draws, gb.runs,
+                        static_cast<unsigned long long>(gb.triangles));
         }
         ImGui::End();
     }

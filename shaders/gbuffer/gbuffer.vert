@@ -2,7 +2,7 @@
 // G-buffer geometry: pulls the vertex from the scene's one vertex buffer
 // (gl_VertexIndex includes the draw's vertex offset), skins it with this and
 // last frame's joint palettes, and places it with this and last frame's
-// instance transform, so motion covers camera, rigid, skinned and morph
+// instance transform (the draw's firstInstance is the instance's index), so motion covers camera, rigid, skinned and morph
 // movement (a morphing instance's last-frame copy, previousVertexDelta).
 #extension GL_GOOGLE_include_directive : require
 
@@ -20,7 +20,7 @@ layout(location = 8) out vec3 outEmissive; // glTF units, without the per-pixel 
 
 void main() {
     const GBufferVertex v = vertices[gl_VertexIndex];
-    const GBufferInstance inst = instances[draw.instance];
+    const GBufferInstance inst = instances[gl_InstanceIndex];
     vec3 position = v.position;
     // Last frame's object-space position: a morph moves the vertex itself.
     const vec3 previousBase =

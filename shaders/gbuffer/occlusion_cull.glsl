@@ -41,7 +41,7 @@ void writeArgs(uint draw, OcclusionDraw d, uint instanceCount) {
     args[at + 1u] = instanceCount;
     args[at + 2u] = d.firstIndex;
     args[at + 3u] = uint(d.vertexOffset);
-    args[at + 4u] = 0u;
+    args[at + 4u] = d.instance;  // firstInstance: gbuffer.vert's instance
 }
 
 #if GLINT_OCCLUSION_LATE

@@ -13,7 +13,7 @@ layout(location = 1) out float outAlpha;
 
 void main() {
     const GBufferVertex v = vertices[gl_VertexIndex];
-    const GBufferInstance inst = instances[draw.instance];
+    const GBufferInstance inst = instances[gl_InstanceIndex];
     vec3 position = v.position;
     if (inst.jointCount > 0u) {
         position = (skinMatrix(v, inst, false) * vec4(v.position, 1.0)).xyz;

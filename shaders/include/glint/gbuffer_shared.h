@@ -131,13 +131,15 @@ struct GBufferFrame {
     GBufferShadow shadow;
 };
 
-// Push constants of one draw (124 bytes, within the 128 Vulkan guarantees).
-// Per material texture the draw samples per pixel, its flag holds the
-// texture coordinate set plus one (1: GBufferVertex::uv0, 2: uv1); 0: the
-// slot is not sampled (its 1x1 fallback stays bound, the vertex holds the
-// whole value). The branches on the flags are uniform per draw.
+// Push constants of a run of draws that share a material (124 bytes,
+// within the 128 Vulkan guarantees). The instance is not among them: each
+// draw's firstInstance is its GBufferInstance index (gl_InstanceIndex), so
+// one multi-draw covers many instances. Per material texture the draw
+// samples per pixel, its flag holds the texture coordinate set plus one
+// (1: GBufferVertex::uv0, 2: uv1); 0: the slot is not sampled (its 1x1
+// fallback stays bound, the vertex holds the whole value). The branches on
+// the flags are uniform per draw.
 struct GBufferDraw {
-    uint instance;
     uint doubleSided;     // 1: back faces are lit with the flipped normal
     float normalScale;    // glTF normalTexture.scale
     // Perturb the normal with the normal map (binding 7).
@@ -167,7 +169,7 @@ GLINT_END
 #ifdef __cplusplus
 static_assert(sizeof(glint::shader::GBufferVertex) == 120);
 static_assert(sizeof(glint::shader::GBufferInstance) == 144);
-static_assert(sizeof(glint::shader::GBufferDraw) == 128);  // Vulkan's guaranteed push constant space
+static_assert(sizeof(glint::shader::GBufferDraw) <= 128);  // Vulkan's guaranteed push constant space
 static_assert(sizeof(glint::shader::GBufferShadow) == 112);
 static_assert(sizeof(glint::shader::SceneLighting) == 240);
 #endif
