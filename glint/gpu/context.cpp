@@ -340,7 +340,6 @@ void Context::createDevice(const ContextOptions& options) {
     caps_.driverVersion = props.driverVersion;
     caps_.timestampPeriodNs = props.limits.timestampPeriod;
     caps_.bufferImageGranularity = props.limits.bufferImageGranularity;
-    caps_.maxDrawIndirectCount = props.limits.maxDrawIndirectCount;
 
     VkPhysicalDeviceAccelerationStructureFeaturesKHR asFeatures{
         VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_ACCELERATION_STRUCTURE_FEATURES_KHR};
@@ -384,10 +383,12 @@ void Context::createDevice(const ContextOptions& options) {
     require(f12.hostQueryReset, "hostQueryReset");
     require(f13.synchronization2, "synchronization2");
     require(f13.dynamicRendering, "dynamicRendering");
-    // The G-buffer draws runs of instances with one multi-draw each, the
-    // instance in each command's firstInstance (passes/gbuffer.cpp).
+    // The G-buffer draws runs of instances with multi-draws whose count the
+    // occlusion cull writes, the instance in each command's firstInstance
+    // (passes/gbuffer.cpp).
     require(features.features.multiDrawIndirect, "multiDrawIndirect");
     require(features.features.drawIndirectFirstInstance, "drawIndirectFirstInstance");
+    require(f12.drawIndirectCount, "drawIndirectCount");
 
     caps_.accelerationStructure = hasAs && asFeatures.accelerationStructure;
     caps_.rayQuery = hasRq && rqFeatures.rayQuery && caps_.accelerationStructure;
@@ -419,6 +420,7 @@ void Context::createDevice(const ContextOptions& options) {
     VkPhysicalDeviceVulkan12Features e12{VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_VULKAN_1_2_FEATURES};
     e12.bufferDeviceAddress = VK_TRUE;
     e12.timelineSemaphore = VK_TRUE;
+    e12.drawIndirectCount = VK_TRUE;
     e12.scalarBlockLayout = VK_TRUE;
     e12.hostQueryReset = VK_TRUE;
     e12.descriptorIndexing = f12.descriptorIndexing;

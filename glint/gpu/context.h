@@ -86,7 +86,6 @@ struct Capabilities {
     bool timestamps = false;        // graphics queue can write timestamps
     float timestampPeriodNs = 0.0f; // nanoseconds per tick
     uint64_t bufferImageGranularity = 1;
-    uint32_t maxDrawIndirectCount = 1;  // commands one vkCmdDraw*Indirect may take
     uint32_t maxPushDescriptors = 0;
     uint32_t subgroupSize = 0;
 

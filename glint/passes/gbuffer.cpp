@@ -663,8 +663,11 @@ void GBufferRenderer::record(const FrameWork& work, rg::PassContext& pc, const G
     const gpu::Pipeline* bound = nullptr;
     const gpu::Buffer* boundVertices = nullptr;
     MaterialTextures boundTextures = fallbacks;
-    const uint32_t maxCommands = std::max(ctx_.caps().maxDrawIndirectCount, 1u);
-    for (size_t begin = 0; begin < work.draws.size();) {
+    const uint64_t countsOffset = occlusionCountsOffset(work.argsChunks);
+    constexpr uint32_t chunk = shader::kOcclusionGroupSize;
+    constexpr uint32_t stride = sizeof(VkDrawIndexedIndirectCommand);
+    size_t run = 0;
+    for (size_t begin = 0; begin < work.draws.size(); ++run) {
         // One run: the draws that bind what its first one binds.
         const SurfaceDraw& first = work.draws[begin];
         size_t end = begin + 1;
@@ -697,12 +700,13 @@ void GBufferRenderer::record(const FrameWork& work, rg::PassContext& pc, const G
                                  draw.range->vertexOffset + vertexShift, draw.instance);
             }
         } else {
-            // The cull's commands for these draws: the same ranges, with 0
-            // or 1 instances.
-            for (size_t d = begin; d < end; d += maxCommands) {
-                vkCmdDrawIndexedIndirect(cmd, indirect, d * sizeof(VkDrawIndexedIndirectCommand),
-                                         uint32_t(std::min<size_t>(end - d, maxCommands)),
-                                         sizeof(VkDrawIndexedIndirectCommand));
+            // The run's chunks: the commands the cull kept, and their count.
+            const uint64_t firstSlot = work.runFirstSlot.at(run);
+            const uint64_t endSlot = firstSlot + (end - begin);
+            for (uint64_t s = firstSlot; s < endSlot; s += chunk) {
+                vkCmdDrawIndexedIndirectCount(cmd, indirect, s * stride, indirect,
+                                              countsOffset + s / chunk * sizeof(uint32_t),
+                                              uint32_t(std::min<uint64_t>(endSlot - s, chunk)), stride);
             }
         }
         if (counts) {

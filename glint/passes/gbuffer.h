@@ -322,6 +322,7 @@ private:
     gpu::Buffer vertices_;  // GBufferVertex, every geometry of every mesh's LOD 0
     gpu::Buffer indices_;
     std::vector<std::vector<DrawRange>> meshDraws_;  // per mesh: its LOD-0 geometries
+    uint32_t rangeStates_ = 0;  // distinct DrawRange::state values
     std::vector<int32_t> meshFirstVertex_;           // per mesh: its first vertex in vertices_
     // Per mesh with morph targets: its vertices as uploaded (else empty).
     std::vector<std::vector<shader::GBufferVertex>> morphBaseVertices_;

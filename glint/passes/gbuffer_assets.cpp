@@ -163,6 +163,7 @@ void GBufferRenderer::loadAssets() {
             range.state = states.emplace(std::move(key), uint32_t(states.size())).first->second;
         }
     }
+    rangeStates_ = uint32_t(states.size());
     // Vulkan buffers cannot be empty; an empty scene still binds something.
     if (vertices.empty()) vertices.push_back({});
     if (indices.empty()) indices.push_back(0);

@@ -98,6 +98,15 @@ struct Facing {
     }
 };
 
+// The occlusion cull's command buffers (glint/occlusion_shared.h): the
+// command slots of `chunks` chunks, then one count per chunk.
+inline uint64_t occlusionCountsOffset(uint32_t chunks) {
+    return uint64_t(chunks) * shader::kOcclusionGroupSize * sizeof(VkDrawIndexedIndirectCommand);
+}
+inline uint64_t occlusionArgsBytes(uint32_t chunks) {
+    return occlusionCountsOffset(chunks) + uint64_t(chunks) * sizeof(uint32_t);
+}
+
 } // namespace glint::passes::gbuffer_detail
 
 namespace glint::passes {
@@ -193,7 +202,13 @@ struct GBufferRenderer::FrameWork {
     // size of the cull's command buffers, the same every frame.
     uint32_t drawCapacity = 0;
     std::vector<shader::OcclusionInstance> occlusionInstances;
+    // Per command slot (glint/occlusion_shared.h: each run of draws takes
+    // whole chunks of slots), and per run its first slot.
     std::vector<shader::OcclusionDraw> occlusionDraws;
+    std::vector<uint32_t> runFirstSlot;
+    // The command buffers' chunks, enough for any frame of this scene (so
+    // their size stays), and the word where the chunks' counts begin.
+    uint32_t argsChunks = 0;
     // The first pass to record uploads the host buffers (upload()).
     mutable std::once_flag uploaded;
 };

@@ -12,6 +12,7 @@
 #include "glint/passes/gbuffer_internal.h"
 
 #include "glint/gpu/descriptors.h"
+#include "glint/gpu/error.h"
 #include "glint/graph/executor.h"
 
 #include "glint/occlusion_shared.h"
@@ -76,8 +77,16 @@ void GBufferRenderer::prepareOcclusion(FrameWork& work) const {
     work.occlusionInstances.assign(count, shader::OcclusionInstance{});
     std::vector<uint8_t> hasDraws(count, 0);
     work.occlusionDraws.clear();
-    work.occlusionDraws.reserve(work.draws.size());
-    for (const SurfaceDraw& draw : work.draws) {
+    work.occlusionDraws.reserve(work.draws.size() + shader::kOcclusionGroupSize);
+    work.runFirstSlot.clear();
+    constexpr uint32_t chunk = shader::kOcclusionGroupSize;
+    for (size_t d = 0; d < work.draws.size(); ++d) {
+        const SurfaceDraw& draw = work.draws[d];
+        if (d == 0 || draw.run != work.draws[d - 1].run) {
+            // A run starts a chunk: pad the last one with empty slots.
+            work.occlusionDraws.resize((work.occlusionDraws.size() + chunk - 1) / chunk * chunk);
+            work.runFirstSlot.push_back(uint32_t(work.occlusionDraws.size()));
+        }
         hasDraws[draw.instance] = 1;
         // A morphing instance draws from its own copy of the vertices: the
         // command carries the shift into it (the shift is the same whatever
@@ -85,6 +94,16 @@ void GBufferRenderer::prepareOcclusion(FrameWork& work) const {
         const int32_t shift = vertexSource(work, draw.instance, *slots_[work.slot]).second;
         work.occlusionDraws.push_back(
             {draw.instance, draw.range->indexCount, draw.range->firstIndex, draw.range->vertexOffset + shift});
+    }
+    work.occlusionDraws.resize((work.occlusionDraws.size() + chunk - 1) / chunk * chunk);
+    // A run wastes less than a chunk, and there are at most as many runs as
+    // run keys (a state, morphed or not, mirrored or not) or draws.
+    const uint64_t runs = std::min<uint64_t>(work.drawCapacity, uint64_t(rangeStates_) * 4);
+    work.argsChunks = uint32_t((work.drawCapacity + chunk - 1) / chunk + runs);
+    if (work.occlusionDraws.size() > uint64_t(work.argsChunks) * chunk) {
+        throw gpu::GpuError("G-buffer: the occlusion cull's " + std::to_string(work.occlusionDraws.size()) +
+                            " command slots exceed the " + std::to_string(uint64_t(work.argsChunks) * chunk) +
+                            " it sized for this scene");
     }
     for (size_t i = 0; i < count; ++i) {
         if (!hasDraws[i]) continue;  // boundsMin.w = 0: no draws, never visible
@@ -110,7 +129,7 @@ GBufferRenderer::OcclusionHandles GBufferRenderer::addEarlyCull(rg::Graph& graph
     const uint32_t draws = uint32_t(work->occlusionDraws.size());
     // Sized for every draw the scene can have, so a moving camera keeps
     // one plan (the graph's buffers keep their sizes).
-    const uint64_t argsBytes = uint64_t(std::max(work->drawCapacity, 1u)) * sizeof(VkDrawIndexedIndirectCommand);
+    const uint64_t argsBytes = occlusionArgsBytes(work->argsChunks);
     // A scene with another instance count starts a new (zeroed) pair:
     // nothing drawn early that frame.
     h.visibility = graph.createHistoryBuffer(kVisibilityHistoryName,
@@ -119,6 +138,7 @@ GBufferRenderer::OcclusionHandles GBufferRenderer::addEarlyCull(rg::Graph& graph
     shader::OcclusionConstants constants{};
     constants.drawCount = draws;
     constants.instanceCount = instances;
+    constants.countsAt = uint32_t(occlusionCountsOffset(work->argsChunks) / sizeof(uint32_t));
     const CullBuffers& early = graph.addPass<CullBuffers>(
         "gbuffer.cull_early", rg::Queue::Graphics,
         [&](rg::Builder& b, CullBuffers& d) {
@@ -209,7 +229,8 @@ rg::Buffer GBufferRenderer::addLateCull(rg::Graph& graph, const std::shared_ptr<
     constants.hizMips = mips;
     constants.drawCount = uint32_t(work->occlusionDraws.size());
     constants.instanceCount = uint32_t(work->occlusionInstances.size());
-    const uint64_t argsBytes = uint64_t(std::max(work->drawCapacity, 1u)) * sizeof(VkDrawIndexedIndirectCommand);
+    const uint64_t argsBytes = occlusionArgsBytes(work->argsChunks);
+    constants.countsAt = uint32_t(occlusionCountsOffset(work->argsChunks) / sizeof(uint32_t));
     struct LateData : CullBuffers {
         rg::Texture hiz;
         rg::Buffer current;

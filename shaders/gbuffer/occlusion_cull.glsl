@@ -1,8 +1,10 @@
 // The occlusion cull of the G-buffer's draws (glint/occlusion_shared.h,
 // passes/gbuffer_occlusion.cpp), the body of occlusion_early.comp and
-// occlusion_late.comp. One invocation per recorded draw writes its indirect
-// command; the late phase also runs one invocation per scene instance,
-// which writes next frame's visibility and the counts.
+// occlusion_late.comp. One invocation per command slot decides whether its
+// draw is drawn; its workgroup (one chunk) writes the drawn commands to the
+// chunk's first slots, in slot order, and their count. The late phase also
+// runs one invocation per scene instance, which writes next frame's
+// visibility and the counts.
 //
 // GLINT_OCCLUSION_LATE: 0, the early phase: a draw gets one instance where
 // its instance was visible last frame (the history), and invocation 0
@@ -18,8 +20,8 @@ layout(local_size_x = kOcclusionGroupSize) in;
 
 layout(set = 0, binding = 0, scalar) readonly buffer Draws { OcclusionDraw draws[]; };
 layout(set = 0, binding = 1, scalar) readonly buffer Previous { uint previous[]; };
-// VkDrawIndexedIndirectCommand per draw: indexCount, instanceCount,
-// firstIndex, vertexOffset, firstInstance.
+// VkDrawIndexedIndirectCommand per slot (indexCount, instanceCount,
+// firstIndex, vertexOffset, firstInstance), then a count per chunk.
 layout(set = 0, binding = 2, scalar) writeonly buffer Args { uint args[]; };
 layout(set = 0, binding = 3, scalar) buffer Stats { uint stats[]; };
 #if GLINT_OCCLUSION_LATE
@@ -35,13 +37,32 @@ bool drawnEarly(uint instance) {
     return instance < uint(previous.length()) && previous[instance] != 0u;
 }
 
-void writeArgs(uint draw, OcclusionDraw d, uint instanceCount) {
-    const uint at = draw * 5u;
-    args[at + 0u] = d.indexCount;
-    args[at + 1u] = instanceCount;
-    args[at + 2u] = d.firstIndex;
-    args[at + 3u] = uint(d.vertexOffset);
-    args[at + 4u] = d.instance;  // firstInstance: gbuffer.vert's instance
+shared uint scan[kOcclusionGroupSize];
+
+// Compacts the chunk: every invocation of the workgroup calls this (it
+// holds barriers), `drawn` or not. The drawn commands go to the chunk's
+// first slots in slot order (an inclusive scan of the flags), so the
+// G-buffer draws them in the order the CPU sorted them.
+void writeChunk(OcclusionDraw d, bool drawn) {
+    const uint l = gl_LocalInvocationID.x;
+    scan[l] = drawn ? 1u : 0u;
+    barrier();
+    for (uint offset = 1u; offset < kOcclusionGroupSize; offset <<= 1u) {
+        const uint add = l >= offset ? scan[l - offset] : 0u;
+        barrier();
+        scan[l] += add;
+        barrier();
+    }
+    const uint chunk = gl_WorkGroupID.x;
+    if (drawn) {
+        const uint at = (chunk * kOcclusionGroupSize + scan[l] - 1u) * 5u;
+        args[at + 0u] = d.indexCount;
+        args[at + 1u] = 1u;
+        args[at + 2u] = d.firstIndex;
+        args[at + 3u] = uint(d.vertexOffset);
+        args[at + 4u] = d.instance;  // firstInstance: gbuffer.vert's instance
+    }
+    if (l == kOcclusionGroupSize - 1u) args[pc.countsAt + chunk] = scan[l];
 }
 
 #if GLINT_OCCLUSION_LATE
@@ -92,16 +113,17 @@ void main() {
     if (t == 0u) {
         for (uint w = 0u; w < kOcclusionStatWords; ++w) stats[w] = 0u;
     }
-    if (t < pc.drawCount) {
-        const OcclusionDraw d = draws[t];
-        writeArgs(t, d, drawnEarly(d.instance) ? 1u : 0u);
-    }
+    // The dispatch covers the slots (whole chunks).
+    OcclusionDraw d = OcclusionDraw(0u, 0u, 0u, 0);
+    if (t < pc.drawCount) d = draws[t];
+    writeChunk(d, d.indexCount != 0u && drawnEarly(d.instance));
 #else
+    // Slots come in whole chunks: a workgroup holds slots or instances.
     if (t < pc.drawCount) {
         const OcclusionDraw d = draws[t];
-        const bool early = drawnEarly(d.instance);
-        const bool now = d.instance < pc.instanceCount && visible(instances[d.instance]);
-        writeArgs(t, d, now && !early ? 1u : 0u);
+        const bool early = d.indexCount != 0u && drawnEarly(d.instance);
+        const bool now = d.indexCount != 0u && d.instance < pc.instanceCount && visible(instances[d.instance]);
+        writeChunk(d, now && !early);
         if (now || early) atomicAdd(stats[kOcclusionStatTriangles], d.indexCount / 3u);
         return;
     }

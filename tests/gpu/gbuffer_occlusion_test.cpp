@@ -15,6 +15,8 @@
 
 #include <glm/gtc/matrix_transform.hpp>
 
+#include <numeric>
+
 #include <string>
 #include <vector>
 
@@ -166,4 +168,53 @@ TEST_CASE("with one instance in view the cull does not run: nothing could hide b
     gbuffer_test::render(gpu, scene, {test::testCamera({0.0f, 1.0f, 0.0f})}, &stats, withCull(true), &counts);
     CHECK(stats.instancesCulled == 0u);
     CHECK(counts.size() == shader::kOcclusionStatWords);
+}
+
+TEST_CASE("draws in runs of several chunks: each chunk keeps its drawn commands, in order") {
+    // Behind the wall's scene, a 40 x 20 grid of small boxes, every other
+    // one red and double-sided (another state: albedo is per vertex, the
+    // facing is not), every seventh mirrored: four runs, two of them longer
+    // than a chunk, so the cull pads and compacts runs over chunk
+    // boundaries. Some boxes stand behind the wall.
+    test::GpuTest gpu;
+    scene::Scene scene = wallScene();
+    scene::Material red = scene.materials[0];
+    red.baseColorFactor = glm::vec4(0.8f, 0.1f, 0.1f, 1.0f);
+    red.doubleSided = true;
+    scene.materials.push_back(red);
+    for (uint32_t material = 0; material < 2; ++material) {
+        scene::Mesh mesh;
+        mesh.name = "small" + std::to_string(material);
+        mesh.lods.push_back({{scene::makeBox({0.15f, 0.15f, 0.15f}, material)}});
+        scene.meshes.push_back(std::move(mesh));
+    }
+    const uint32_t firstSmall = uint32_t(scene.meshes.size() - 2);
+    uint32_t boxes = 0;
+    for (uint32_t row = 0; row < 20; ++row) {
+        for (uint32_t column = 0; column < 40; ++column, ++boxes) {
+            scene::Instance inst;
+            inst.mesh = firstSmall + (boxes % 2);
+            glm::mat4 t = glm::translate(glm::mat4(1.0f), {-3.0f + 0.15f * float(column), 0.1f, -2.5f - 0.5f * float(row)});
+            if (boxes % 7 == 0) t = glm::scale(t, {-1.0f, 1.0f, 1.0f});
+            inst.transform = inst.previousTransform = t;
+            scene.instances.push_back(inst);
+        }
+    }
+    scene::prepareScene(scene);
+    const scene::Camera camera = test::testCamera({0.0f, 1.0f, 0.0f});
+    const std::vector<scene::Camera> path(3, camera);
+    passes::GBufferStats stats;
+    std::vector<uint32_t> counts;
+    const gbuffer_test::GBufferImage culled = gbuffer_test::render(gpu, scene, path, &stats, withCull(true), &counts);
+    const gbuffer_test::GBufferImage all = gbuffer_test::render(gpu, scene, path, nullptr, withCull(false));
+    REQUIRE(counts.size() == shader::kOcclusionStatWords);
+    // Grey and red, each mirrored or not (the wall's scene is grey).
+    CHECK(stats.runs == 4u);
+    const uint32_t inView = stats.draws;  // one draw per instance
+    CHECK(inView > 2 * shader::kOcclusionGroupSize);
+    CHECK(counts[shader::kOcclusionStatOccluded] > 0u);
+    CHECK(counts[shader::kOcclusionStatEarly] + counts[shader::kOcclusionStatLate] +
+              counts[shader::kOcclusionStatOccluded] ==
+          inView);
+    checkSameTargets(culled, all);
 }

@@ -11,8 +11,12 @@
 //      the frustum is tested against it, the result becomes next frame's
 //      history, and the visible instances not drawn early are drawn late,
 //      over the early ones.
-// Each draw the CPU records is an indirect draw of one instance whose
-// instance count (0 or 1) the cull pass writes.
+// The G-buffer's draws are sorted into runs that bind the same (passes/
+// gbuffer_internal.h, SurfaceDraw). Each run takes whole chunks of
+// kOcclusionGroupSize command slots; a cull workgroup handles one chunk: it
+// writes the chunk's drawn commands to its first slots, in order, and their
+// count after all the slots. The raster passes draw each chunk with one
+// vkCmdDrawIndexedIndirectCount, so a draw the cull rejects costs nothing.
 //
 // The Hi-Z is a min-depth pyramid (reversed Z: the farthest depth of each
 // footprint). Its level 0 is bit_ceil(screen) / 2 texels a side, so every
@@ -27,7 +31,8 @@
 
 GLINT_BEGIN
 
-GLINT_CONST uint kOcclusionGroupSize = 64u;
+// Command slots per chunk, and the cull's workgroup size.
+GLINT_CONST uint kOcclusionGroupSize = 256u;
 
 // hiz.comp: a 16 x 16 workgroup per 32 x 32 texels of its source reduces
 // each 2 x 2 (the minimum) and then four more levels in shared memory.
@@ -45,8 +50,9 @@ struct OcclusionInstance {
     vec4 boundsMax;
 };
 
-// One indirect draw the G-buffer records (the same index range in both
-// phases): the cull pass writes its VkDrawIndexedIndirectCommand.
+// One command slot of the G-buffer's draws (the same index range in both
+// phases): the cull pass writes its VkDrawIndexedIndirectCommand where the
+// draw is drawn. indexCount 0: a slot that pads its run to whole chunks.
 struct OcclusionDraw {
     uint instance;
     uint indexCount;
@@ -60,9 +66,9 @@ struct OcclusionConstants {
     mat4 viewProjection;  // the jittered one the G-buffer draws with
     uvec2 screenSize;
     uint hizMips;
-    uint drawCount;
+    uint drawCount;      // command slots, a multiple of kOcclusionGroupSize
     uint instanceCount;
-    uint pad;
+    uint countsAt;       // the args buffer's word where the chunks' counts begin
 };
 
 // Push constants of hiz_base.comp and hiz_down.comp (56 bytes).
