@@ -183,9 +183,12 @@ RayGenerationOutputs addRayGenerationPass(rg::Graph& graph, RayGenerationPipelin
                 .storageBuffer("RtRays", pc.buffer(d.out.rtRays))
                 .storageImage("classDebug", pc.view(d.out.classDebug))
                 .storageBuffer("RtArgs", pc.buffer(d.out.rtArgs))
-                // Without tile modes the shader never reads them; the class
-                // buffer only completes the descriptor set.
-                .storageBuffer("TileModes", pc.buffer(d.tileModes.valid() ? d.tileModes : d.out.classes))
+                // Without tile modes the shader never reads them; the blue
+                // noise, which no pass writes, only completes the descriptor
+                // set. (A buffer of the graph would be a read it does not
+                // know of: sync validation takes a bound readonly buffer as
+                // read, and the class buffer may alias memory a pass wrote.)
+                .storageBuffer("TileModes", d.tileModes.valid() ? pc.buffer(d.tileModes) : pipelines.blueNoise_)
                 .storageBuffer("BlueNoise", pipelines.blueNoise_)
                 .push(pipelines.ctx_, pc.cmd());
             pipeline.pushConstants(pc.cmd(), constants);
