@@ -170,8 +170,8 @@ struct GBufferOutputs {
 struct GBufferStats {
     uint64_t frame = 0;           // addGBufferPass calls so far
     // this frame: the draws recorded (those of the instances in the
-    // frustum; with occlusion culling each is an indirect draw, recorded in
-    // both phases, that the GPU may give no instance: see occlusionStats)
+    // frustum; with occlusion culling each is a command slot, in both
+    // phases, that the cull keeps or drops: see occlusionStats)
     uint32_t draws = 0;
     // this frame: the runs they were recorded in (draws binding the same
     // pipeline, material, textures, vertices and winding: one multi-draw

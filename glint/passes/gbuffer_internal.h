@@ -198,8 +198,8 @@ struct GBufferRenderer::FrameWork {
     // Occlusion culling (GBufferSettings::occlusionCulling): per instance
     // its grown bounds and whether it has draws; per draw its index range.
     bool occlusionCulling = false;
-    // Draws the scene would have with every instance in the frustum: the
-    // size of the cull's command buffers, the same every frame.
+    // Draws the scene would have with every instance in the frustum: what
+    // sizes the cull's command buffers, the same every frame.
     uint32_t drawCapacity = 0;
     std::vector<shader::OcclusionInstance> occlusionInstances;
     // Per command slot (glint/occlusion_shared.h: each run of draws takes
@@ -207,7 +207,7 @@ struct GBufferRenderer::FrameWork {
     std::vector<shader::OcclusionDraw> occlusionDraws;
     std::vector<uint32_t> runFirstSlot;
     // The command buffers' chunks, enough for any frame of this scene (so
-    // their size stays), and the word where the chunks' counts begin.
+    // their size stays; occlusionArgsBytes).
     uint32_t argsChunks = 0;
     // The first pass to record uploads the host buffers (upload()).
     mutable std::once_flag uploaded;

@@ -2,8 +2,9 @@
 // G-buffer geometry: pulls the vertex from the scene's one vertex buffer
 // (gl_VertexIndex includes the draw's vertex offset), skins it with this and
 // last frame's joint palettes, and places it with this and last frame's
-// instance transform (the draw's firstInstance is the instance's index), so motion covers camera, rigid, skinned and morph
-// movement (a morphing instance's last-frame copy, previousVertexDelta).
+// instance transform (gl_InstanceIndex: each draw's firstInstance is its
+// instance), so motion covers camera, rigid, skinned and morph movement (a
+// morphing instance's last-frame copy, previousVertexDelta).
 #extension GL_GOOGLE_include_directive : require
 
 #include "gbuffer_common.glsl"

@@ -6,12 +6,12 @@
 // runs one invocation per scene instance, which writes next frame's
 // visibility and the counts.
 //
-// GLINT_OCCLUSION_LATE: 0, the early phase: a draw gets one instance where
-// its instance was visible last frame (the history), and invocation 0
-// zeroes the counts. 1, the late phase: an instance is visible where its
-// bounds reach in front of the farthest depth the Hi-Z holds over their
-// screen rectangle; a draw gets one instance where it is visible now and
-// was not drawn early.
+// GLINT_OCCLUSION_LATE: 0, the early phase: a draw is drawn where its
+// instance was visible last frame (the history), and invocation 0 zeroes
+// the counts. 1, the late phase: an instance is visible where its bounds
+// reach in front of the farthest depth the Hi-Z holds over their screen
+// rectangle; a draw is drawn where it is visible now and was not drawn
+// early.
 #extension GL_EXT_scalar_block_layout : require
 
 #include "glint/occlusion_shared.h"
