@@ -15,8 +15,6 @@
 
 #include <glm/gtc/matrix_transform.hpp>
 
-#include <numeric>
-
 #include <string>
 #include <vector>
 

@@ -16,7 +16,7 @@
 // kOcclusionGroupSize command slots; a cull workgroup handles one chunk: it
 // writes the chunk's drawn commands to its first slots, in order, and their
 // count after all the slots. The raster passes draw each chunk with one
-// vkCmdDrawIndexedIndirectCount, so a draw the cull rejects costs nothing.
+// vkCmdDrawIndexedIndirectCount, so a draw the cull rejects issues no command.
 //
 // The Hi-Z is a min-depth pyramid (reversed Z: the farthest depth of each
 // footprint). Its level 0 is bit_ceil(screen) / 2 texels a side, so every
