@@ -344,15 +344,43 @@ std::shared_ptr<GBufferRenderer::FrameWork> GBufferRenderer::prepare(const GBuff
     // The draws: opaque and alpha-tested geometry (blended geometry is the
     // transparent pass's); those of instances outside the frustum count
     // towards the capacity only.
+    // A geometry stored by facing draws the facets that face the camera,
+    // consecutive ones as one draw.
     std::vector<SurfaceDraw> draws;
+    stats_.facetTrianglesSkipped = 0;
     for (size_t i = 0; i < work->instances.size(); ++i) {
+        const bool morphed = work->morphedFirstVertex[i] >= 0;
+        std::optional<glm::vec3> eye;  // the camera in the mesh's space, once a facet asks
         for (const DrawRange& range : meshDraws_.at(work->meshes[i])) {
             if (range.indexCount == 0 || range.coverage == Coverage::Blended) continue;
-            ++work->drawCapacity;
+            // Kept facets between skipped ones: at most every other one.
+            work->drawCapacity += std::max(1u, uint32_t(range.facets.size() + 1) / 2);
             if (!work->visible[i]) continue;
             const bool masked = range.coverage == Coverage::Masked;
-            draws.push_back({uint32_t(i), &range, masked,
-                             runKey(masked, range.state, work->morphedFirstVertex[i] >= 0, work->mirrored[i] != 0)});
+            const uint64_t run = runKey(masked, range.state, morphed, work->mirrored[i] != 0);
+            const auto draw = [&](uint32_t firstIndex, uint32_t indexCount) {
+                draws.push_back({uint32_t(i), &range, firstIndex, indexCount, masked, run});
+            };
+            if (range.facets.empty() || morphed || !settings.facetCulling) {
+                draw(range.firstIndex, range.indexCount);
+                continue;
+            }
+            if (!eye) {
+                const glm::mat4& transform = work->instances[i].transform;  // affine
+                eye = glm::inverse(glm::mat3(transform)) * (camera.position - glm::vec3(transform[3]));
+            }
+            uint32_t first = 0, count = 0;  // the kept facets since the last skipped one
+            for (const scene::Facet& facet : range.facets) {
+                if (scene::facetHidden(facet, *eye)) {
+                    stats_.facetTrianglesSkipped += facet.indexCount / 3;
+                    if (count != 0) draw(first, count);
+                    count = 0;
+                    continue;
+                }
+                if (count == 0) first = facet.firstIndex;
+                count += facet.indexCount;
+            }
+            if (count != 0) draw(first, count);
         }
     }
     // In the order record() issues them: by run key (opaque before
@@ -696,8 +724,8 @@ void GBufferRenderer::record(const FrameWork& work, rg::PassContext& pc, const G
             for (size_t d = begin; d < end; ++d) {
                 const SurfaceDraw& draw = work.draws[d];
                 const int32_t vertexShift = vertexSource(work, draw.instance, slot).second;
-                vkCmdDrawIndexed(cmd, draw.range->indexCount, 1, draw.range->firstIndex,
-                                 draw.range->vertexOffset + vertexShift, draw.instance);
+                vkCmdDrawIndexed(cmd, draw.indexCount, 1, draw.firstIndex, draw.range->vertexOffset + vertexShift,
+                                 draw.instance);
             }
         } else {
             // The run's chunks: the commands the cull kept, and their count.
@@ -712,12 +740,12 @@ void GBufferRenderer::record(const FrameWork& work, rg::PassContext& pc, const G
         if (counts) {
             ++stats_.runs;
             for (size_t d = begin; d < end; ++d) {
-                const DrawRange& r = *work.draws[d].range;
-                stats_.normalMappedDraws += r.material.normalMap != 0 ? 1u : 0u;
+                const SurfaceDraw& draw = work.draws[d];
+                stats_.normalMappedDraws += draw.range->material.normalMap != 0 ? 1u : 0u;
                 stats_.texturedDraws += textured ? 1u : 0u;
                 stats_.maskedDraws += first.masked ? 1u : 0u;
                 ++stats_.draws;
-                stats_.triangles += r.indexCount / 3;
+                stats_.triangles += draw.indexCount / 3;
             }
         }
         begin = end;

@@ -146,6 +146,14 @@ struct GBufferSettings {
     // runs only where that is two instances or more (one cannot hide
     // behind itself); the shadow map is not occlusion culled.
     bool occlusionCulling = true;
+    // Skip the groups of an instance's triangles that all face away from
+    // the camera (scene/facets.h: large single-sided geometry whose
+    // triangles face a few ways, such as walls), tested on the CPU per
+    // instance and geometry: the rasterizer would cull each of their
+    // triangles, after fetching and transforming its vertices. The image is
+    // the same; only the raster work differs. The shadow map draws both
+    // faces, so it keeps every triangle.
+    bool facetCulling = true;
 };
 
 struct GBufferOutputs {
@@ -178,6 +186,9 @@ struct GBufferStats {
     // each with occlusion culling, one push of constants without)
     uint32_t runs = 0;
     uint64_t triangles = 0;       // this frame
+    // this frame: of the instances in the frustum, triangles not drawn
+    // because their facet faced away (facetCulling)
+    uint64_t facetTrianglesSkipped = 0;
     uint32_t shadowDraws = 0;     // this frame, into the shadow map
     uint32_t instancesCulled = 0;        // this frame: outside the camera's frustum, not drawn
     uint32_t shadowInstancesCulled = 0;  // this frame: outside the shadow map's box, not drawn into it
@@ -187,6 +198,7 @@ struct GBufferStats {
     uint32_t textureImages = 0;   // material textures uploaded (one per texture and colour space)
     uint64_t textureBytes = 0;    // their bytes, mips included
     uint32_t normalMaps = 0;      // of them, normal textures
+    uint32_t facetedGeometries = 0;  // geometries stored by facing (DrawRange::facets)
     uint32_t normalMappedDraws = 0;  // this frame
     uint32_t texturedDraws = 0;   // this frame: draws sampling any material texture
     uint32_t maskedDraws = 0;     // this frame: alpha-tested draws (glTF alphaMode MASK)

@@ -59,6 +59,7 @@ void GBufferRenderer::loadAssets() {
     // for the whole frame, draws differ only in their ranges.
     std::vector<shader::GBufferVertex> vertices;
     std::vector<uint32_t> indices;
+    uint32_t facetedGeometries = 0;
     meshDraws_.resize(scene_.meshes.size());
     meshFirstVertex_.assign(scene_.meshes.size(), 0);
     morphBaseVertices_.resize(scene_.meshes.size());
@@ -142,8 +143,22 @@ void GBufferRenderer::loadAssets() {
                                        0.0f, 1.0f);
                 vertices.push_back(out);
             }
-            indices.insert(indices.end(), g.indices.begin(), g.indices.end());
-            meshDraws_[m].push_back(range);
+            // Single-sided opaque and alpha-tested geometry that does not
+            // move its vertices is stored by facing, so that a frame can
+            // skip the groups that face away (SurfaceDraw).
+            const bool facing = !range.doubleSided && range.coverage != Coverage::Blended && !g.skinned() &&
+                                g.morphTargets.empty();
+            scene::FacetSplit split;
+            if (facing) split = scene::splitIntoFacets(g.positions, g.indices);
+            if (split.facets.empty()) {
+                indices.insert(indices.end(), g.indices.begin(), g.indices.end());
+            } else {
+                indices.insert(indices.end(), split.indices.begin(), split.indices.end());
+                for (scene::Facet& f : split.facets) f.firstIndex += range.firstIndex;
+                range.facets = std::move(split.facets);
+                ++facetedGeometries;
+            }
+            meshDraws_[m].push_back(std::move(range));
         }
         if (!mesh.morphWeights.empty()) {
             // Kept for the per-frame morphed copies: materials and skins stay,
@@ -182,9 +197,12 @@ void GBufferRenderer::loadAssets() {
     stats_.textureImages = uint32_t(textureImages_.size());
     stats_.textureBytes = textureBytes;
     stats_.normalMaps = uint32_t(normalImages.size());
+    stats_.facetedGeometries = facetedGeometries;
     spdlog::info("G-buffer: {} material textures uploaded for per-pixel sampling ({:.2f} MiB with mips), {} of them "
                  "normal maps",
                  stats_.textureImages, double(textureBytes) / (1024.0 * 1024.0), stats_.normalMaps);
+    spdlog::debug("G-buffer: {} geometries stored by facing, their groups skipped where they face away",
+                  facetedGeometries);
 }
 
 void GBufferRenderer::reloadAssetsIfEdited() {

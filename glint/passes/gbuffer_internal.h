@@ -8,6 +8,7 @@
 #include "glint/passes/gbuffer.h"
 
 #include "glint/gpu/pipeline.h"
+#include "glint/scene/facets.h"
 #include "glint/scene/scene.h"
 
 #include "glint/gbuffer_shared.h"
@@ -131,6 +132,11 @@ struct GBufferRenderer::DrawRange {
     // Ranges with equal coverage, material and textures share the number:
     // the scene's distinct binding states, counted from 0.
     uint32_t state = 0;
+    // Its triangles grouped by facing (scene/facets.h), firstIndex into the
+    // shared index buffer, where the range's indices are stored in the
+    // facets' order; empty: one group, never skipped (double-sided,
+    // blended, skinned or morphed geometry, or none faces one way enough).
+    std::vector<scene::Facet> facets;
 };
 
 // A blended geometry of one instance, with its distance from the camera
@@ -164,6 +170,10 @@ struct GBufferRenderer::FrameSlot {
 struct GBufferRenderer::SurfaceDraw {
     uint32_t instance = 0;
     const DrawRange* range = nullptr;
+    // The indices drawn: the range's, or those of its facets that face the
+    // camera (consecutive ones in one draw).
+    uint32_t firstIndex = 0;
+    uint32_t indexCount = 0;
     bool masked = false;
     uint64_t run = 0;
 };

@@ -93,7 +93,7 @@ void GBufferRenderer::prepareOcclusion(FrameWork& work) const {
         // the slot).
         const int32_t shift = vertexSource(work, draw.instance, *slots_[work.slot]).second;
         work.occlusionDraws.push_back(
-            {draw.instance, draw.range->indexCount, draw.range->firstIndex, draw.range->vertexOffset + shift});
+            {draw.instance, draw.indexCount, draw.firstIndex, draw.range->vertexOffset + shift});
     }
     work.occlusionDraws.resize((work.occlusionDraws.size() + chunk - 1) / chunk * chunk);
     // A run wastes less than a chunk, and there are at most as many runs as

@@ -81,6 +81,38 @@ Geometry makeBox(const glm::vec3& size, uint32_t material, float uvPerMetre) {
     return finish(std::move(g), material);
 }
 
+Geometry makeDividedBox(const glm::vec3& size, uint32_t divisions, uint32_t material, float uvPerMetre) {
+    Geometry g;
+    const uint32_t n = std::max(divisions, 1u);
+    const glm::vec3 h = size * 0.5f;
+    const glm::vec3 axes[3] = {{1, 0, 0}, {0, 1, 0}, {0, 0, 1}};
+    for (int axis = 0; axis < 3; ++axis) {
+        for (float sign : {-1.0f, 1.0f}) {
+            // addQuad winds each triangle around its vertices' normal.
+            const glm::vec3 normal = axes[axis] * sign;
+            const glm::vec3 u = axes[(axis + 1) % 3];
+            const glm::vec3 v = axes[(axis + 2) % 3];
+            const float hu = glm::dot(glm::abs(u), h);
+            const float hv = glm::dot(glm::abs(v), h);
+            const uint32_t first = g.vertexCount();
+            for (uint32_t j = 0; j <= n; ++j) {
+                for (uint32_t i = 0; i <= n; ++i) {
+                    const glm::vec2 t(2.0f * float(i) / float(n) - 1.0f, 2.0f * float(j) / float(n) - 1.0f);
+                    const glm::vec3 p = normal * h + u * (t.x * hu) + v * (t.y * hv);
+                    addVertex(g, p, normal, glm::vec2(t.x * hu, t.y * hv) * uvPerMetre);
+                }
+            }
+            for (uint32_t j = 0; j < n; ++j) {
+                for (uint32_t i = 0; i < n; ++i) {
+                    const uint32_t a = first + j * (n + 1) + i;
+                    addQuad(g, a, a + 1, a + n + 2, a + n + 1);
+                }
+            }
+        }
+    }
+    return finish(std::move(g), material);
+}
+
 Geometry makeGrid(const glm::vec2& size, const glm::uvec2& cells, uint32_t material, float uvPerMetre,
                   float (*height)(float, float)) {
     Geometry g;

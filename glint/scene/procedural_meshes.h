@@ -10,6 +10,10 @@ namespace glint::scene {
 // Box of `size`, centred on the origin; UVs in metres times `uvPerMetre`.
 Geometry makeBox(const glm::vec3& size, uint32_t material, float uvPerMetre = 1.0f);
 
+// The same box with each face divided into `divisions` x `divisions`
+// quads: finely tessellated flat walls, as the city's buildings have.
+Geometry makeDividedBox(const glm::vec3& size, uint32_t divisions, uint32_t material, float uvPerMetre = 1.0f);
+
 // Grid in the XZ plane facing +Y, centred on the origin, `cells` quads.
 // `height` (optional) displaces each vertex along Y from its (x, z).
 Geometry makeGrid(const glm::vec2& size, const glm::uvec2& cells, uint32_t material, float uvPerMetre = 1.0f,

@@ -60,7 +60,7 @@ constexpr std::array<bool, 3> kEveryMode{true, true, true};
 
 // The one table of parameters: name, field, the viewer's range, the
 // bench's sweep, and where the value lives.
-const std::array<ParameterSlot, 24> kParameters = {{
+const std::array<ParameterSlot, 25> kParameters = {{
     // A confidence; the talk's 0.9 (default) bracketed from "trust SSLR
     // often" to "almost never".
     {{"sslr_threshold", "ReflectionFrameSettings::confidenceThreshold", 0.0f, 1.0f, false, {0.5, 0.7, 0.8, 0.95, 0.99},
@@ -107,6 +107,8 @@ const std::array<ParameterSlot, 24> kParameters = {{
      [](ReflectionRunOptions& o) { return &o.frame.gbuffer.frustumCulling; }},
     {{"occlusion_culling", "GBufferSettings::occlusionCulling (0 or 1)", 0.0f, 1.0f, true, {}, {}, {}}, nullptr,
      nullptr, [](ReflectionRunOptions& o) { return &o.frame.gbuffer.occlusionCulling; }},
+    {{"facet_culling", "GBufferSettings::facetCulling (0 or 1)", 0.0f, 1.0f, true, {}, {}, {}}, nullptr, nullptr,
+     [](ReflectionRunOptions& o) { return &o.frame.gbuffer.facetCulling; }},
     // Half-rate RT on a checkerboard (default off).
     {{"rt_checkerboard", "RayGenerationSettings::checkerboard (0 or 1)", 0.0f, 1.0f, true, {1}, {1}, kTraced}, nullptr,
      nullptr, [](ReflectionRunOptions& o) { return &o.frame.rays.checkerboard; }},
@@ -627,10 +629,12 @@ std::string statsJson(const gpu::Context& ctx, const ReflectionRunOptions& optio
                           {"rt", share(shader::kPixelRt)},    {"env", share(shader::kPixelEnv)},
                           {"sky", share(shader::kPixelSky)}};
     j["bvh"] = {{"blas_built", r.blasBuilt}, {"blas_rebuilt", r.blasRebuilt}, {"tlas_instances", r.tlasInstances}};
-    // The last frame's raster work: what frustum culling left to draw.
+    // The last frame's raster work: what frustum culling left to draw, and
+    // the triangles of the facets skipped for facing away.
     j["raster"] = {{"draws", r.gbuffer.draws},
                    {"runs", r.gbuffer.runs},
                    {"triangles", r.gbuffer.triangles},
+                   {"facet_triangles_skipped", r.gbuffer.facetTrianglesSkipped},
                    {"instances_culled", r.gbuffer.instancesCulled},
                    {"shadow_draws", r.gbuffer.shadowDraws},
                    {"shadow_instances_culled", r.gbuffer.shadowInstancesCulled}};

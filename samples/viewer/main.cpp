@@ -587,8 +587,9 @@ private:
                             double(g.poolBytes) / 1048576.0);
             }
             const passes::GBufferStats& gb = renderer_->gbufferStats();
-            ImGui::Text("G-buffer: %u draws in %u runs, %llu triangles", gb.draws, gb.runs,
-                        static_cast<unsigned long long>(gb.triangles));
+            ImGui::Text("G-buffer: %u draws in %u runs, %llu triangles (%llu facing away, skipped)", gb.draws,
+                        gb.runs, static_cast<unsigned long long>(gb.triangles),
+                        static_cast<unsigned long long>(gb.facetTrianglesSkipped));
         }
         ImGui::End();
     }
