@@ -13,9 +13,9 @@
 // best-fitting free block (or at the top). It is linear-scan register
 // allocation over bytes: O(n log n), good packing for frame-shaped
 // lifetimes, no quadratic interference test. A sweep over the offsets then
-// marks the resources that share bytes: barriers.cpp makes their first uses
-// wait for the last users of those bytes, and an alias starts from
-// UNDEFINED.
+// marks the resources that share bytes: the barrier walk
+// (barrier_frame_start.cpp) makes their first uses wait for the last users
+// of those bytes, and an alias starts from UNDEFINED.
 
 #include <algorithm>
 #include <bit>
@@ -67,7 +67,7 @@ uint64_t alignUp(uint64_t v, uint64_t a) {
 }
 
 // compile() runs every frame: the vectors keep their storage from one
-// compile to the next (as barriers.cpp's scratch does).
+// compile to the next (as the barrier walk's scratch does, barrier_walk.h).
 struct Scratch {
     std::vector<HeapKey> keys;
     std::vector<Item> all;                       // used transients in resource order

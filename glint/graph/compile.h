@@ -10,7 +10,8 @@
 //                 otherwise), then queue assignment
 //   lifetimes.cpp first/last use, queues and usage flags per resource
 //   alias.cpp     transient placement in per-queue heaps
-//   barriers.cpp  hazards -> sync2 barriers and cross-queue waits
+//   barriers.cpp  hazards -> sync2 barriers and cross-queue waits (where
+//                 resources start the frame: barrier_frame_start.cpp)
 //   batches.cpp   per-queue submission batches and semaphore placement
 
 #include "glint/graph/memory.h"

@@ -1,4 +1,11 @@
+// The BVH update pass: BvhManager's frame -- what to build, pack and copy,
+// decided on the CPU when the pass is declared (prepare, the particles'
+// quads included), then recorded (record) -- and the pass's declaration in
+// a graph (addBvhUpdatePass). Per-object state and the buffers that grow
+// with the scene are made in bvh_update_resources.cpp.
+
 #include "glint/passes/bvh_update.h"
+#include "glint/passes/bvh_update_internal.h"
 
 #include "glint/gpu/commands.h"
 #include "glint/gpu/descriptors.h"
@@ -24,40 +31,6 @@ namespace glint::passes {
 
 namespace {
 
-constexpr VkBufferUsageFlags kBuildInput = VK_BUFFER_USAGE_ACCELERATION_STRUCTURE_BUILD_INPUT_READ_ONLY_BIT_KHR;
-
-// Growth policy of every buffer whose size follows the scene: the next power
-// of two, so a slowly growing pool or TLAS reallocates O(log n) times.
-uint64_t grownCapacity(uint64_t needed, uint64_t minimum) {
-    return std::bit_ceil(std::max(needed, minimum));
-}
-
-// The executor keeps transient memory while the plan's transient layout is
-// unchanged and rebuilds it after a device wait otherwise, so the scratch
-// request only ever grows, in powers of two, from this size.
-constexpr uint64_t kMinScratchBytes = 64 * 1024;
-constexpr uint32_t kMinTlasInstances = 64;
-constexpr uint32_t kMinOffsetEntries = 256;
-constexpr VkDeviceSize kMaterialRowBytes = sizeof(shader::RtGeometryMaterial);
-constexpr uint32_t kMinParticles = 64;
-constexpr uint64_t kMinDeformMotionBytes = 1024 * sizeof(shader::DeformMotion);
-
-// The pack pass's source vertices of `g`. Material attributes are sampled
-// here with the CPU reference: texture sampling at the vertices gives the
-// same answer every frame, so doing it per frame on the GPU would cost
-// texture bindings and fetches for nothing. The pack pass then only skins
-// the normal and packs it.
-std::vector<shader::BvhSourceVertex> sourceVertices(const scene::Scene& scene, const scene::Geometry& g) {
-    std::vector<shader::BvhSourceVertex> vertices(g.vertexCount());
-    for (uint32_t v = 0; v < g.vertexCount(); ++v) {
-        const shader::SurfaceVertex s = scene::surfaceAtVertex(scene, g, v);
-        const shader::PackedVertex packed = shader::packVertex(s);
-        vertices[v] = {g.positions[v], s.normal, packed.albedoSmoothness,
-                       packed.normalMetallicReflectance & 0xFFFF0000u};
-    }
-    return vertices;
-}
-
 // Where a world point on `instance` this frame was last frame: its last
 // transform after the inverse of this one (in double: a far instance's
 // float inverse would move still points). Identity for a still instance.
@@ -82,6 +55,8 @@ VkPipelineStageFlags2 traceStages(const gpu::Capabilities& caps) {
 
 } // namespace
 
+using namespace bvh_update_detail;
+
 rg::BoundaryState tracedAccelState(const gpu::Capabilities& caps) {
     return rg::BoundaryState::raw(traceStages(caps), VK_ACCESS_2_ACCELERATION_STRUCTURE_READ_BIT_KHR,
                                   VK_IMAGE_LAYOUT_UNDEFINED, rg::Queue::Graphics);
@@ -90,92 +65,6 @@ rg::BoundaryState tracedAccelState(const gpu::Capabilities& caps) {
 rg::BoundaryState tracedBufferState(const gpu::Capabilities& caps) {
     return rg::BoundaryState::raw(traceStages(caps), VK_ACCESS_2_SHADER_STORAGE_READ_BIT, VK_IMAGE_LAYOUT_UNDEFINED,
                                   rg::Queue::Graphics);
-}
-
-// ---------------------------------------------------------------------------
-// Per-object state
-// ---------------------------------------------------------------------------
-
-// One geometry of a mesh's reflection LOD on the GPU, uploaded the first time
-// a BLAS uses it.
-struct BvhManager::SourceGeometry {
-    gpu::Buffer vertices;  // BvhSourceVertex per vertex
-    gpu::Buffer indices;   // three per triangle
-    gpu::Buffer skin;      // BvhSkinVertex per vertex; empty when not skinned
-    uint32_t triangleCount = 0;
-};
-
-struct BvhManager::ResidentBlas {
-    scene::BlasDesc desc;
-    // Three vec3 per triangle, the build input. A static BLAS never rebuilds,
-    // so its positions are released once its build has finished.
-    gpu::Buffer positions;
-    uint64_t builtInFrame = 0;
-    // Per BLAS geometry, its first DeformMotion in the frame's deform motion
-    // buffer, when the frame builtInFrame rebuilt it over an earlier shape
-    // (kNoDeformMotion: a first build, or a static BLAS).
-    std::vector<uint32_t> deformMotion;
-    std::vector<const SourceGeometry*> sources;  // per BLAS geometry
-    // Per BLAS geometry, its row of the material table (HitMaterials::row),
-    // fixed for the BLAS's life: each frame copies them beside the offsets.
-    std::vector<shader::RtGeometryMaterial> materialRows;
-    std::optional<gpu::AccelBuild> build;        // geometry addresses into `positions`, reused by rebuilds
-    gpu::AccelerationStructure structure;
-    // A morphing instance's BLAS: per frame slot and BLAS geometry, its
-    // source vertices with the instance's morph weights applied on the CPU
-    // (host-visible, written when a build of that slot records; empty for
-    // geometries without morph targets).
-    std::vector<std::vector<gpu::Buffer>> morphedVertices;
-};
-
-struct BvhManager::FrameWork {
-    struct Pack {
-        const SourceGeometry* source = nullptr;
-        const gpu::Buffer* positions = nullptr;
-        shader::BvhPackParams params{};
-        // Set for a morphing geometry: read these source vertices instead of
-        // source->vertices, after writing `morphed` into them.
-        const gpu::Buffer* vertices = nullptr;
-        std::vector<shader::BvhSourceVertex> morphed;
-    };
-    struct Build {
-        ResidentBlas* blas = nullptr;
-        VkDeviceSize scratchOffset = 0;
-    };
-    uint32_t slot = 0;
-    std::vector<Pack> packs;
-    std::vector<Build> builds;
-    std::vector<VkAccelerationStructureInstanceKHR> instances;
-    std::vector<uint32_t> offsets;
-    std::vector<shader::RtGeometryMaterial> materials;  // parallel to offsets
-    std::vector<glm::mat4> joints;  // the palette as it was when the frame was declared
-    std::optional<gpu::AccelBuild> tlasBuild;
-    std::shared_ptr<gpu::Buffer> poolCopySource;  // the outgrown pool, copied into the new one first
-    VkDeviceSize poolCopyBytes = 0;
-    // Geometry that enters the GPU this frame: host-written staging copied
-    // into its device-local buffer at the start of the pass, on the pass's
-    // own queue, so a first entry into range never blocks the host on a
-    // submission of its own.
-    struct Upload {
-        std::shared_ptr<gpu::Buffer> staging;
-        const gpu::Buffer* target = nullptr;
-    };
-    std::vector<Upload> uploads;
-    // Particles: empty without (then nothing below is recorded).
-    std::vector<shader::ParticleData> particles;
-    shader::ParticleBillboardParams billboard{};
-    // One BLAS build and one TLAS instance per quad axis.
-    std::vector<gpu::AccelBuild> particleBlasBuilds;
-    std::optional<gpu::AccelBuild> particleTlasBuild;
-    std::array<VkAccelerationStructureInstanceKHR, shader::kParticleQuadAxes> particleInstances{};
-    std::array<VkDeviceSize, shader::kParticleQuadAxes> particleBlasScratchOffsets{};  // beside the BLAS builds
-    VkDeviceSize particleTlasScratchOffset = 0;  // beside the TLAS build
-};
-
-template <class T> void BvhManager::retire(T&& object) {
-    // Frames up to frame_ - 1 may have recorded uses; frame_ itself when the
-    // object is still used by the frame being declared (a pool copy source).
-    retired_.keep(std::forward<T>(object), frame_);
 }
 
 BvhManager::BvhManager(gpu::Context& ctx, const scene::Scene& scene, uint32_t framesInFlight,
@@ -221,179 +110,6 @@ void BvhManager::bind(rg::FrameResources& resources, const BvhUpdateOutputs& out
     if (outputs.particleTlas.valid()) {
         resources.bind(outputs.particleTlas, *particleTlas_);
         resources.bind(outputs.particles, particleData_);
-    }
-}
-
-// ---------------------------------------------------------------------------
-// Uploads and growth
-// ---------------------------------------------------------------------------
-
-const BvhManager::SourceGeometry& BvhManager::sourceGeometry(uint32_t mesh, uint32_t lod, uint32_t geometry,
-                                                             FrameWork& work) {
-    auto& slot = geometries_[{mesh, lod, geometry}];
-    if (slot) {
-        return *slot;
-    }
-    const scene::Geometry& g = scene_.meshes.at(mesh).lods.at(lod).geometries.at(geometry);
-    const std::string name = "bvh." + scene_.meshes[mesh].name + ".lod" + std::to_string(lod) + ".geometry" +
-                             std::to_string(geometry);
-    // Sampled once: see sourceVertices.
-    const std::vector<shader::BvhSourceVertex> vertices = sourceVertices(scene_, g);
-    auto source = std::make_unique<SourceGeometry>();
-    source->triangleCount = g.triangleCount();
-    // `target` is filled by the frame's pass (FrameWork::uploads); the
-    // staging lives until that frame has finished.
-    const auto upload = [&](gpu::Buffer& target, const void* data, size_t bytes, const std::string& what) {
-        const VkDeviceSize size = std::max<VkDeviceSize>(bytes, 4);
-        auto staging = std::make_shared<gpu::Buffer>(
-            ctx_, gpu::BufferDesc{size, VK_BUFFER_USAGE_TRANSFER_SRC_BIT, gpu::MemoryUsage::Upload,
-                                  name + what + ".staging", true});
-        std::memcpy(staging->mapped(), data, bytes);
-        target = gpu::Buffer(ctx_, {size, VK_BUFFER_USAGE_STORAGE_BUFFER_BIT | VK_BUFFER_USAGE_TRANSFER_DST_BIT,
-                                    gpu::MemoryUsage::DeviceLocal, name + what, true});
-        stats_.uploadBytes += size;
-        retired_.keepShared(staging, frame_);
-        work.uploads.push_back({std::move(staging), &target});
-    };
-    upload(source->vertices, vertices.data(), vertices.size() * sizeof(vertices[0]), ".vertices");
-    upload(source->indices, g.indices.data(), g.indices.size() * sizeof(uint32_t), ".indices");
-    stats_.geometryBytes += source->vertices.size() + source->indices.size();
-    if (g.skinned()) {
-        std::vector<shader::BvhSkinVertex> skin(g.vertexCount());
-        for (uint32_t v = 0; v < g.vertexCount(); ++v) {
-            const glm::u16vec4 j = g.joints[v];
-            skin[v] = {glm::uvec2(uint32_t(j.x) | uint32_t(j.y) << 16, uint32_t(j.z) | uint32_t(j.w) << 16),
-                       g.weights[v]};
-        }
-        upload(source->skin, skin.data(), skin.size() * sizeof(skin[0]), ".skin");
-        stats_.geometryBytes += source->skin.size();
-    }
-    ++stats_.uploadedGeometries;
-    slot = std::move(source);
-    return *slot;
-}
-
-BvhManager::ResidentBlas& BvhManager::createBlas(const scene::BlasDesc& desc, FrameWork& work) {
-    auto blas = std::make_unique<ResidentBlas>();
-    blas->desc = desc;
-    const std::string name = "bvh.blas" + std::to_string(desc.id) + "." + scene_.meshes.at(desc.mesh).name;
-    blas->positions = gpu::Buffer(ctx_, {std::max<VkDeviceSize>(VkDeviceSize(desc.triangleCount) * 3 * sizeof(glm::vec3), 12),
-                                         VK_BUFFER_USAGE_STORAGE_BUFFER_BIT | kBuildInput,
-                                         gpu::MemoryUsage::DeviceLocal, name + ".positions", true});
-    std::vector<gpu::TriangleGeometry> triangles;
-    VkDeviceSize first = 0;
-    for (const scene::BlasGeometry& g : desc.geometries) {
-        blas->sources.push_back(&sourceGeometry(desc.mesh, desc.lod, g.meshGeometry, work));
-        blas->materialRows.push_back(hitMaterials_->row(desc.mesh, desc.lod, g.meshGeometry));
-        gpu::TriangleGeometry t;
-        t.vertices = blas->positions.address() + first * sizeof(glm::vec3);
-        t.vertexCount = 3 * g.triangleCount;
-        t.triangleCount = g.triangleCount;
-        // Alpha-tested geometry runs the any-hit test (glint/alpha_test.h);
-        // everything else stays opaque, so rays never stop on it for a test.
-        t.opaque = blas->materialRows.back().alphaTriangles == shader::kAlphaOpaque;
-        triangles.push_back(t);
-        first += 3 * VkDeviceSize(g.triangleCount);
-    }
-    const bool deformable = desc.motion != scene::Motion::Static;
-    blas->build = gpu::AccelBuild::bottomLevel(ctx_, triangles, deformable ? options_.deformableFlags : options_.staticFlags);
-    blas->structure = gpu::AccelerationStructure(ctx_, VK_ACCELERATION_STRUCTURE_TYPE_BOTTOM_LEVEL_KHR,
-                                                 blas->build->structureSize(), name, true);
-    stats_.blasBytes += blas->structure.buffer().size();
-    stats_.positionBytes += blas->positions.size();
-    auto& slot = blases_[desc.id];
-    slot = std::move(blas);
-    return *slot;
-}
-
-void BvhManager::ensurePool(uint32_t triangles, FrameWork& work) {
-    const VkDeviceSize needed = std::max<VkDeviceSize>(triangles, 1) * sizeof(shader::PackedPrimitive);
-    if (pool_ && pool_.size() >= needed) {
-        return;
-    }
-    const VkDeviceSize capacity = grownCapacity(needed, 1024 * sizeof(shader::PackedPrimitive));
-    gpu::Buffer grown(ctx_, {capacity,
-                             VK_BUFFER_USAGE_STORAGE_BUFFER_BIT | VK_BUFFER_USAGE_TRANSFER_SRC_BIT |
-                                 VK_BUFFER_USAGE_TRANSFER_DST_BIT,
-                             gpu::MemoryUsage::DeviceLocal, "bvh.primitive_pool", true});
-    if (pool_) {
-        // Static BLASes were packed once; their primitives must survive.
-        work.poolCopyBytes = pool_.size();
-        work.poolCopySource = std::make_shared<gpu::Buffer>(std::move(pool_));
-        retired_.keepShared(work.poolCopySource, frame_);
-        ++stats_.poolGrowths;
-    }
-    pool_ = std::move(grown);
-    stats_.poolBytes = pool_.size();
-}
-
-void BvhManager::ensureDeformMotion(uint64_t triangles) {
-    const VkDeviceSize needed = std::max<uint64_t>(triangles, 1) * sizeof(shader::DeformMotion);
-    if (deformMotion_ && deformMotion_.size() >= needed) {
-        return;
-    }
-    // Each frame writes what it reads: nothing to keep from the old one.
-    if (deformMotion_) {
-        stats_.deformMotionBytes -= deformMotion_.size();
-        retire(std::move(deformMotion_));
-    }
-    deformMotion_ = gpu::Buffer(ctx_, {grownCapacity(needed, kMinDeformMotionBytes), VK_BUFFER_USAGE_STORAGE_BUFFER_BIT,
-                                       gpu::MemoryUsage::DeviceLocal, "bvh.deform_motion", true});
-    stats_.deformMotionBytes += deformMotion_.size();
-}
-
-void BvhManager::ensureTlas(uint32_t instances) {
-    if (tlas_ && instances <= tlasCapacity_) {
-        return;
-    }
-    tlasCapacity_ = uint32_t(grownCapacity(instances, kMinTlasInstances));
-    for (gpu::Buffer& buffer : instanceBuffers_) {
-        if (buffer) retire(std::move(buffer));
-        buffer = gpu::Buffer(ctx_, {VkDeviceSize(tlasCapacity_) * sizeof(VkAccelerationStructureInstanceKHR), kBuildInput,
-                                    gpu::MemoryUsage::Upload, "bvh.tlas_instances", true});
-    }
-    // Sized for the capacity so instance counts up to it reuse the structure.
-    const gpu::AccelBuild sizing =
-        gpu::AccelBuild::topLevel(ctx_, instanceBuffers_[0].address(), tlasCapacity_, options_.tlasFlags);
-    if (tlas_) retire(std::move(tlas_));
-    tlas_ = std::make_unique<gpu::AccelerationStructure>(ctx_, VK_ACCELERATION_STRUCTURE_TYPE_TOP_LEVEL_KHR,
-                                                         sizing.structureSize(), "bvh.tlas", true);
-    stats_.tlasBytes = tlas_->buffer().size();
-}
-
-void BvhManager::ensureOffsets(size_t entries) {
-    const VkDeviceSize needed = std::max<VkDeviceSize>(entries, 1) * sizeof(uint32_t);
-    if (offsets_ && offsets_.size() >= needed) {
-        return;
-    }
-    const VkDeviceSize capacity = grownCapacity(needed, kMinOffsetEntries * sizeof(uint32_t));
-    if (offsets_) retire(std::move(offsets_));
-    offsets_ = gpu::Buffer(ctx_, {capacity, VK_BUFFER_USAGE_STORAGE_BUFFER_BIT | VK_BUFFER_USAGE_TRANSFER_DST_BIT,
-                                  gpu::MemoryUsage::DeviceLocal, "bvh.primitive_offsets", true});
-    for (gpu::Buffer& staging : offsetStaging_) {
-        if (staging) retire(std::move(staging));
-        staging = gpu::Buffer(ctx_, {capacity, VK_BUFFER_USAGE_TRANSFER_SRC_BIT, gpu::MemoryUsage::Upload,
-                                     "bvh.primitive_offsets.staging", true});
-    }
-    // The material table has as many rows.
-    const VkDeviceSize materialCapacity = capacity / sizeof(uint32_t) * kMaterialRowBytes;
-    if (materials_) retire(std::move(materials_));
-    materials_ = gpu::Buffer(ctx_, {materialCapacity, VK_BUFFER_USAGE_STORAGE_BUFFER_BIT | VK_BUFFER_USAGE_TRANSFER_DST_BIT,
-                                    gpu::MemoryUsage::DeviceLocal, "bvh.materials", true});
-    for (gpu::Buffer& staging : materialStaging_) {
-        if (staging) retire(std::move(staging));
-        staging = gpu::Buffer(ctx_, {materialCapacity, VK_BUFFER_USAGE_TRANSFER_SRC_BIT, gpu::MemoryUsage::Upload,
-                                     "bvh.materials.staging", true});
-    }
-}
-
-void BvhManager::ensureJointPalette(size_t matrices) {
-    const VkDeviceSize needed = std::max<VkDeviceSize>(matrices, 1) * sizeof(glm::mat4);
-    for (gpu::Buffer& palette : jointPalettes_) {
-        if (palette && palette.size() >= needed) continue;
-        if (palette) retire(std::move(palette));
-        palette = gpu::Buffer(ctx_, {grownCapacity(needed, 64 * sizeof(glm::mat4)), VK_BUFFER_USAGE_STORAGE_BUFFER_BIT,
-                                     gpu::MemoryUsage::Upload, "bvh.joint_palette", true});
     }
 }
 
@@ -499,26 +215,6 @@ void BvhManager::recordParticleQuads(const FrameWork& work, VkCommandBuffer cmd,
     particleQuadsPipeline_.pushConstants(cmd, work.billboard);
     vkCmdDispatch(cmd, (work.billboard.count + shader::kParticleBillboardGroupSize - 1) / shader::kParticleBillboardGroupSize,
                   1, 1);
-}
-
-const gpu::Buffer& BvhManager::morphedVertexBuffer(ResidentBlas& blas, size_t geometryIndex, uint32_t slot,
-                                                  VkDeviceSize bytes) {
-    // Sized once for every slot and geometry: the frame's packs keep
-    // pointers to these buffers, which must not move.
-    if (blas.morphedVertices.empty()) {
-        blas.morphedVertices.resize(framesInFlight_);
-        for (std::vector<gpu::Buffer>& buffers : blas.morphedVertices) {
-            buffers.resize(blas.desc.geometries.size());
-        }
-    }
-    std::vector<gpu::Buffer>& buffers = blas.morphedVertices.at(slot);
-    gpu::Buffer& buffer = buffers.at(geometryIndex);
-    if (!buffer || buffer.size() < bytes) {
-        if (buffer) retire(std::move(buffer));
-        buffer = gpu::Buffer(ctx_, {std::max<VkDeviceSize>(bytes, 4), VK_BUFFER_USAGE_STORAGE_BUFFER_BIT,
-                                    gpu::MemoryUsage::Upload, "bvh.morphed_vertices", true});
-    }
-    return buffer;
 }
 
 std::shared_ptr<BvhManager::FrameWork> BvhManager::prepare(const scene::BvhPlan& plan, const scene::Camera* camera) {

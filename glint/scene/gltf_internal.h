@@ -1,7 +1,8 @@
 #pragma once
 // Shared by gltf_loader.cpp (files, GLB container, JSON preflight, tinygltf)
-// and gltf_convert.cpp (tinygltf model -> scene, with every accessor
-// checked). Internal: nothing outside glint/scene includes it.
+// and the conversion (tinygltf model -> scene, with every accessor checked:
+// gltf_convert.cpp and the files beside it, through gltf_converter.h).
+// Internal: nothing outside glint/scene includes it.
 
 #include "glint/scene/gltf_loader.h"
 

@@ -7,7 +7,7 @@
 // buffer's declared size against the data that is really there and every
 // image bufferView against its buffer. The
 // conversion to the scene model (gltf_convert.cpp) then checks every
-// accessor before reading it.
+// accessor before reading it (gltf_accessors.cpp).
 
 #include "glint/scene/gltf_internal.h"
 
