@@ -1,9 +1,9 @@
 #pragma once
-// What passes/gbuffer.cpp (the shadow map and the G-buffer) and
-// passes/transparent.cpp (the blended surfaces, drawn forward with the same
-// geometry, skinning and material textures) share of GBufferRenderer's
-// insides: the pipelines' bindings, and the per-geometry draw ranges and
-// per-frame work. Not part of the passes' interface.
+// What passes/gbuffer*.cpp (the G-buffer, its assets, occlusion cull and
+// shadow map) and passes/transparent.cpp (the blended surfaces, drawn
+// forward with the same geometry, skinning and material textures) share of
+// GBufferRenderer's insides: the pipelines' bindings, and the per-geometry
+// draw ranges and per-frame work. Not part of the passes' interface.
 
 #include "glint/passes/gbuffer.h"
 

@@ -56,31 +56,6 @@ glm::vec3 heightNormal(float (*height)(float, float), float x, float z, float ep
 
 } // namespace
 
-Geometry makeBox(const glm::vec3& size, uint32_t material, float uvPerMetre) {
-    Geometry g;
-    const glm::vec3 h = size * 0.5f;
-    const glm::vec3 axes[3] = {{1, 0, 0}, {0, 1, 0}, {0, 0, 1}};
-    for (int axis = 0; axis < 3; ++axis) {
-        for (float sign : {-1.0f, 1.0f}) {
-            const glm::vec3 n = axes[axis] * sign;
-            const glm::vec3 u = axes[(axis + 1) % 3];
-            const glm::vec3 v = axes[(axis + 2) % 3];
-            const glm::vec3 c = n * h;
-            const float hu = glm::dot(glm::abs(u), h);
-            const float hv = glm::dot(glm::abs(v), h);
-            uint32_t q[4];
-            const glm::vec2 corners[4] = {{-1, -1}, {1, -1}, {1, 1}, {-1, 1}};
-            for (int k = 0; k < 4; ++k) {
-                const glm::vec3 p = c + u * (corners[k].x * hu) + v * (corners[k].y * hv);
-                const glm::vec2 uv = glm::vec2(corners[k].x * hu, corners[k].y * hv) * uvPerMetre;
-                q[k] = addVertex(g, p, n, uv);
-            }
-            addQuad(g, q[0], q[1], q[2], q[3]);
-        }
-    }
-    return finish(std::move(g), material);
-}
-
 Geometry makeDividedBox(const glm::vec3& size, uint32_t divisions, uint32_t material, float uvPerMetre) {
     Geometry g;
     const uint32_t n = std::max(divisions, 1u);
@@ -111,6 +86,11 @@ Geometry makeDividedBox(const glm::vec3& size, uint32_t divisions, uint32_t mate
         }
     }
     return finish(std::move(g), material);
+}
+
+// One quad a face: the same triangles, corners and order as any division.
+Geometry makeBox(const glm::vec3& size, uint32_t material, float uvPerMetre) {
+    return makeDividedBox(size, 1, material, uvPerMetre);
 }
 
 Geometry makeGrid(const glm::vec2& size, const glm::uvec2& cells, uint32_t material, float uvPerMetre,

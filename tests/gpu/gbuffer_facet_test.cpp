@@ -73,15 +73,6 @@ passes::GBufferSettings settingsWith(bool facets, bool occlusion) {
     return settings;
 }
 
-void checkSameTargets(const gbuffer_test::GBufferImage& a, const gbuffer_test::GBufferImage& b) {
-    CHECK(a.depth == b.depth);
-    CHECK(a.normal == b.normal);
-    CHECK(a.albedo == b.albedo);
-    CHECK(a.roughnessMetal == b.roughnessMetal);
-    CHECK(a.motion == b.motion);
-    CHECK(a.lit == b.lit);
-}
-
 } // namespace
 
 TEST_CASE("faces turned away from the camera are not sent, and the G-buffer is the same as with every triangle") {
@@ -103,7 +94,7 @@ TEST_CASE("faces turned away from the camera are not sent, and the G-buffer is t
                 gbuffer_test::render(gpu, scene, path, &on, settingsWith(true, occlusion), &countsOn);
             const gbuffer_test::GBufferImage all =
                 gbuffer_test::render(gpu, scene, path, &off, settingsWith(false, occlusion), &countsOff);
-            checkSameTargets(culled, all);
+            gbuffer_test::checkSameTargets(culled, all);
             // The three single-sided meshes are stored by facing; the
             // double-sided one is not.
             CHECK(on.facetedGeometries == 2u);

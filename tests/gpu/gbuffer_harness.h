@@ -1,7 +1,8 @@
 #pragma once
 // What the G-buffer's GPU tests share (gbuffer_test.cpp,
-// gbuffer_occlusion_test.cpp): every target of a frame read back inside the
-// graph and decoded on the host, and a renderer run over a camera path.
+// gbuffer_occlusion_test.cpp, gbuffer_facet_test.cpp): every target of a
+// frame read back inside the graph and decoded on the host, a renderer run
+// over a camera path, and the check that two runs drew the same.
 #include "support/gpu_test.h"
 
 #include "glint/graph/executor.h"
@@ -86,6 +87,17 @@ private:
     std::vector<rg::HostReadback> buffers_;
 };
 
+
+// Every target bit for bit: what a cull that changes only the raster work
+// must leave.
+inline void checkSameTargets(const GBufferImage& a, const GBufferImage& b) {
+    CHECK(a.depth == b.depth);
+    CHECK(a.normal == b.normal);
+    CHECK(a.albedo == b.albedo);
+    CHECK(a.roughnessMetal == b.roughnessMetal);
+    CHECK(a.motion == b.motion);
+    CHECK(a.lit == b.lit);
+}
 
 // Runs the G-buffer over `frames` (one frame each, waiting for each) and
 // returns the last frame's targets; `stats` gets the renderer's counts and

@@ -61,15 +61,6 @@ passes::GBufferSettings withCull(bool on) {
     return settings;
 }
 
-void checkSameTargets(const gbuffer_test::GBufferImage& a, const gbuffer_test::GBufferImage& b) {
-    CHECK(a.depth == b.depth);
-    CHECK(a.normal == b.normal);
-    CHECK(a.albedo == b.albedo);
-    CHECK(a.roughnessMetal == b.roughnessMetal);
-    CHECK(a.motion == b.motion);
-    CHECK(a.lit == b.lit);
-}
-
 } // namespace
 
 TEST_CASE("the Hi-Z's levels halve exactly from half the screen's power-of-two ceiling") {
@@ -123,7 +114,7 @@ TEST_CASE("instances behind a wall are not drawn, and the G-buffer is the same a
     CHECK(stats.draws == kInstances);
     // Two 12-triangle boxes are not drawn.
     CHECK(steady[shader::kOcclusionStatTriangles] == stats.triangles - 24u);
-    checkSameTargets(culled, all);
+    gbuffer_test::checkSameTargets(culled, all);
 }
 
 TEST_CASE("a box that comes out from behind the wall is drawn the frame it does") {
@@ -139,7 +130,7 @@ TEST_CASE("a box that comes out from behind the wall is drawn the frame it does"
     // Not visible last frame, so not drawn early: the late phase finds it.
     CHECK(counts[shader::kOcclusionStatLate] >= 1u);
     CHECK(counts[shader::kOcclusionStatOccluded] == kHiddenFromBoth);
-    checkSameTargets(culled, all);
+    gbuffer_test::checkSameTargets(culled, all);
     // And it is there: the box's grey covers pixels the wall's edge no
     // longer hides (compared against a run without the box that comes out).
     scene::Scene without = scene;
@@ -214,5 +205,5 @@ TEST_CASE("draws in runs of several chunks: each chunk keeps its drawn commands,
     CHECK(counts[shader::kOcclusionStatEarly] + counts[shader::kOcclusionStatLate] +
               counts[shader::kOcclusionStatOccluded] ==
           inView);
-    checkSameTargets(culled, all);
+    gbuffer_test::checkSameTargets(culled, all);
 }
