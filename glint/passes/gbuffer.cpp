@@ -11,15 +11,10 @@
 
 #include "glint/gbuffer_shared.h"
 
-#include <glm/gtc/constants.hpp>
-#include <spdlog/spdlog.h>
-
 #include <algorithm>
 #include <array>
 #include <bit>
-#include <cmath>
 #include <cstring>
-#include <limits>
 #include <optional>
 #include <string>
 

@@ -118,8 +118,9 @@ FacetSplit splitIntoFacets(std::span<const glm::vec3> positions, std::span<const
         f.indexCount = uint32_t(split.indices.size()) - f.firstIndex;
         if (f.indexCount > 0) split.facets.push_back(f);
     }
-    // Indices past the last whole triangle stay at the end (none in a valid
-    // geometry): the split draws what the geometry drew.
+    // Indices past the last whole triangle (none in a valid geometry) stay
+    // at the end, unused by any facet: the split holds as many indices as
+    // the geometry, so either can take its place in an index buffer.
     split.indices.insert(split.indices.end(), indices.begin() + 3 * triangles, indices.end());
     return split;
 }

@@ -27,7 +27,8 @@ namespace {
 constexpr uint32_t kDivisions = 16;  // 512 triangles a face: each face a facet
 constexpr uint64_t kFaceTriangles = 2ull * kDivisions * kDivisions;
 
-// Five divided boxes of side 1 in front of testCamera (looking down -z): one on the axes, one rotated and stretched, one mirrored, one
+// Five divided boxes of side 1 in front of testCamera (looking down -z):
+// one on the axes, one rotated and stretched, one mirrored, one
 // double-sided (never split: both faces are drawn) and one alpha-tested.
 scene::Scene boxesScene() {
     scene::Scene s;
