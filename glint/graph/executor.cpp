@@ -13,6 +13,7 @@
 
 #include <algorithm>
 #include <chrono>
+#include <cstring>
 #include <ctime>
 
 namespace glint::rg {
@@ -75,9 +76,34 @@ struct Executor::FrameSlot {
     uint32_t spanPair = 0;
     bool spanRecorded = false;
     std::optional<double> spanMilliseconds;
+    // The buffers of the frame's uploads (Graph::uploadBuffer), by upload
+    // index: host-visible, rewritten whenever the slot is reused.
+    std::vector<std::unique_ptr<gpu::Buffer>> uploads;
 };
 
 // ---------------------------------------------------------------- Executor
+
+void Executor::bindUploads(const Plan& plan, FrameSlot& slot) {
+    const ir::Declaration& decl = *plan.declaration;
+    if (slot.uploads.size() < decl.uploads.size()) slot.uploads.resize(decl.uploads.size());
+    for (size_t k = 0; k < decl.uploads.size(); ++k) {
+        const ir::Declaration::Upload& u = decl.uploads[k];
+        const PlannedResource& r = plan.resources[u.resource];
+        if (!r.used) continue;
+        // Bound whole, so exactly its size; any usage a reader may need.
+        const VkBufferUsageFlags usage = r.bufferUsage | VK_BUFFER_USAGE_STORAGE_BUFFER_BIT |
+                                         VK_BUFFER_USAGE_UNIFORM_BUFFER_BIT | VK_BUFFER_USAGE_TRANSFER_SRC_BIT;
+        std::unique_ptr<gpu::Buffer>& buffer = slot.uploads[k];
+        if (!buffer || buffer->size() != u.size || (buffer->desc().usage & usage) != usage) {
+            // run() waited for the frame that used this slot last.
+            buffer = std::make_unique<gpu::Buffer>(
+                gpu_, gpu::BufferDesc{u.size, usage, gpu::MemoryUsage::Upload,
+                                      "rg.upload." + std::string(decl.resources[u.resource].name), true});
+        }
+        std::memcpy(buffer->mapped(), decl.uploadBytes.data() + u.offset, u.size);
+        physical_[u.resource].buffer = buffer.get();
+    }
+}
 
 Executor::Executor(gpu::Context& gpu, uint32_t framesInFlight)
     : gpu_(gpu), framesInFlight_(std::max(framesInFlight, 1u)), requirements_(std::make_unique<RequirementsCache>()) {
@@ -327,6 +353,7 @@ SubmittedFrame Executor::run(const Plan& plan, const FrameResources& imports) {
     prepareTransients(plan);
     prepareHistory(plan);
     bindResources(plan, imports);
+    bindUploads(plan, slot);
     const ExternalSync external = placeSemaphores(plan, imports);
 
     // ---- timeline values: this frame's batches count up from where the

@@ -251,6 +251,7 @@ private:
     void prepareTransients(const Plan& plan);
     void prepareHistory(const Plan& plan);
     void bindResources(const Plan& plan, const FrameResources& imports);
+    void bindUploads(const Plan& plan, FrameSlot& slot);
     void recordBarriers(VkCommandBuffer cmd, const Plan& plan, std::span<const Barrier> barriers) const;
     struct ExternalSync;
     ExternalSync placeSemaphores(const Plan& plan, const FrameResources& imports) const;

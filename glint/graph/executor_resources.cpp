@@ -328,6 +328,9 @@ void Executor::bindResources(const Plan& plan, const FrameResources& imports) {
     const auto& decl = *plan.declaration;
     physical_.assign(plan.resources.size(), Physical{});
     resourceNames_.resize(plan.resources.size());
+    // Uploads are bound by bindUploads, to the frame slot's own buffers.
+    std::vector<uint8_t> uploaded(plan.resources.size(), 0);
+    for (const ir::Declaration::Upload& u : decl.uploads) uploaded[u.resource] = 1;
     for (uint32_t i = 0; i < plan.resources.size(); ++i) {
         const PlannedResource& r = plan.resources[i];
         const ir::Resource& d = decl.resources[i];
@@ -347,6 +350,7 @@ void Executor::bindResources(const Plan& plan, const FrameResources& imports) {
             break;
         }
         case ir::Origin::Imported: {
+            if (uploaded[i]) break;
             bool bound = false;
             if (r.kind == ResourceKind::Texture) {
                 const auto it = imports.images_.find(i);

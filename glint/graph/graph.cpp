@@ -174,7 +174,8 @@ std::string_view ir::NameArena::store(std::string_view a, std::string_view b) {
 
 ir::Declaration::Declaration(const Declaration& other)
     : graphId(other.graphId), passes(other.passes), uses(other.uses), resources(other.resources),
-      outputs(other.outputs), orderings(other.orderings), written(other.written), cellCount(other.cellCount) {
+      outputs(other.outputs), orderings(other.orderings), written(other.written), cellCount(other.cellCount),
+      uploads(other.uploads), uploadBytes(other.uploadBytes) {
     for (Pass& p : passes) p.name = names.store(p.name);
     for (Resource& r : resources) r.name = names.store(r.name);
 }
@@ -355,6 +356,24 @@ uint32_t Graph::declareBufferImport(std::string_view name, const BufferImport& i
     r.buffer = import.desc;
     finishResource(r, 1);
     return index;
+}
+
+Buffer Graph::uploadBuffer(std::string_view name, std::span<const std::byte> bytes) {
+    if (bytes.empty() || bytes.size() % 4 != 0 || bytes.size() > UINT32_MAX) {
+        throw GraphError(ErrorKind::InvalidDescription, name, name,
+                         "an upload must be a non-zero multiple of 4 bytes, not " + std::to_string(bytes.size()));
+    }
+    // Written by the host before the frame is submitted (the submission
+    // makes it visible); its final state is no one's concern (Access::None:
+    // no barrier at the frame's end), as the next frame in flight writes
+    // other memory.
+    constexpr BoundaryState kHostWritten =
+        BoundaryState::raw(VK_PIPELINE_STAGE_2_HOST_BIT, VK_ACCESS_2_HOST_WRITE_BIT, VK_IMAGE_LAYOUT_UNDEFINED);
+    const uint32_t index = declareBufferImport(name, {{bytes.size()}, kHostWritten, BoundaryState::of(Access::None)});
+    ir::Declaration& d = mutableDecl();
+    d.uploads.push_back({index, static_cast<uint32_t>(d.uploadBytes.size()), static_cast<uint32_t>(bytes.size())});
+    d.uploadBytes.insert(d.uploadBytes.end(), bytes.begin(), bytes.end());
+    return Buffer{index, 0, id()};
 }
 
 uint32_t Graph::declareAccelStructImport(std::string_view name, const AccelStructImport& import) {

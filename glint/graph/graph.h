@@ -31,6 +31,7 @@
 #include <cstdint>
 #include <memory>
 #include <optional>
+#include <span>
 #include <string_view>
 #include <utility>
 
@@ -143,6 +144,13 @@ public:
     Buffer importBuffer(std::string_view name, const BufferImport& import) {
         return Buffer{declareBufferImport(name, import), 0, id()};
     }
+    // A buffer holding `bytes` (copied now) when the frame starts: an import
+    // the executor binds to host-visible memory of its own, one buffer per
+    // frame in flight, and fills before it submits the frame, so no pass,
+    // transfer or barrier of the GPU's puts the bytes there. For a pass's
+    // constants (rg::addUpload). Readers declare their own reads. Throws a
+    // GraphError naming it unless the size is a non-zero multiple of 4.
+    Buffer uploadBuffer(std::string_view name, std::span<const std::byte> bytes);
     AccelStruct importAccelStruct(std::string_view name, const AccelStructImport& import) {
         return AccelStruct{declareAccelStructImport(name, import), 0, id()};
     }

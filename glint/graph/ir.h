@@ -125,6 +125,17 @@ struct Declaration {
     std::vector<uint8_t> written; // per cell: holds data some pass (or the frame's start) wrote
     uint32_t cellCount = 0;
     NameArena names;
+    // Buffers Graph::uploadBuffer declared: imports that the executor binds
+    // to host-visible memory of its own and fills with these bytes
+    // (uploadBytes[offset, offset + size)) before the frame is submitted.
+    // Not part of a plan's shape: a reused plan runs its frame's bytes.
+    struct Upload {
+        uint32_t resource;
+        uint32_t offset;
+        uint32_t size;
+    };
+    std::vector<Upload> uploads;
+    std::vector<std::byte> uploadBytes;
 };
 
 inline uint32_t cellOf(const Resource& r, uint32_t mip, uint32_t layer) {

@@ -11,9 +11,6 @@ namespace glint::rg {
 
 namespace {
 
-// vkCmdUpdateBuffer takes at most 65536 bytes per call, in multiples of 4.
-constexpr size_t kUpdateLimit = 65536;
-
 constexpr BoundaryState kHostRead =
     BoundaryState::raw(VK_PIPELINE_STAGE_2_HOST_BIT, VK_ACCESS_2_HOST_READ_BIT, VK_IMAGE_LAYOUT_UNDEFINED);
 
@@ -29,26 +26,8 @@ const ir::Resource& declared(const Graph& graph, H handle, const std::string& re
 
 } // namespace
 
-Buffer addUpload(Graph& graph, std::string_view name, std::span<const std::byte> bytes, Queue queue) {
-    if (bytes.empty() || bytes.size() % 4 != 0) {
-        throw GraphError(ErrorKind::InvalidDescription, name, name,
-                         "an upload must be a non-zero multiple of 4 bytes, not " + std::to_string(bytes.size()));
-    }
-    struct Data {
-        Buffer target;
-    };
-    auto copy = std::make_shared<std::vector<std::byte>>(bytes.begin(), bytes.end());
-    const Data& data = graph.addPass<Data>(
-        name, queue,
-        [&](Builder& b, Data& d) { d.target = b.write(b.createBuffer(name, {bytes.size()}), Access::TransferDst); },
-        [copy](const Data& d, PassContext& pc) {
-            const VkBuffer target = pc.buffer(d.target).handle();
-            for (size_t offset = 0; offset < copy->size(); offset += kUpdateLimit) {
-                const size_t size = std::min(kUpdateLimit, copy->size() - offset);
-                vkCmdUpdateBuffer(pc.cmd(), target, offset, size, copy->data() + offset);
-            }
-        });
-    return data.target;
+Buffer addUpload(Graph& graph, std::string_view name, std::span<const std::byte> bytes) {
+    return graph.uploadBuffer(name, bytes);
 }
 
 HostReadback::HostReadback(gpu::Context& ctx, VkDeviceSize bytes, std::string name)

@@ -2,7 +2,7 @@
 // Moving small data in and out of a frame through the graph, so that a
 // pass, a sample or a test does not write its own copy pass:
 //
-//   // constants that outgrow push constants, uploaded inside the frame:
+//   // constants that outgrow push constants, written by the host for the frame:
 //   const rg::Buffer constants = rg::addUpload(graph, "integrate.constants", values);
 //   ... b.read(constants, rg::Access::StorageRead) ...
 //
@@ -26,19 +26,20 @@
 
 namespace glint::rg {
 
-// Declares a transient buffer of bytes.size() bytes and a transfer pass on
-// `queue` that fills it with `bytes` (copied now; vkCmdUpdateBuffer in
-// pieces of at most 64 KiB). Readers then declare their own access to the
-// returned handle; the graph orders and synchronizes the rest.
-Buffer addUpload(Graph& graph, std::string_view name, std::span<const std::byte> bytes, Queue queue = Queue::Graphics);
+// A buffer of bytes.size() bytes that holds `bytes` (copied now) when the
+// frame starts (Graph::uploadBuffer): the executor writes them into
+// host-visible memory of its own before it submits the frame, so no
+// transfer pass runs and no barrier waits for one between the passes
+// around the reader. Readers then declare their own access to the returned
+// handle, on either queue.
+Buffer addUpload(Graph& graph, std::string_view name, std::span<const std::byte> bytes);
 
 // One value's bytes (a constants struct).
 template <class T>
     requires(!std::is_convertible_v<const T&, std::span<const std::byte>>)
-Buffer addUpload(Graph& graph, std::string_view name, const T& value, Queue queue = Queue::Graphics) {
+Buffer addUpload(Graph& graph, std::string_view name, const T& value) {
     static_assert(std::is_trivially_copyable_v<T>, "addUpload copies the value's bytes");
-    return addUpload(graph, name, std::span<const std::byte>(reinterpret_cast<const std::byte*>(&value), sizeof(T)),
-                     queue);
+    return addUpload(graph, name, std::span<const std::byte>(reinterpret_cast<const std::byte*>(&value), sizeof(T)));
 }
 
 // A host-visible buffer that a frame fills at its end: copy() declares a

@@ -1,8 +1,8 @@
 #pragma once
 // Pass 7 of the reflection pipeline: reflection motion, temporal
 // accumulation and a spatial filter for rough reflections. Two compute
-// passes on the graphics queue (after temporal.constants, a transfer that
-// fills their uniform buffer):
+// passes on the graphics queue, sharing their constants (the upload
+// "temporal.constants", rg::addUpload):
 //   temporal.accumulate  per pixel: sanitise this frame's radiance (NaN and
 //                        Inf never reach the history), reproject through the
 //                        reflected (virtual) point at the hit distance and

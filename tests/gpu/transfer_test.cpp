@@ -1,22 +1,26 @@
 // The graph's transfer helpers (glint/graph/transfer.h): bytes uploaded
 // into a frame with rg::addUpload come back unchanged through
-// rg::HostReadback, across vkCmdUpdateBuffer's 64 KiB pieces; misuse is
-// refused where it is declared, naming the readback.
+// rg::HostReadback, with no pass of their own, and frames in flight each
+// keep their own bytes; misuse is refused where it is declared, naming the
+// upload or the readback.
 #include "support/gpu_test.h"
 
 #include "glint/graph/error.h"
 #include "glint/graph/executor.h"
 #include "glint/graph/graph.h"
+#include "glint/graph/plan_cache.h"
 #include "glint/graph/transfer.h"
 #include "glint/graph/verify.h"
 
 #include <cstddef>
 #include <cstdint>
+#include <memory>
+#include <string>
 #include <vector>
 
 using namespace glint;
 
-TEST_CASE("an upload larger than one vkCmdUpdateBuffer reads back byte for byte") {
+TEST_CASE("a large upload reads back byte for byte, and the frame runs no pass to upload it") {
     test::GpuTest gpu;
     rg::Executor executor(gpu.ctx());
     std::vector<uint32_t> words(70000 / 4);  // 68.4 KiB: two pieces
@@ -29,6 +33,9 @@ TEST_CASE("an upload larger than one vkCmdUpdateBuffer reads back byte for byte"
     const rg::Plan plan = graph.compile(executor.compileOptions());
     const rg::VerifyReport report = rg::verify(plan);
     REQUIRE_MESSAGE(report.ok(), report.text());
+    // The host writes the bytes: the readback's copy is the frame's only pass.
+    REQUIRE(plan.passes.size() == 1);
+    CHECK(plan.passName(plan.passes.front()) != "transfer_test.upload");
     executor.run(plan, resources);
     executor.waitIdle();
     const std::span<const uint32_t> back = readback.as<uint32_t>();
@@ -41,6 +48,38 @@ TEST_CASE("an upload larger than one vkCmdUpdateBuffer reads back byte for byte"
     };
     const rg::Buffer one = rg::addUpload(graph, "transfer_test.constants", Constants{{1, 2, 3}, 4});
     CHECK(one.valid());
+}
+
+TEST_CASE("frames in flight each read their own upload, through a reused plan") {
+    test::GpuTest gpu;
+    constexpr uint32_t kFrames = 6;
+    rg::Executor executor(gpu.ctx(), 2);
+    rg::PlanCache cache(4);
+    std::vector<std::unique_ptr<rg::HostReadback>> readbacks;
+    for (uint32_t frame = 0; frame < kFrames; ++frame) {
+        // A compute-free frame: the bytes go from the upload straight to the
+        // readback's copy; nothing waits between the frames but the slots.
+        readbacks.push_back(
+            std::make_unique<rg::HostReadback>(gpu.ctx(), 64, "transfer_test.frame" + std::to_string(frame)));
+        rg::Graph graph(executor.queueCaps());
+        rg::FrameResources resources;
+        std::vector<uint32_t> words(16);
+        for (uint32_t i = 0; i < words.size(); ++i) words[i] = frame * 1000u + i;
+        readbacks.back()->copy(graph, resources, rg::addUpload(graph, "transfer_test.constants",
+                                                               std::as_bytes(std::span(words))));
+        const rg::Plan plan = cache.compile(graph, executor.compileOptions());
+        const rg::VerifyReport report = rg::verify(plan);
+        REQUIRE_MESSAGE(report.ok(), report.text());
+        executor.run(plan, resources);
+    }
+    CHECK(cache.hits() == kFrames - 1);
+    executor.waitIdle();
+    for (uint32_t frame = 0; frame < kFrames; ++frame) {
+        CAPTURE(frame);
+        const std::span<const uint32_t> back = readbacks[frame]->as<uint32_t>();
+        REQUIRE(back.size() == 16);
+        for (uint32_t i = 0; i < back.size(); ++i) CHECK(back[i] == frame * 1000u + i);
+    }
 }
 
 TEST_CASE("an empty or unaligned upload, a readback too small or a foreign handle are refused by name") {
