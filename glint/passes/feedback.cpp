@@ -1,39 +1,106 @@
 #include "glint/passes/feedback.h"
 
+#include "glint/gpu/descriptors.h"
 #include "glint/gpu/error.h"
+#include "glint/graph/executor.h"
+
+#include "glint/feedback_shared.h"
+#include "glint/ray_generation_shared.h"
 
 #include <cmath>
-#include <string>
+#include <vector>
 
 namespace glint::passes {
 
-shader::FeedbackConstants feedbackConstants(const FeedbackSettings& settings, uint32_t width, uint32_t height,
-                                            uint64_t frameIndex, bool resetHistory) {
+namespace {
+
+constexpr uint32_t kGroupSize = 64;  // reproject.comp's local_size_x
+
+} // namespace
+
+FeedbackPipelines::FeedbackPipelines(gpu::Context& ctx)
+    : ctx_(ctx),
+      reproject_(gpu::createComputePipeline(ctx, {"feedback/reproject.comp", {},
+                                                  uint32_t(sizeof(shader::FeedbackConstants)),
+                                                  "feedback.reproject"})),
+      // The motion is read texel by texel (texelFetch); the sampler only
+      // completes the combined descriptor.
+      nearest_(ctx, {VK_FILTER_NEAREST, VK_SAMPLER_MIPMAP_MODE_NEAREST, VK_SAMPLER_ADDRESS_MODE_CLAMP_TO_EDGE, 0.0f,
+                     "feedback.nearest"}) {}
+
+FeedbackOutputs addFeedbackPass(rg::Graph& graph, FeedbackPipelines& pipelines, const FeedbackInputs& inputs,
+                                const FeedbackSettings& settings) {
+    const GBufferOutputs& gbuf = inputs.gbuffer;
+    if (gbuf.width == 0 || gbuf.height == 0) {
+        throw gpu::GpuError("addFeedbackPass: the G-buffer has no size");
+    }
     const auto fraction = [](float f) { return f >= 0.0f && f <= 1.0f; };
     if (!fraction(settings.sslrMissFraction) || !fraction(settings.rtHitFraction)) {
-        throw gpu::GpuError("feedback: sslrMissFraction and rtHitFraction must lie in [0, 1] (got " +
+        throw gpu::GpuError("addFeedbackPass: sslrMissFraction and rtHitFraction must lie in [0, 1] (got " +
                             std::to_string(settings.sslrMissFraction) + ", " + std::to_string(settings.rtHitFraction) +
                             ")");
     }
     if (!fraction(settings.sslrMinHitShare) || settings.sslrProbeInterval == 0) {
-        throw gpu::GpuError("feedback: sslrMinHitShare must lie in [0, 1] and sslrProbeInterval be at least 1 (got " +
-                            std::to_string(settings.sslrMinHitShare) + ", " +
+        throw gpu::GpuError("addFeedbackPass: sslrMinHitShare must lie in [0, 1] and sslrProbeInterval be at least 1 "
+                            "(got " + std::to_string(settings.sslrMinHitShare) + ", " +
                             std::to_string(settings.sslrProbeInterval) + ")");
     }
+    FeedbackOutputs out;
+    out.tilesX = (gbuf.width + shader::kTileSize - 1) / shader::kTileSize;
+    out.tilesY = (gbuf.height + shader::kTileSize - 1) / shader::kTileSize;
+    const uint32_t tiles = out.tilesX * out.tilesY;
+    const uint64_t tileBytes = uint64_t(tiles) * sizeof(uint32_t);
+    out.minFrameHits =
+        uint32_t(std::ceil(double(settings.sslrMinHitShare) * double(gbuf.width) * double(gbuf.height)));
+    // The tiles' counters and the frame's sum of hits. A resize starts the
+    // pair afresh (zeroed); the shaders still bound their indices by the
+    // buffer's own length.
+    out.counters = graph.createHistoryBuffer(kFeedbackHistoryName, {tileBytes + sizeof(uint32_t)});
+
     shader::FeedbackConstants constants{};
-    constants.size = {width, height};
-    constants.tiles = {(width + shader::kTileSize - 1) / shader::kTileSize,
-                       (height + shader::kTileSize - 1) / shader::kTileSize};
+    constants.size = {gbuf.width, gbuf.height};
+    constants.tiles = {out.tilesX, out.tilesY};
     // The same 32-bit frame as the rest of the noise (glint/sampling.glsl).
-    constants.frame = uint32_t(frameIndex);
+    constants.frame = uint32_t(inputs.frameIndex);
     constants.minRays = settings.minRays;
     constants.sslrMissFraction = settings.sslrMissFraction;
     constants.rtHitFraction = settings.rtHitFraction;
     constants.adaptive = settings.adaptive ? 1u : 0u;
-    constants.resetHistory = resetHistory ? 1u : 0u;
-    constants.minFrameHits = uint32_t(std::ceil(double(settings.sslrMinHitShare) * double(width) * double(height)));
+    constants.resetHistory = inputs.resetHistory ? 1u : 0u;
+    constants.minFrameHits = out.minFrameHits;
     constants.probeInterval = settings.sslrProbeInterval;
-    return constants;
+
+    struct ReprojectData {
+        rg::Texture motion;
+        rg::Buffer previous;
+        FeedbackOutputs out;
+    };
+    const ReprojectData& reproject = graph.addPass<ReprojectData>(
+        "feedback", rg::Queue::Graphics,
+        [&](rg::Builder& b, ReprojectData& d) {
+            d.motion = b.read(gbuf.motion, rg::Access::SampledRead);
+            d.previous = b.read(out.counters.previous, rg::Access::StorageRead);
+            d.out = out;
+            // Starts the frame's sum of hits; integrate writes the rest.
+            d.out.counters.current = b.write(out.counters.current, rg::Access::StorageWrite);
+            d.out.reprojected =
+                b.write(b.createBuffer("feedback.reprojected", {tileBytes}), rg::Access::StorageWrite);
+            d.out.tileModes = b.write(b.createBuffer("feedback.tile_modes", {tileBytes}), rg::Access::StorageWrite);
+        },
+        [&pipelines, constants, tiles](const ReprojectData& d, rg::PassContext& pc) {
+            const gpu::Pipeline& pipeline = pipelines.reproject_;
+            pipeline.bind(pc.cmd());
+            gpu::PushDescriptors(pipeline)
+                .sampledImage("motionTexture", pc.view(d.motion), pipelines.nearest_.handle(), pc.layout(d.motion))
+                .storageBuffer("Previous", pc.buffer(d.previous))
+                .storageBuffer("Reprojected", pc.buffer(d.out.reprojected))
+                .storageBuffer("TileModes", pc.buffer(d.out.tileModes))
+                .storageBuffer("Current", pc.buffer(d.out.counters.current))
+                .push(pipelines.ctx_, pc.cmd());
+            pipeline.pushConstants(pc.cmd(), constants);
+            pc.dispatch(pipeline, (tiles + kGroupSize - 1) / kGroupSize);
+        });
+    return reproject.out;
 }
 
 } // namespace glint::passes

@@ -1,17 +1,16 @@
 #pragma once
-// Pass 6 of the reflection pipeline, its first half: the tile feedback,
-// done by ray generation (passes/ray_generation.h) at the start of its
-// work. Far Cry 6 keeps one u32 per 8x8 tile with the SSLR hit and miss
-// counts of two frames (layout: glint/feedback_shared.h) and uses it to
-// send each tile's hybrid pixels to SSLR only, to SSLR with the ray tracer
-// behind it, or straight to the ray tracer. Each ray generation workgroup
-// (one tile)
+// Pass 6 of the reflection pipeline, its first half: the tile
+// feedback. Far Cry 6 keeps one u32 per 8x8 tile with the SSLR hit and miss
+// counts of two frames (layout: glint/feedback_shared.h)
+// and uses it to send each tile's hybrid pixels to SSLR only, to SSLR with
+// the ray tracer behind it, or straight to the ray tracer. At the start of a
+// frame, after the G-buffer, one compute pass
 //   - carries last frame's counters (the history buffer
-//     "reflections.feedback") to its tile along the motion of one
-//     pseudo-random pixel of the tile, new every frame ("reprojected";
-//     content from off screen gets 0);
-//   - decides the tile's mode from the two frames of counts it carried
-//     ("tileModes": kTileMode*, written for the debug view and tests);
+//     "reflections.feedback") to this frame's tiles along the motion of one
+//     pseudo-random pixel per tile, new every frame ("reprojected"; content
+//     from off screen gets 0);
+//   - decides each tile's mode from the two frames of counts it carried
+//     ("tileModes": kTileMode*, read by ray generation);
 //   - but first whether SSLR pays at all this frame: where last frame's
 //     SSLR hits, summed over the frame, fall short of sslrMinHitShare of the
 //     pixels, every tile sends its hybrid pixels straight to RT
@@ -23,19 +22,18 @@
 // Integrate (passes/integrate.h) writes this frame's counts into the
 // history's `current` half, rotating the reprojected counter's counts into
 // the previous half, and adds the frame's hits to the sum after the tiles.
-// (This was a compute pass of its own before ray generation; folded into
-// ray generation, the hybrid frame has one pass and one barrier fewer.)
 //
-//   each frame, in hybrid mode:
-//     passes::RayGenerationInputs rayInputs{gbuf, frame, camera};
-//     rayInputs.feedback = settings.feedback;   // FeedbackSettings
-//     rayInputs.resetHistory = cut;
-//     const auto rays = passes::addRayGenerationPass(graph, rayPipelines, rayInputs, {});
-//     ... integrate reads rays.feedback->reprojected, writes rays.feedback->counters.current ...
+//   passes::FeedbackPipelines feedbackPipelines(ctx);   // once
+//   each frame, after the G-buffer:
+//     const auto feedback = passes::addFeedbackPass(graph, feedbackPipelines, {gbuf, frame}, {});
+//     ... ray generation reads feedback.tileModes ...
+//     ... integrate reads feedback.reprojected and writes feedback.counters.current ...
 
+#include "glint/gpu/context.h"
+#include "glint/gpu/pipeline.h"
+#include "glint/gpu/resources.h"
 #include "glint/graph/graph.h"
-
-#include "glint/feedback_shared.h"
+#include "glint/passes/gbuffer.h"
 
 #include <cstdint>
 
@@ -43,6 +41,16 @@ namespace glint::passes {
 
 // The history pair's name: one pair per executor, kept across frames.
 inline constexpr const char* kFeedbackHistoryName = "reflections.feedback";
+
+struct FeedbackInputs {
+    GBufferOutputs gbuffer;  // motion (and the size)
+    // Picks each tile's probe pixel; the same index, the same probes.
+    uint64_t frameIndex = 0;
+    // Carry no counters (a camera cut, a new scene: the temporal pass's
+    // history is discarded with them): every tile starts hybrid, without
+    // evidence, as on the first frame.
+    bool resetHistory = false;
+};
 
 struct FeedbackSettings {
     // A tile whose two frames hold fewer traced SSLR rays than this has no
@@ -77,11 +85,10 @@ struct FeedbackSettings {
 
 struct FeedbackOutputs {
     // u32 per tile, then the frame's SSLR hits (glint/feedback_shared.h);
-    // previous: last frame's; current: its tiles written by integrate, its
-    // frame word started by ray generation.
+    // previous: last frame's; current: written by integrate.
     rg::HistoryBuffer counters;
     rg::Buffer reprojected;      // u32 per tile: last frame's counter carried to this tile
-    rg::Buffer tileModes;        // u32 per tile, shader::kTileMode* (for the debug view)
+    rg::Buffer tileModes;        // u32 per tile, shader::kTileMode*
     uint32_t tilesX = 0;
     uint32_t tilesY = 0;
     // The frame's hits that make SSLR pay (sslrMinHitShare of the pixels,
@@ -90,12 +97,24 @@ struct FeedbackOutputs {
     uint32_t minFrameHits = 0;
 };
 
-// Checks `settings` (a gpu::GpuError names the value out of range) and
-// gives ray generation's feedback constants for a frame of width x height.
-// resetHistory: carry no counters (a camera cut, a new scene: the temporal
-// pass's history is discarded with them); every tile starts hybrid, without
-// evidence, as on the first frame.
-shader::FeedbackConstants feedbackConstants(const FeedbackSettings& settings, uint32_t width, uint32_t height,
-                                            uint64_t frameIndex, bool resetHistory);
+// The pipeline and the sampler the pass records with; created once.
+class FeedbackPipelines {
+public:
+    explicit FeedbackPipelines(gpu::Context& ctx);
+
+private:
+    friend FeedbackOutputs addFeedbackPass(rg::Graph&, FeedbackPipelines&, const FeedbackInputs&,
+                                           const FeedbackSettings&);
+    gpu::Context& ctx_;
+    gpu::Pipeline reproject_;
+    gpu::Sampler nearest_;
+};
+
+// Declares the pass (see the top of this file) on the graphics queue. The
+// history pair is created on the graph here; integrate must write its
+// `current` half in the same frame (the executor swaps the pair only in
+// frames that write it).
+FeedbackOutputs addFeedbackPass(rg::Graph& graph, FeedbackPipelines& pipelines, const FeedbackInputs& inputs,
+                                const FeedbackSettings& settings = {});
 
 } // namespace glint::passes

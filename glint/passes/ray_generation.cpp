@@ -3,9 +3,7 @@
 #include "glint/gpu/descriptors.h"
 #include "glint/gpu/error.h"
 #include "glint/graph/executor.h"
-#include "glint/graph/transfer.h"
 
-#include "glint/feedback_shared.h"
 #include "glint/ray_generation_shared.h"
 #include "glint/sampling.glsl"
 #include "glint/sslr_shared.h"
@@ -75,9 +73,7 @@ RayGenerationPipelines::RayGenerationPipelines(gpu::Context& ctx)
       // completes the combined descriptor.
       nearest_(ctx, {VK_FILTER_NEAREST, VK_SAMPLER_MIPMAP_MODE_NEAREST, VK_SAMPLER_ADDRESS_MODE_CLAMP_TO_EDGE, 0.0f,
                      "ray_generation.nearest"}),
-      blueNoise_(uploadBlueNoise(ctx)),
-      unused_(ctx, {16, VK_BUFFER_USAGE_STORAGE_BUFFER_BIT, gpu::MemoryUsage::DeviceLocal,
-                    "ray_generation.unused_feedback"}) {}
+      blueNoise_(uploadBlueNoise(ctx)) {}
 
 RayGenerationOutputs addRayGenerationPass(rg::Graph& graph, RayGenerationPipelines& pipelines,
                                           const RayGenerationInputs& inputs, const RayGenerationSettings& settings) {
@@ -134,7 +130,7 @@ RayGenerationOutputs addRayGenerationPass(rg::Graph& graph, RayGenerationPipelin
     constants.rtMaxDistance = settings.rtMaxDistance;
     constants.sslrMinDistance = inputs.sslrMinDistance;
     constants.flags = uint32_t(inputs.mode) | (settings.reuse ? shader::kRayGenReuse : 0u) |
-                      (inputs.feedback ? shader::kRayGenTileModes : 0u) |
+                      (inputs.tileModes.valid() ? shader::kRayGenTileModes : 0u) |
                       (settings.checkerboard ? shader::kRayGenCheckerboard : 0u) |
                       (settings.blueNoise ? shader::kRayGenBlueNoise : 0u) |
                       (settings.sslrFirst ? shader::kRayGenSslrFirst : 0u);
@@ -142,27 +138,9 @@ RayGenerationOutputs addRayGenerationPass(rg::Graph& graph, RayGenerationPipelin
     constants.rtToHybridShare = settings.rtToHybridShare;
     constants.tilesX = out.tilesX;
 
-    // The tile feedback: its counters (a history pair, created here), and
-    // its constants beside the push constants, which they would outgrow.
-    rg::Buffer feedbackConstants;
-    if (inputs.feedback) {
-        FeedbackOutputs& fb = out.feedback.emplace();
-        const shader::FeedbackConstants values =
-            passes::feedbackConstants(*inputs.feedback, gbuf.width, gbuf.height, inputs.frameIndex, inputs.resetHistory);
-        fb.tilesX = out.tilesX;
-        fb.tilesY = out.tilesY;
-        fb.minFrameHits = values.minFrameHits;
-        // The tiles' counters and the frame's sum of hits. A resize starts
-        // the pair afresh (zeroed); the shaders still bound their indices
-        // by the buffer's own length.
-        fb.counters = graph.createHistoryBuffer(kFeedbackHistoryName,
-                                                {uint64_t(out.tilesX) * out.tilesY * sizeof(uint32_t) + sizeof(uint32_t)});
-        feedbackConstants = rg::addUpload(graph, "ray_generation.feedback", values);
-    }
-
     struct ClassifyData {
-        rg::Texture depth, normal, roughnessMetal, motion;
-        rg::Buffer feedbackConstants, previousCounters;
+        rg::Texture depth, normal, roughnessMetal;
+        rg::Buffer tileModes;
         RayGenerationOutputs out;
     };
     const ClassifyData& classify = graph.addPass<ClassifyData>(
@@ -171,19 +149,10 @@ RayGenerationOutputs addRayGenerationPass(rg::Graph& graph, RayGenerationPipelin
             d.depth = b.read(gbuf.depth, rg::Access::SampledRead);
             d.normal = b.read(gbuf.normal, rg::Access::SampledRead);
             d.roughnessMetal = b.read(gbuf.roughnessMetal, rg::Access::SampledRead);
-            d.out = out;
-            if (out.feedback) {
-                const uint64_t tileBytes = uint64_t(out.tilesX) * out.tilesY * sizeof(uint32_t);
-                FeedbackOutputs& fb = *d.out.feedback;
-                d.motion = b.read(gbuf.motion, rg::Access::SampledRead);
-                d.feedbackConstants = b.read(feedbackConstants, rg::Access::StorageRead);
-                d.previousCounters = b.read(fb.counters.previous, rg::Access::StorageRead);
-                // Starts the frame's sum of hits; integrate writes the rest.
-                fb.counters.current = b.write(fb.counters.current, rg::Access::StorageWrite);
-                fb.reprojected =
-                    b.write(b.createBuffer("ray_generation.reprojected", {tileBytes}), rg::Access::StorageWrite);
-                fb.tileModes = b.write(b.createBuffer("ray_generation.tile_modes", {tileBytes}), rg::Access::StorageWrite);
+            if (inputs.tileModes.valid()) {
+                d.tileModes = b.read(inputs.tileModes, rg::Access::StorageRead);
             }
+            d.out = out;
             const auto buffer = [&](const char* name, uint64_t bytes) {
                 return b.write(b.createBuffer(name, {bytes}), rg::Access::StorageWrite);
             };
@@ -202,8 +171,7 @@ RayGenerationOutputs addRayGenerationPass(rg::Graph& graph, RayGenerationPipelin
             const gpu::Pipeline& pipeline = pipelines.classify_;
             const VkSampler sampler = pipelines.nearest_.handle();
             pipeline.bind(pc.cmd());
-            gpu::PushDescriptors push(pipeline);
-            push
+            gpu::PushDescriptors(pipeline)
                 // Layouts as the plan chose them (a sampled depth image stays depth read-only).
                 .sampledImage("depthTexture", pc.view(d.depth), sampler, pc.layout(d.depth))
                 .sampledImage("normalTexture", pc.view(d.normal), sampler, pc.layout(d.normal))
@@ -215,28 +183,14 @@ RayGenerationOutputs addRayGenerationPass(rg::Graph& graph, RayGenerationPipelin
                 .storageBuffer("RtRays", pc.buffer(d.out.rtRays))
                 .storageImage("classDebug", pc.view(d.out.classDebug))
                 .storageBuffer("RtArgs", pc.buffer(d.out.rtArgs))
-                .storageBuffer("BlueNoise", pipelines.blueNoise_);
-            if (const std::optional<FeedbackOutputs>& fb = d.out.feedback) {
-                push.sampledImage("motionTexture", pc.view(d.motion), sampler, pc.layout(d.motion))
-                    .storageBuffer("Feedback", pc.buffer(d.feedbackConstants))
-                    .storageBuffer("Previous", pc.buffer(d.previousCounters))
-                    .storageBuffer("Current", pc.buffer(fb->counters.current))
-                    .storageBuffer("Reprojected", pc.buffer(fb->reprojected))
-                    .storageBuffer("TileModes", pc.buffer(fb->tileModes));
-            } else {
-                // Without the feedback the shader touches none of these:
-                // buffers no pass uses complete the set (a buffer of the
-                // graph would be an access it does not know of: sync
-                // validation takes a bound buffer as used), and the depth,
-                // read anyway, stands in for the motion.
-                push.sampledImage("motionTexture", pc.view(d.depth), sampler, pc.layout(d.depth))
-                    .storageBuffer("Feedback", pipelines.blueNoise_)
-                    .storageBuffer("Previous", pipelines.blueNoise_)
-                    .storageBuffer("Current", pipelines.unused_)
-                    .storageBuffer("Reprojected", pipelines.unused_)
-                    .storageBuffer("TileModes", pipelines.unused_);
-            }
-            push.push(pipelines.ctx_, pc.cmd());
+                // Without tile modes the shader never reads them; the blue
+                // noise, which no pass writes, only completes the descriptor
+                // set. (A buffer of the graph would be a read it does not
+                // know of: sync validation takes a bound readonly buffer as
+                // read, and the class buffer may alias memory a pass wrote.)
+                .storageBuffer("TileModes", d.tileModes.valid() ? pc.buffer(d.tileModes) : pipelines.blueNoise_)
+                .storageBuffer("BlueNoise", pipelines.blueNoise_)
+                .push(pipelines.ctx_, pc.cmd());
             pipeline.pushConstants(pc.cmd(), constants);
             pc.dispatch(pipeline, d.out.tilesX, d.out.tilesY);
         });

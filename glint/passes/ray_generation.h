@@ -1,11 +1,9 @@
 #pragma once
 // Pass 2 of the reflection pipeline: ray generation and tile
-// classification. One compute pass reads the G-buffer and, per 8x8 tile,
-// the tile feedback (passes/feedback.h: hybrid mode's tile modes), then per
-// pixel
+// classification. One compute pass reads the G-buffer and, per pixel,
 //   - classifies it: sky (no ray), env (rougher than the cutoff: the
 //     environment map, no ray), RT (near), SSLR (far, beyond the BVH) or
-//     hybrid (between; its tile's mode may send it to SSLR only or RT);
+//     hybrid (between; the feedback counters decide later);
 //   - draws one reflection direction from GGX visible normals (Heitz 2018)
 //     with per-pixel, per-frame low-discrepancy noise (glint/sampling.glsl);
 //   - on rough quads, shares one ray per 2x2 quad (the leader rotates with
@@ -17,8 +15,7 @@
 // glint/ray_generation_shared.h.
 //
 //   passes::RayGenerationPipelines pipelines(ctx);     // once
-//   each frame, after the G-buffer (in hybrid mode with the tile feedback,
-//   passes/feedback.h, which ray generation does first):
+//   each frame, after the G-buffer:
 //     const auto rays = passes::addRayGenerationPass(graph, pipelines, {gbuf, frame, camera}, {});
 //     ... SSLR: dispatchIndirect(rays.sslrArgs, kRayListDispatchArgsBytes) over rays.sslrRays ...
 
@@ -26,14 +23,12 @@
 #include "glint/gpu/pipeline.h"
 #include "glint/gpu/resources.h"
 #include "glint/graph/graph.h"
-#include "glint/passes/feedback.h"
 #include "glint/passes/gbuffer.h"
 #include "glint/scene/bvh_planner.h"
 #include "glint/scene/camera.h"
 
 #include <cstdint>
 #include <filesystem>
-#include <optional>
 #include <vector>
 
 namespace glint::passes {
@@ -55,19 +50,15 @@ struct RayGenerationInputs {
     uint64_t frameIndex = 0;
     // This frame's unjittered matrices and position; the G-buffer's camera.
     scene::Camera camera;
+    // The feedback pass's tile modes (u32 per tile, glint/feedback_shared.h)
+    // for the hybrid band; without them (invalid) hybrid pixels stay hybrid.
+    rg::Buffer tileModes;
     // The frame's mode: which classes a pixel may take.
     ReflectionMode mode = ReflectionMode::Hybrid;
     // Pixels at or beyond this distance from the camera go to SSLR only:
     // the BVH holds nothing farther (ReflectionFrameSettings::reach; Far
     // Cry 6: 100 around the camera).
     float sslrMinDistance = scene::kDefaultBvhRadius;
-    // The tile feedback (passes/feedback.h), hybrid mode's: each tile carries
-    // last frame's counters along the G-buffer's motion and its hybrid band
-    // follows the mode they decide. Without it hybrid pixels stay hybrid and
-    // no counters are carried.
-    std::optional<FeedbackSettings> feedback;
-    // Carry no feedback counters (a camera cut, a new scene).
-    bool resetHistory = false;
 };
 
 struct RayGenerationSettings {
@@ -152,9 +143,6 @@ struct RayGenerationOutputs {
     uint32_t height = 0;
     uint32_t tilesX = 0;
     uint32_t tilesY = 0;
-    // With RayGenerationInputs::feedback: the counters, the counter carried
-    // to each tile and each tile's mode (integrate reads and writes them).
-    std::optional<FeedbackOutputs> feedback;
 };
 
 // The pipeline, the sampler and the blue noise the pass records with;
@@ -175,9 +163,6 @@ private:
     gpu::Pipeline classify_;
     gpu::Sampler nearest_;
     gpu::Buffer blueNoise_;
-    // Completes the descriptors of the feedback's outputs in frames without
-    // it (the shader writes nothing there then); no pass reads it.
-    gpu::Buffer unused_;
 };
 
 // The blue noise file the passes read, and its texels as the shaders

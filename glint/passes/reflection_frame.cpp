@@ -22,8 +22,8 @@ constexpr std::array<std::string_view, 3> kModeNames = {"hybrid", "ssr", "rt"};
 constexpr std::array<std::string_view, 3> kBackendNames = {"auto", "query", "pipeline"};
 
 // Passes that make up the reflections' cost, by name prefix.
-constexpr std::array<std::string_view, 6> kReflectionPassPrefixes = {
-    "ray_generation", "sslr", "rt_trace", "particles.trace", "integrate", "temporal"};
+constexpr std::array<std::string_view, 7> kReflectionPassPrefixes = {
+    "feedback", "ray_generation", "sslr", "rt_trace", "particles.trace", "integrate", "temporal"};
 
 } // namespace
 
@@ -62,6 +62,7 @@ ReflectionRenderer::ReflectionRenderer(gpu::Context& ctx, const scene::Scene& sc
       bvh_(ctx.caps().canTraceRays()
                ? std::make_unique<BvhManager>(ctx, scene, options.framesInFlight, options.bvhUpdate)
                : nullptr),
+      feedback_(ctx),
       rays_(ctx),
       sslr_(ctx),
       rt_(ctx.caps().canTraceRays() ? std::make_unique<RtTracePipelines>(ctx, options.backend) : nullptr),
@@ -144,15 +145,16 @@ ReflectionFrame ReflectionRenderer::addFrame(rg::Graph& graph, const scene::Came
     if (settings.sslrParticles) {
         f.gbuffer.lit = addParticleForwardPass(graph, particles_, {f.gbuffer, scene_.particles, camera}).lit;
     }
-    // 2. Ray generation and tile classification, with 6 (of last frame),
-    // the tile feedback: only the hybrid band follows tile modes.
+    // 6 (of last frame). Feedback: only the hybrid band follows tile modes.
     RayGenerationInputs rayInputs{f.gbuffer, frameIndex, camera};
     rayInputs.mode = mode;
     rayInputs.sslrMinDistance = settings.reach;
     if (mode == ReflectionMode::Hybrid) {
-        rayInputs.feedback = settings.feedback;
-        rayInputs.resetHistory = settings.resetHistory;
+        f.feedback =
+            addFeedbackPass(graph, feedback_, {f.gbuffer, frameIndex, settings.resetHistory}, settings.feedback);
+        rayInputs.tileModes = f.feedback->tileModes;
     }
+    // 2. Ray generation and tile classification.
     RayGenerationSettings raySettings = settings.rays;
     const bool sslrFallback = !f.bvhComplete && settings.sslrWhileBvhBuilds && screenSpace;
     raySettings.sslrFirst = raySettings.sslrFirst || (sslrFallback && mode == ReflectionMode::Hybrid);
@@ -161,7 +163,6 @@ ReflectionFrame ReflectionRenderer::addFrame(rg::Graph& graph, const scene::Came
     const bool viewsSslr = view.substr(0, 5) == "sslr_" || view == "lit_pyramid";
     const bool viewsRt = view.substr(0, 3) == "rt_";
     f.rays = addRayGenerationPass(graph, rays_, rayInputs, raySettings);
-    f.feedback = f.rays.feedback;
     // 3. SSLR, extending the RT list with what it cannot resolve.
     rg::Buffer rtList = f.rays.rtRays;
     rg::Buffer rtArgs = f.rays.rtArgs;

@@ -4,7 +4,7 @@
 // the golden-image tests declare every frame, and the reference for an
 // engine that wires the passes into its own frame.
 //
-//   BVH update (async compute) -> G-buffer -> ray generation (with the feedback)
+//   BVH update (async compute) -> G-buffer -> feedback -> ray generation
 //   -> SSLR -> ray-traced hits -> particles trace -> integrate -> temporal
 //   -> particles forward -> transparent (when blended surfaces are in view)
 //   -> composite
@@ -216,6 +216,7 @@ private:
     GBufferRenderer gbuffer_;
     scene::BvhPlanner planner_;
     std::unique_ptr<BvhManager> bvh_;  // null without ray tracing
+    FeedbackPipelines feedback_;
     RayGenerationPipelines rays_;
     SslrPipelines sslr_;
     std::unique_ptr<RtTracePipelines> rt_;  // null without ray tracing

@@ -47,7 +47,7 @@ std::vector<app::Flag> viewerSwitches();
 
 // Whether ReflectionRenderer::addFrame produces debug view `view` in
 // `mode`: the SSLR views need screen space (not rt), the ray-traced ones a
-// trace (not ssr), the tile views the feedback (hybrid only). The
+// trace (not ssr), the tile views the feedback pass (hybrid only). The
 // panel greys out the others so a frame never asks for what it lacks.
 bool debugViewAvailable(std::string_view view, passes::ReflectionMode mode);
 

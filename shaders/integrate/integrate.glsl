@@ -277,7 +277,7 @@ void main() {
 
 #if GLINT_INTEGRATE_FEEDBACK
     // This frame's counts and, rotated into the previous half, the counts
-    // ray generation carried here from last frame (glint/feedback_shared.h).
+    // the feedback pass carried here from last frame (glint/feedback_shared.h).
     // length(): the buffers are bound whole, whatever the image's size.
     if (lane == 0u) {
         const uint tile = gl_WorkGroupID.y * C.tiles.x + gl_WorkGroupID.x;

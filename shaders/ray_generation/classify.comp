@@ -1,14 +1,11 @@
 #version 460
 // Ray generation and tile classification (passes/ray_generation.h): one
-// workgroup per 8x8 tile. With the feedback (passes/feedback.h) the tile
-// first carries last frame's counter to itself and decides its mode (every
-// invocation alike, from the same few words); each pixel is then
-// classified (sky, env, SSLR, hybrid, RT), draws one GGX visible-normal
-// reflection ray, and rough pixels of a 2x2 quad share the quad leader's
-// ray; the tile then appends its SSLR and hybrid pixels' ray leaders to the
-// SSLR ray list and its RT pixels' leaders to the RT ray list, counting
-// both in their args, and opens SSLR's colour pyramid passes when a listed
-// ray cone-traces.
+// workgroup per 8x8 tile. Each pixel is classified (sky, env, SSLR,
+// hybrid, RT), draws one GGX visible-normal reflection ray, and rough
+// pixels of a 2x2 quad share the quad leader's ray; the tile then appends
+// its SSLR and hybrid pixels' ray leaders to the SSLR ray list and its RT
+// pixels' leaders to the RT ray list, counting both in their args, and
+// opens SSLR's colour pyramid passes when a listed ray cone-traces.
 #extension GL_GOOGLE_include_directive : require
 #extension GL_EXT_scalar_block_layout : require
 
@@ -28,17 +25,9 @@ layout(set = 0, binding = 6, scalar) writeonly buffer RtRays { PackedRay rtRays[
 layout(set = 0, binding = 7, scalar) buffer SslrArgs { uint sslrArgs[]; };
 layout(set = 0, binding = 8, rgba8) uniform writeonly image2D classDebug;
 layout(set = 0, binding = 9, scalar) buffer RtArgs { uint rtArgs[]; };
-// The feedback (glint/feedback_shared.h), bound and used only with
-// kRayGenTileModes: last frame's counters (and their frame word), this
-// frame's counters (only the frame word is written here, integrate writes
-// the tiles), the counter carried to each tile, each tile's mode, the
-// constants, and the G-buffer's motion the counters follow.
-layout(set = 0, binding = 10, scalar) readonly buffer Previous { uint previous[]; };
-layout(set = 0, binding = 12, scalar) writeonly buffer Current { uint current[]; };
-layout(set = 0, binding = 13, scalar) writeonly buffer Reprojected { uint reprojected[]; };
-layout(set = 0, binding = 14, scalar) writeonly buffer TileModes { uint tileModes[]; };
-layout(set = 0, binding = 15, scalar) readonly buffer Feedback { FeedbackConstants feedback; };
-layout(set = 0, binding = 16) uniform sampler2D motionTexture;
+// The feedback pass's kTileMode* per tile (glint/feedback_shared.h); read
+// only when pc.tileModesEnabled is 1.
+layout(set = 0, binding = 10, scalar) readonly buffer TileModes { uint tileModes[]; };
 // The spatiotemporal blue noise (glint/sampling.glsl); read only with kRayGenBlueNoise.
 layout(set = 0, binding = 11, scalar) readonly buffer BlueNoise { uvec2 blueNoise[]; };
 
@@ -64,7 +53,7 @@ const vec4 kClassColours[5] = vec4[5](vec4(0.0, 0.0, 0.0, 1.0), vec4(0.5, 0.5, 0
 // random share of an RT tile's pixels stays hybrid, so SSLR keeps being
 // tried there and the tile can come back to it when SSLR starts to hit;
 // in a frame where SSLR does not pay (kTileModeRtOnly) none does.
-uint applyMode(uint pixelClass, uvec2 pixel, uint tileMode) {
+uint applyMode(uint pixelClass, uvec2 pixel) {
     const uint mode = pc.flags & kRayGenModeMask;
     if (mode == kModeSsr) {
         return kPixelSslr;
@@ -81,6 +70,7 @@ uint applyMode(uint pixelClass, uvec2 pixel, uint tileMode) {
     if (pixelClass != kPixelHybrid || (pc.flags & kRayGenTileModes) == 0u) {
         return pixelClass;
     }
+    const uint tileMode = tileModes[(pixel.y / kTileSize) * pc.tilesX + pixel.x / kTileSize];
     if (tileMode == kTileModeSslr) {
         return kPixelSslr;
     }
@@ -101,42 +91,6 @@ uint applyMode(uint pixelClass, uvec2 pixel, uint tileMode) {
     return kPixelHybrid;
 }
 
-// By the bits: implementations may fold isnan/isinf away (integrate.glsl).
-bool isFinite(vec2 v) {
-    return (floatBitsToUint(v.x) & 0x7F800000u) != 0x7F800000u && (floatBitsToUint(v.y) & 0x7F800000u) != 0x7F800000u;
-}
-
-// The tile's feedback (the Far Cry 6 talk's): last frame's counter of the
-// tile where the content of one pseudo-random pixel of this tile was last
-// frame (its "random motion vector", a new pixel every frame; content from
-// off screen, or anything after a reset, carries 0), and the tile's mode
-// from the two frames of counts it holds, unless last frame's SSLR hits,
-// summed over the frame, say that SSLR does not pay: then RT-only, except
-// on probe frames (glint/feedback_shared.h).
-uvec2 tileFeedback(uvec2 tile) {
-    const uint tiles = feedback.tiles.x * feedback.tiles.y;
-    // length(): the buffers are bound whole.
-    const uint lastFrameWord = tiles < uint(previous.length()) ? previous[tiles] : 0u;
-    const bool reset = feedback.resetHistory != 0u;
-    const bool pays = sslrPays(lastFrameWord, feedback.minFrameHits,
-                               feedbackProbeFrame(feedback.frame, feedback.probeInterval), reset);
-    const uvec2 probe = feedbackProbePixel(tile, feedback.frame, feedback.size);
-    // glint/gbuffer_shared.h: history lookup = pixel + motion.
-    const vec2 motion = texelFetch(motionTexture, ivec2(probe), 0).xy;
-    const vec2 last = vec2(probe) + 0.5 + motion;
-    uint counter = 0u;
-    if (!reset && isFinite(motion) && all(greaterThanEqual(last, vec2(0.0))) && all(lessThan(last, vec2(feedback.size)))) {
-        const uvec2 lastTile = uvec2(last) / kTileSize;
-        const uint lastIndex = lastTile.y * feedback.tiles.x + lastTile.x;
-        counter = lastIndex < uint(previous.length()) ? previous[lastIndex] : 0u;
-    }
-    const uint mode = feedback.adaptive == 0u ? kTileModeHybrid
-                      : !pays                 ? kTileModeRtOnly
-                                              : decideTileMode(counter, feedback.minRays, feedback.sslrMissFraction,
-                                                               feedback.rtHitFraction);
-    return uvec2(counter, mode);
-}
-
 void main() {
     const uvec2 pixel = gl_GlobalInvocationID.xy;
     const uint lane = gl_LocalInvocationIndex;
@@ -145,22 +99,6 @@ void main() {
         sharedSslrCount = 0u;
         sharedRtCount = 0u;
         sharedCone = 0u;
-    }
-    uint tileMode = kTileModeHybrid;
-    if ((pc.flags & kRayGenTileModes) != 0u) {
-        // Every invocation reads the same words: one request each.
-        const uvec2 tileFeedbackValue = tileFeedback(gl_WorkGroupID.xy);
-        tileMode = tileFeedbackValue.y;
-        if (lane == 0u) {
-            const uint tile = gl_WorkGroupID.y * feedback.tiles.x + gl_WorkGroupID.x;
-            reprojected[tile] = tileFeedbackValue.x;
-            tileModes[tile] = tileMode;
-            // This frame's sum of hits starts here; integrate adds to it.
-            const uint tiles = feedback.tiles.x * feedback.tiles.y;
-            if (tile == 0u && tiles < uint(current.length())) {
-                current[tiles] = kFeedbackFrameHitsStart;
-            }
-        }
     }
 
     uint pixelClass = kPixelSky;
@@ -186,7 +124,7 @@ void main() {
                 pixelClass = distance < pc.rtMaxDistance ? kPixelRt
                              : distance >= pc.sslrMinDistance ? kPixelSslr
                                                               : kPixelHybrid;
-                pixelClass = applyMode(pixelClass, pixel, tileMode);
+                pixelClass = applyMode(pixelClass, pixel);
                 vec2 u;
                 if ((pc.flags & kRayGenBlueNoise) != 0u) {
                     const uvec2 texel = blueNoise[blueNoiseTexel(pixel, pc.frame)];

@@ -392,7 +392,7 @@ struct Frame {
     std::vector<glm::u8vec4> source;
     std::vector<uint32_t> counters;     // integrate's new counters, one per tile
     uint32_t frameHitsWord = 0;         // the counters' word after the tiles (glint/feedback_shared.h)
-    std::vector<uint32_t> reprojected;  // ray generation's feedback
+    std::vector<uint32_t> reprojected;  // the feedback pass's
     std::vector<uint32_t> tileModes;
     Traces sslr;  // the SSLR inputs integrate read (its sslr* fields)
 };
@@ -502,9 +502,7 @@ struct RunOptions {
     float confidenceThreshold = passes::kDefaultConfidenceThreshold;
     passes::RayGenerationSettings rays = floorRaySettings();
     float sslrMinDistance = kFloorSslrMinDistance;
-    // Ray generation follows the feedback's tile modes; false: the feedback
-    // decides nothing (FeedbackSettings::adaptive off: hybrid pixels stay
-    // hybrid), its counters are still carried.
+    // Ray generation follows the feedback's tile modes.
     bool followTileModes = false;
     // Runs the real SSLR pass instead of uploading traces.sslr*.
     passes::SslrPipelines* realSslr = nullptr;
@@ -512,7 +510,7 @@ struct RunOptions {
 };
 
 // One scene, one executor (the history persists across frames), the real
-// G-buffer and ray generation (with its feedback), hand-made traces and
+// G-buffer and ray generation, hand-made traces, the feedback pass and
 // integrate.
 class Harness {
 public:
@@ -522,6 +520,7 @@ public:
           executor_(ctx_),
           renderer_(ctx_, scene_),
           rayPipelines_(ctx_),
+          feedbackPipelines_(ctx_),
           integratePipelines_(ctx_),
           transfers_(ctx_),
           lighting_(passes::sceneLighting(scene_)) {}
@@ -534,15 +533,15 @@ public:
         rg::FrameResources resources;
         Frame f;
         const passes::GBufferOutputs gbuf = passes::addGBufferPass(graph, renderer_, {camera});
+        std::optional<passes::FeedbackOutputs> feedback;
+        if (present.feedback) {
+            feedback = passes::addFeedbackPass(graph, feedbackPipelines_, {gbuf, frameIndex}, options.feedback);
+        }
         passes::RayGenerationInputs rayInputs{gbuf, frameIndex, camera};
         rayInputs.sslrMinDistance = options.sslrMinDistance;
-        if (present.feedback) {
-            rayInputs.feedback = options.feedback;
-            rayInputs.feedback->adaptive = options.feedback.adaptive && options.followTileModes;
-        }
+        if (options.followTileModes && feedback) rayInputs.tileModes = feedback->tileModes;
         const passes::RayGenerationOutputs rays =
             passes::addRayGenerationPass(graph, rayPipelines_, rayInputs, options.rays);
-        const std::optional<passes::FeedbackOutputs>& feedback = rays.feedback;
 
         passes::IntegrateInputs in;
         in.gbuffer = gbuf;
@@ -635,9 +634,8 @@ public:
         return f;
     }
 
-    // A frame of the G-buffer and ray generation with its feedback alone,
-    // whose counters' current half is then written with `counters`
-    // (standing in for integrate):
+    // A frame of the G-buffer and the feedback pass alone, whose counters'
+    // current half is written with `counters` (standing in for integrate):
     // one per tile, then the frame's word of hits, which is 1 + the tiles'
     // hits where `counters` has none.
     struct FeedbackFrame {
@@ -650,11 +648,8 @@ public:
         rg::Graph graph(executor_.queueCaps());
         rg::FrameResources resources;
         const passes::GBufferOutputs gbuf = passes::addGBufferPass(graph, renderer_, {camera});
-        passes::RayGenerationInputs rayInputs{gbuf, frameIndex, camera};
-        rayInputs.feedback = settings;
-        rayInputs.resetHistory = resetHistory;
         const passes::FeedbackOutputs feedback =
-            *passes::addRayGenerationPass(graph, rayPipelines_, rayInputs, floorRaySettings()).feedback;
+            passes::addFeedbackPass(graph, feedbackPipelines_, {gbuf, frameIndex, resetHistory}, settings);
         REQUIRE(feedback.tilesX == kTiles);
         REQUIRE(feedback.tilesY == kTiles);
         std::vector<uint32_t> written = counters;
@@ -694,6 +689,7 @@ private:
     rg::Executor executor_;
     passes::GBufferRenderer renderer_;
     passes::RayGenerationPipelines rayPipelines_;
+    passes::FeedbackPipelines feedbackPipelines_;
     passes::IntegratePipelines integratePipelines_;
     Transfers transfers_;
     shader::SceneLighting lighting_;

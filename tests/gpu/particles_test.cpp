@@ -243,7 +243,7 @@ public:
             gbuf.lit = passes::addParticleForwardPass(graph, particles_, {gbuf, scene_.particles, camera_}).lit;
         }
         const passes::RayGenerationOutputs rays =
-            passes::addRayGenerationPass(graph, rays_, {gbuf, noise, camera_, mode}, {});
+            passes::addRayGenerationPass(graph, rays_, {gbuf, noise, camera_, {}, mode}, {});
         std::optional<passes::SslrOutputs> sslr;
         if (mode != passes::ReflectionMode::Rt) {
             sslr = passes::addSslrPass(graph, sslr_, {gbuf, rays, noise, camera_.view, camera_.projection});

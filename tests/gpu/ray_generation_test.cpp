@@ -40,6 +40,8 @@ constexpr float kNear = test::kPassTestNear;
 using test::square;
 using test::testCamera;
 
+constexpr rg::BoundaryState kHostWrite =
+    rg::BoundaryState::raw(VK_PIPELINE_STAGE_2_HOST_BIT, VK_ACCESS_2_HOST_WRITE_BIT, VK_IMAGE_LAYOUT_UNDEFINED);
 constexpr size_t kReadbacks = 6;
 
 // What the pass wrote in one frame, read back on the host.
@@ -129,61 +131,45 @@ struct Band {
     float sslrMinDistance = scene::kDefaultBvhRadius;
 };
 
-// Renders the G-buffer and the ray generation for each frame index. With
-// `lastCounters` (u32 per tile, then the frame's word of SSLR hits:
-// glint/feedback_shared.h) the tile feedback runs with its default
-// settings, and every frame finds them as last frame's counters (a frame
-// ahead of the first writes them too): the camera is still, so each tile
-// carries its own.
+// Renders the G-buffer and the ray generation for each frame index, with
+// the given tile modes (u32 per tile, glint/feedback_shared.h) when not empty.
 std::vector<RayFrame> generate(test::GpuTest& gpu, const scene::Scene& scene, const std::vector<uint64_t>& frames,
                                const passes::RayGenerationSettings& settings = {}, const Band& band = {},
-                               const std::vector<uint32_t>& lastCounters = {}) {
+                               const std::vector<uint32_t>& tileModes = {}) {
     auto& ctx = gpu.ctx();
     rg::Executor executor(ctx);
     passes::GBufferRenderer renderer(ctx, scene);
     passes::RayGenerationPipelines pipelines(ctx);
     Readback readback(ctx);
+    gpu::Buffer modes;
+    if (!tileModes.empty()) {
+        modes = gpu::Buffer(ctx, {tileModes.size() * 4, VK_BUFFER_USAGE_STORAGE_BUFFER_BIT, gpu::MemoryUsage::Upload,
+                                  "ray_generation_test.tile_modes"});
+        std::memcpy(modes.mapped(), tileModes.data(), tileModes.size() * 4);
+    }
     const scene::Camera camera = testCamera();
-    const bool feedback = !lastCounters.empty();
     std::vector<RayFrame> out;
-    for (size_t i = feedback ? 0 : 1; i <= frames.size(); ++i) {
-        const uint64_t frame = i == 0 ? frames.front() + 1000 : frames[i - 1];
+    for (const uint64_t frame : frames) {
         rg::Graph graph(executor.queueCaps());
         rg::FrameResources resources;
         const passes::GBufferOutputs gbuf = passes::addGBufferPass(graph, renderer, {camera});
         passes::RayGenerationInputs inputs{gbuf, frame, camera};
         inputs.mode = band.mode;
         inputs.sslrMinDistance = band.sslrMinDistance;
-        if (feedback) inputs.feedback = passes::FeedbackSettings{};
+        if (!tileModes.empty()) {
+            inputs.tileModes = graph.importBuffer(
+                "tile_modes", {{modes.size()}, kHostWrite, rg::BoundaryState::of(rg::Access::StorageRead)});
+            resources.bind(inputs.tileModes, modes);
+        }
         const passes::RayGenerationOutputs rays = passes::addRayGenerationPass(graph, pipelines, inputs, settings);
         REQUIRE(rays.tilesX == kSize / shader::kTileSize);
-        REQUIRE(rays.feedback.has_value() == feedback);
         readback.add(graph, rays, resources);
-        if (feedback) {
-            // Standing in for integrate: next frame's counters.
-            REQUIRE(lastCounters.size() == size_t(rays.tilesX) * rays.tilesY + 1);
-            const rg::Buffer seed = rg::addUpload(graph, "seed", std::as_bytes(std::span(lastCounters)));
-            struct Copy {
-                rg::Buffer from, to;
-            };
-            graph.addPass<Copy>(
-                "seed_counters", rg::Queue::Graphics,
-                [&](rg::Builder& b, Copy& d) {
-                    d.from = b.read(seed, rg::Access::TransferSrc);
-                    d.to = b.write(rays.feedback->counters.current, rg::Access::TransferDst);
-                },
-                [bytes = lastCounters.size() * 4](const Copy& d, rg::PassContext& pc) {
-                    const VkBufferCopy region{0, 0, bytes};
-                    vkCmdCopyBuffer(pc.cmd(), pc.buffer(d.from).handle(), pc.buffer(d.to).handle(), 1, &region);
-                });
-        }
         const rg::Plan plan = graph.compile(executor.compileOptions());
         const auto report = rg::verify(plan);
         REQUIRE_MESSAGE(report.ok(), report.text());
         executor.run(plan, resources);
         executor.waitIdle();
-        RayFrame decoded = readback.decode();
-        if (i > 0) out.push_back(std::move(decoded));
+        out.push_back(readback.decode());
     }
     return out;
 }
@@ -595,8 +581,7 @@ TEST_CASE("the ssr and rt modes send every traced pixel one way, and the RT list
     }
 }
 
-TEST_CASE("hybrid pixels follow their tile's feedback, an RT tile keeps the configured share hybrid, and a frame "
-          "whose SSLR does not pay keeps none but on probe frames") {
+TEST_CASE("hybrid pixels follow their tile's mode, an RT tile keeps the configured share hybrid, an RT-only tile none") {
     test::GpuTest gpu;
     passes::RayGenerationSettings settings;
     Band band;
@@ -604,36 +589,29 @@ TEST_CASE("hybrid pixels follow their tile's feedback, an RT tile keeps the conf
     band.sslrMinDistance = 1e9f;  // no SSLR band: every floor pixel is hybrid before the feedback
     settings.rtToHybridShare = 0.25f;
     constexpr uint32_t kTiles = kSize / shader::kTileSize;
-    // Columns of tiles whose last two frames say SSLR (only hits), hybrid
-    // (both) and RT (only misses), repeating; then the frame's word of hits.
-    const std::array<uint32_t, 3> modes = {shader::kTileModeSslr, shader::kTileModeHybrid, shader::kTileModeRt};
-    const std::array<uint32_t, 3> counts = {shader::packFeedback(5, 0, 0, 0), shader::packFeedback(2, 2, 0, 0),
-                                            shader::packFeedback(0, 5, 0, 0)};
-    std::vector<uint32_t> counters(kTiles * kTiles + 1);
-    for (uint32_t t = 0; t < kTiles * kTiles; ++t) {
-        counters[t] = counts[(t % kTiles) % 3];
-        REQUIRE(shader::decideTileMode(counters[t], 1, 0.0f, 0.0f) == modes[(t % kTiles) % 3]);
+    // Columns of tiles: SSLR, hybrid, RT, RT-only, repeating.
+    std::vector<uint32_t> modes(kTiles * kTiles);
+    for (uint32_t t = 0; t < modes.size(); ++t) {
+        modes[t] = std::array{shader::kTileModeSslr, shader::kTileModeHybrid, shader::kTileModeRt,
+                              shader::kTileModeRtOnly}[(t % kTiles) % 4];
     }
-    const auto modeOf = [&](uint32_t x) { return modes[(x / shader::kTileSize) % 3]; };
-    const passes::FeedbackSettings defaults;
-    const uint32_t minHits = uint32_t(std::ceil(double(defaults.sslrMinHitShare) * kSize * kSize));
-    REQUIRE(minHits > 0);
-
-    // SSLR pays (last frame's hits reach the share): the columns' modes.
-    counters.back() = shader::kFeedbackFrameHitsStart + minHits;
-    uint64_t rtTilePixels = 0, keptHybrid = 0;
+    uint64_t rtTilePixels = 0, keptHybrid = 0, rtOnlyPixels = 0;
     const std::vector<RayFrame> frames =
-        generate(gpu, floorScene(0.05f), {0, 1, 2, 3, 4, 5, 6, 7}, settings, band, counters);
+        generate(gpu, floorScene(0.05f), {0, 1, 2, 3, 4, 5, 6, 7}, settings, band, modes);
     for (const RayFrame& f : frames) {
         for (uint32_t y = kSize / 2; y < kSize; ++y) {
             for (uint32_t x = 0; x < kSize; ++x) {
-                const uint32_t mode = modeOf(x);
+                const uint32_t mode = modes[(y / shader::kTileSize) * kTiles + x / shader::kTileSize];
                 const uint32_t c = f.classes[f.at(x, y)];
                 INFO("pixel " << x << ", " << y << ", tile mode " << mode);
                 if (mode == shader::kTileModeSslr) {
                     REQUIRE(c == shader::kPixelSslr);
                 } else if (mode == shader::kTileModeHybrid) {
                     REQUIRE(c == shader::kPixelHybrid);
+                } else if (mode == shader::kTileModeRtOnly) {
+                    // The frame's SSLR does not pay: nothing stays hybrid.
+                    REQUIRE(c == shader::kPixelRt);
+                    ++rtOnlyPixels;
                 } else {
                     REQUIRE((c == shader::kPixelRt || c == shader::kPixelHybrid));
                     ++rtTilePixels;
@@ -645,33 +623,7 @@ TEST_CASE("hybrid pixels follow their tile's feedback, an RT tile keeps the conf
     // 8 frames x 512 pixels of the RT columns' floor: the binomial standard
     // deviation of the share is ~0.007, so 0.03 is a four-sigma bound.
     REQUIRE(rtTilePixels > 3000);
+    REQUIRE(rtOnlyPixels > 3000);
     const double share = double(keptHybrid) / double(rtTilePixels);
     CHECK(std::abs(share - 0.25) < 0.03);
-
-    // One hit short: every hybrid pixel goes to RT, none kept hybrid,
-    // whatever its tile says; a probe frame follows the tiles again.
-    counters.back() = shader::kFeedbackFrameHitsStart + minHits - 1;
-    std::vector<uint64_t> probes, others;
-    for (uint64_t frame = 0; probes.empty() || others.size() < 2; ++frame) {
-        (shader::feedbackProbeFrame(uint32_t(frame), defaults.sslrProbeInterval) ? probes : others).push_back(frame);
-    }
-    const std::vector<RayFrame> gated =
-        generate(gpu, floorScene(0.05f), {others[0], others[1], probes[0]}, settings, band, counters);
-    for (size_t k = 0; k < gated.size(); ++k) {
-        const bool probe = k == 2;
-        CAPTURE(probe);
-        uint32_t sslr = 0;
-        for (uint32_t y = kSize / 2; y < kSize; ++y) {
-            for (uint32_t x = 0; x < kSize; ++x) {
-                const uint32_t c = gated[k].classes[gated[k].at(x, y)];
-                if (!probe) {
-                    REQUIRE(c == shader::kPixelRt);
-                } else if (modeOf(x) == shader::kTileModeSslr) {
-                    REQUIRE(c == shader::kPixelSslr);
-                }
-                sslr += c == shader::kPixelSslr ? 1u : 0u;
-            }
-        }
-        CHECK((sslr > 0) == probe);
-    }
 }

@@ -147,6 +147,7 @@ TEST_CASE("the real frame on two queues: the BVH update alone on async compute o
         }
         std::vector<std::string_view> expected = {"shadow_map", "gbuffer", "ray_generation"};
         if (mode == passes::ReflectionMode::Hybrid) {
+            expected.push_back("feedback");
             expected.push_back("sslr");
         }
         for (const std::string_view name : expected) {

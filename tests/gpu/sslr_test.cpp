@@ -227,7 +227,7 @@ SslrFrame traceScene(test::GpuTest& gpu, const scene::Scene& scene, uint64_t fra
     const passes::GBufferOutputs gbuf = passes::addGBufferPass(graph, renderer, {camera});
     const passes::RayGenerationOutputs rays =
         passes::addRayGenerationPass(graph, rayPipelines,
-                                     {gbuf, frame, camera, passes::ReflectionMode::Hybrid, 1e9f}, raySettings);
+                                     {gbuf, frame, camera, {}, passes::ReflectionMode::Hybrid, 1e9f}, raySettings);
     const passes::SslrOutputs sslr =
         passes::addSslrPass(graph, sslrPipelines, {gbuf, rays, frame, camera.view, camera.projection}, settings);
     readback.add(graph, rays, sslr, gbuf, resources);
@@ -442,7 +442,7 @@ PyramidFrame buildPyramid(test::GpuTest& gpu, const scene::Scene& scene, glm::uv
     const passes::GBufferOutputs gbuf = passes::addGBufferPass(graph, renderer, {camera});
     const passes::RayGenerationOutputs rays =
         passes::addRayGenerationPass(graph, rayPipelines,
-                                     {gbuf, 1, camera, passes::ReflectionMode::Hybrid, 1e9f}, raySettings);
+                                     {gbuf, 1, camera, {}, passes::ReflectionMode::Hybrid, 1e9f}, raySettings);
     const passes::SslrOutputs sslr =
         passes::addSslrPass(graph, sslrPipelines, {gbuf, rays, 1, camera.view, camera.projection}, {});
     REQUIRE(sslr.litPyramid.valid());

@@ -1,8 +1,8 @@
 // The 8x8-tile feedback counters of the hybrid reflections (Far Cry 6 talk,
 // constants and packing shared by GLSL and C++
-// (passes/integrate.cpp writes them; ray generation,
-// shaders/ray_generation/classify.comp, carries them to this frame's tiles
-// and decides each tile's mode; passes/feedback.h describes it all).
+// (passes/integrate.cpp writes them, passes/feedback.cpp reprojects them
+// and decides each tile's mode, shaders/ray_generation/classify.comp reads
+// the modes).
 //
 // One u32 per 8x8 tile (glint/ray_generation_shared.h's kTileSize), 8 bits
 // per count, saturating at 255:
@@ -15,11 +15,11 @@
 // reprojected counter's low half (last frame's counts) into the high half.
 //
 // The counters buffer holds one word more, after the tiles: 1 + the
-// frame's SSLR hits summed over every tile (ray generation sets it to 1 at
-// the start of the frame; integrate adds each tile's hits until the sum
+// frame's SSLR hits summed over every tile (the feedback pass sets it to 1
+// at the start of the frame; integrate adds each tile's hits until the sum
 // reaches FeedbackConstants::minFrameHits). 0 says no frame wrote it (a new
-// pair): no evidence. Next frame's ray generation reads it to decide
-// whether SSLR pays at all (sslrPays).
+// pair): no evidence. Next frame's feedback pass reads it to decide whether
+// SSLR pays at all (sslrPays).
 #ifndef GLINT_FEEDBACK_SHARED_H
 #define GLINT_FEEDBACK_SHARED_H
 
@@ -30,8 +30,8 @@
 
 GLINT_BEGIN
 
-// Tile modes, one u32 per tile, decided by ray generation from the
-// reprojected counters for its hybrid pixels:
+// Tile modes, one u32 per tile, decided by the feedback pass from the
+// reprojected counters and read by ray generation for its hybrid pixels:
 // SSLR only, SSLR then RT for low confidence, or straight to RT.
 GLINT_CONST uint kTileModeSslr = 0u;
 GLINT_CONST uint kTileModeHybrid = 1u;
@@ -60,7 +60,7 @@ GLINT_FUNC uint rotateFeedback(uint reprojected, uint hits, uint misses) {
 }
 
 // ---------------------------------------------------------------------------
-// The tiles' feedback (shaders/ray_generation/classify.comp)
+// The feedback pass (passes/feedback.cpp, shaders/feedback/reproject.comp)
 // ---------------------------------------------------------------------------
 
 // The tile's mode from its two frames of counts (a reprojected counter):
@@ -127,8 +127,7 @@ GLINT_FUNC uvec2 feedbackProbePixel(uvec2 tile, uint frame, uvec2 size) {
     return uvec2(x0 + (h & 0xFFFFu) % w, y0 + (h >> 16u) % hgt);
 }
 
-// Ray generation's feedback constants (48 bytes; an upload, beside its
-// push constants: passes/feedback.cpp's feedbackConstants).
+// Push constants of reproject.comp (48 bytes).
 struct FeedbackConstants {
     uvec2 size;   // pixels
     uvec2 tiles;  // tiles in x and y
