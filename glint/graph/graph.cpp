@@ -486,6 +486,11 @@ void Graph::abortPass(uint32_t pass) {
     d.uses.resize(d.passes[pass].firstUse);
     d.passes.pop_back();
     d.resources.resize(passFirstResource_);
+    // An upload declared inside the failed setup goes with its resource.
+    while (!d.uploads.empty() && d.uploads.back().resource >= passFirstResource_) {
+        d.uploadBytes.resize(d.uploads.back().offset);
+        d.uploads.pop_back();
+    }
     d.cellCount = passFirstCell_;
     d.written.resize(passFirstCell_);
 }

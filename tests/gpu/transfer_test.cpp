@@ -23,7 +23,7 @@ using namespace glint;
 TEST_CASE("a large upload reads back byte for byte, and the frame runs no pass to upload it") {
     test::GpuTest gpu;
     rg::Executor executor(gpu.ctx());
-    std::vector<uint32_t> words(70000 / 4);  // 68.4 KiB: two pieces
+    std::vector<uint32_t> words(70000 / 4);  // 68.4 KiB
     for (size_t i = 0; i < words.size(); ++i) words[i] = uint32_t(i * 2654435761u);
     const rg::HostReadback readback(gpu.ctx(), words.size() * 4, "transfer_test.readback");
     rg::Graph graph(executor.queueCaps());
@@ -104,4 +104,31 @@ TEST_CASE("an empty or unaligned upload, a readback too small or a foreign handl
     const rg::HostReadback fits(gpu.ctx(), 64 * 64 * 4, "transfer_test.fits");
     CHECK_THROWS_WITH_AS(fits.copy(other, resources, image), doctest::Contains("not a resource of this graph"),
                          rg::GraphError);
+}
+
+TEST_CASE("an upload declared in a pass whose setup throws goes with the pass") {
+    test::GpuTest gpu;
+    rg::Executor executor(gpu.ctx());
+    rg::Graph graph(executor.queueCaps());
+    rg::FrameResources resources;
+    const std::vector<uint32_t> kept = {7, 8, 9, 10};
+    const rg::Buffer first = rg::addUpload(graph, "transfer_test.kept", std::as_bytes(std::span(kept)));
+    CHECK_THROWS_AS(graph.addPass("transfer_test.failing", rg::Queue::Graphics,
+                                  [&](rg::Builder&) {
+                                      const std::vector<uint32_t> lost = {1, 2, 3, 4};
+                                      (void)rg::addUpload(graph, "transfer_test.lost", std::as_bytes(std::span(lost)));
+                                      throw rg::GraphError(rg::ErrorKind::InvalidDescription, "transfer_test.failing",
+                                                           "", "setup failed on purpose");
+                                  }),
+                    rg::GraphError);
+    REQUIRE(graph.declaration().uploads.size() == 1);
+    CHECK(graph.declaration().uploadBytes.size() == kept.size() * 4);
+    const rg::HostReadback readback(gpu.ctx(), kept.size() * 4, "transfer_test.kept_back");
+    readback.copy(graph, resources, first);
+    const rg::Plan plan = graph.compile(executor.compileOptions());
+    REQUIRE(rg::verify(plan).ok());
+    executor.run(plan, resources);
+    executor.waitIdle();
+    const std::span<const uint32_t> back = readback.as<uint32_t>();
+    CHECK(std::equal(back.begin(), back.end(), kept.begin()));
 }
