@@ -12,6 +12,7 @@
 #include <spdlog/spdlog.h>
 
 #include <algorithm>
+#include <bit>
 #include <chrono>
 #include <cstring>
 #include <ctime>
@@ -76,29 +77,38 @@ struct Executor::FrameSlot {
     uint32_t spanPair = 0;
     bool spanRecorded = false;
     std::optional<double> spanMilliseconds;
-    // The buffers of the frame's uploads (Graph::uploadBuffer), by upload
-    // index: host-visible, rewritten whenever the slot is reused.
-    std::vector<std::unique_ptr<gpu::Buffer>> uploads;
+    // The buffers of the frames' uploads (Graph::uploadBuffer), host-visible
+    // and rewritten whenever the slot is reused: by the upload's name (and
+    // its count among this frame's uploads of that name), each of a power
+    // of two of at least 256 bytes that only grows. So a frame of another
+    // mode or with a few more particles reuses them, and the memory they
+    // hold stops growing once every frame's kinds have run.
+    std::map<std::string, std::vector<std::unique_ptr<gpu::Buffer>>, std::less<>> uploads;
 };
 
 // ---------------------------------------------------------------- Executor
 
 void Executor::bindUploads(const Plan& plan, FrameSlot& slot) {
     const ir::Declaration& decl = *plan.declaration;
-    if (slot.uploads.size() < decl.uploads.size()) slot.uploads.resize(decl.uploads.size());
-    for (size_t k = 0; k < decl.uploads.size(); ++k) {
-        const ir::Declaration::Upload& u = decl.uploads[k];
+    std::map<std::string_view, uint32_t> seen;  // this frame's uploads of each name so far
+    for (const ir::Declaration::Upload& u : decl.uploads) {
         const PlannedResource& r = plan.resources[u.resource];
         if (!r.used) continue;
-        // Bound whole, so exactly its size; any usage a reader may need.
+        const std::string_view name = decl.resources[u.resource].name;
+        auto list = slot.uploads.find(name);
+        if (list == slot.uploads.end()) list = slot.uploads.emplace(std::string(name), 0).first;
+        const uint32_t k = seen[name]++;
+        if (list->second.size() <= k) list->second.resize(k + 1);
+        std::unique_ptr<gpu::Buffer>& buffer = list->second[k];
+        // Any usage a reader may need; the readers take only the bytes
+        // they declared (a constants block, a readback of the declared size).
         const VkBufferUsageFlags usage = r.bufferUsage | VK_BUFFER_USAGE_STORAGE_BUFFER_BIT |
                                          VK_BUFFER_USAGE_UNIFORM_BUFFER_BIT | VK_BUFFER_USAGE_TRANSFER_SRC_BIT;
-        std::unique_ptr<gpu::Buffer>& buffer = slot.uploads[k];
-        if (!buffer || buffer->size() != u.size || (buffer->desc().usage & usage) != usage) {
+        if (!buffer || buffer->size() < u.size || (buffer->desc().usage & usage) != usage) {
             // run() waited for the frame that used this slot last.
+            const VkDeviceSize capacity = std::bit_ceil(std::max<VkDeviceSize>(u.size, 256));
             buffer = std::make_unique<gpu::Buffer>(
-                gpu_, gpu::BufferDesc{u.size, usage, gpu::MemoryUsage::Upload,
-                                      "rg.upload." + std::string(decl.resources[u.resource].name), true});
+                gpu_, gpu::BufferDesc{capacity, usage, gpu::MemoryUsage::Upload, "rg.upload." + std::string(name), true});
         }
         std::memcpy(buffer->mapped(), decl.uploadBytes.data() + u.offset, u.size);
         physical_[u.resource].buffer = buffer.get();

@@ -148,8 +148,11 @@ public:
     // the executor binds to host-visible memory of its own, one buffer per
     // frame in flight, and fills before it submits the frame, so no pass,
     // transfer or barrier of the GPU's puts the bytes there. For a pass's
-    // constants (rg::addUpload). Readers declare their own reads. Throws a
-    // GraphError naming it unless the size is a non-zero multiple of 4.
+    // constants (rg::addUpload). Readers declare their own reads. The buffer
+    // bound may be larger than the bytes (it is reused across frames): a
+    // shader that takes an array's length() from the binding counts the
+    // rest too. Throws a GraphError naming it unless the size is a non-zero
+    // multiple of 4.
     Buffer uploadBuffer(std::string_view name, std::span<const std::byte> bytes);
     AccelStruct importAccelStruct(std::string_view name, const AccelStructImport& import) {
         return AccelStruct{declareAccelStructImport(name, import), 0, id()};
