@@ -82,9 +82,20 @@ struct Executor::FrameSlot {
     // its count among this frame's uploads of that name), each of a power
     // of two of at least 256 bytes that only grows. So a frame of another
     // mode or with a few more particles reuses them, and the memory they
-    // hold stops growing once every frame's kinds have run.
-    std::map<std::string, std::vector<std::unique_ptr<gpu::Buffer>>, std::less<>> uploads;
+    // hold stops growing once every frame's kinds have run. A name no frame
+    // of the last kUploadKeepFrames used is let go.
+    struct Uploads {
+        std::vector<std::unique_ptr<gpu::Buffer>> buffers;
+        uint64_t lastFrame = 0;
+    };
+    std::map<std::string, Uploads, std::less<>> uploads;
 };
+
+namespace {
+
+constexpr uint64_t kUploadKeepFrames = 64;
+
+} // namespace
 
 // ---------------------------------------------------------------- Executor
 
@@ -96,10 +107,11 @@ void Executor::bindUploads(const Plan& plan, FrameSlot& slot) {
         if (!r.used) continue;
         const std::string_view name = decl.resources[u.resource].name;
         auto list = slot.uploads.find(name);
-        if (list == slot.uploads.end()) list = slot.uploads.emplace(std::string(name), 0).first;
+        if (list == slot.uploads.end()) list = slot.uploads.emplace(std::string(name), FrameSlot::Uploads{}).first;
+        list->second.lastFrame = frame_;
         const uint32_t k = seen[name]++;
-        if (list->second.size() <= k) list->second.resize(k + 1);
-        std::unique_ptr<gpu::Buffer>& buffer = list->second[k];
+        if (list->second.buffers.size() <= k) list->second.buffers.resize(k + 1);
+        std::unique_ptr<gpu::Buffer>& buffer = list->second.buffers[k];
         // Any usage a reader may need; the readers take only the bytes
         // they declared (a constants block, a readback of the declared size).
         const VkBufferUsageFlags usage = r.bufferUsage | VK_BUFFER_USAGE_STORAGE_BUFFER_BIT |
@@ -113,6 +125,8 @@ void Executor::bindUploads(const Plan& plan, FrameSlot& slot) {
         std::memcpy(buffer->mapped(), decl.uploadBytes.data() + u.offset, u.size);
         physical_[u.resource].buffer = buffer.get();
     }
+    // Every frame that used this slot before has finished (run() waited).
+    std::erase_if(slot.uploads, [&](const auto& entry) { return frame_ - entry.second.lastFrame > kUploadKeepFrames; });
 }
 
 Executor::Executor(gpu::Context& gpu, uint32_t framesInFlight)
