@@ -87,6 +87,7 @@ struct Executor::FrameSlot {
     struct Uploads {
         std::vector<std::unique_ptr<gpu::Buffer>> buffers;
         uint64_t lastFrame = 0;
+        uint32_t usedInLastFrame = 0;  // buffers taken by lastFrame's uploads of the name
     };
     std::map<std::string, Uploads, std::less<>> uploads;
 };
@@ -101,17 +102,20 @@ constexpr uint64_t kUploadKeepFrames = 64;
 
 void Executor::bindUploads(const Plan& plan, FrameSlot& slot) {
     const ir::Declaration& decl = *plan.declaration;
-    std::map<std::string_view, uint32_t> seen;  // this frame's uploads of each name so far
     for (const ir::Declaration::Upload& u : decl.uploads) {
         const PlannedResource& r = plan.resources[u.resource];
         if (!r.used) continue;
         const std::string_view name = decl.resources[u.resource].name;
         auto list = slot.uploads.find(name);
         if (list == slot.uploads.end()) list = slot.uploads.emplace(std::string(name), FrameSlot::Uploads{}).first;
-        list->second.lastFrame = frame_;
-        const uint32_t k = seen[name]++;
-        if (list->second.buffers.size() <= k) list->second.buffers.resize(k + 1);
-        std::unique_ptr<gpu::Buffer>& buffer = list->second.buffers[k];
+        FrameSlot::Uploads& kept = list->second;
+        if (kept.lastFrame != frame_) {
+            kept.lastFrame = frame_;
+            kept.usedInLastFrame = 0;
+        }
+        const uint32_t k = kept.usedInLastFrame++;
+        if (kept.buffers.size() <= k) kept.buffers.resize(k + 1);
+        std::unique_ptr<gpu::Buffer>& buffer = kept.buffers[k];
         // Any usage a reader may need; the readers take only the bytes
         // they declared (a constants block, a readback of the declared size).
         const VkBufferUsageFlags usage = r.bufferUsage | VK_BUFFER_USAGE_STORAGE_BUFFER_BIT |

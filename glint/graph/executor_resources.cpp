@@ -328,9 +328,6 @@ void Executor::bindResources(const Plan& plan, const FrameResources& imports) {
     const auto& decl = *plan.declaration;
     physical_.assign(plan.resources.size(), Physical{});
     resourceNames_.resize(plan.resources.size());
-    // Uploads are bound by bindUploads, to the frame slot's own buffers.
-    std::vector<uint8_t> uploaded(plan.resources.size(), 0);
-    for (const ir::Declaration::Upload& u : decl.uploads) uploaded[u.resource] = 1;
     for (uint32_t i = 0; i < plan.resources.size(); ++i) {
         const PlannedResource& r = plan.resources[i];
         const ir::Resource& d = decl.resources[i];
@@ -350,7 +347,6 @@ void Executor::bindResources(const Plan& plan, const FrameResources& imports) {
             break;
         }
         case ir::Origin::Imported: {
-            if (uploaded[i]) break;
             bool bound = false;
             if (r.kind == ResourceKind::Texture) {
                 const auto it = imports.images_.find(i);
@@ -365,6 +361,12 @@ void Executor::bindResources(const Plan& plan, const FrameResources& imports) {
                 bound = it != imports.accels_.end();
                 if (bound) p.accel = it->second;
             }
+            // An upload (Graph::uploadBuffer) is bound next, by bindUploads.
+            const auto isUpload = [&] {
+                return std::any_of(decl.uploads.begin(), decl.uploads.end(),
+                                   [&](const ir::Declaration::Upload& u) { return u.resource == i; });
+            };
+            if (!bound && r.kind == ResourceKind::Buffer && isUpload()) break;
             if (!bound) {
                 throw gpu::GpuError("render graph: imported " + std::string(toString(r.kind)) + " '" + std::string(d.name) +
                                     "' has no resource bound for this frame (FrameResources::bind)");
