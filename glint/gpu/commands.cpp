@@ -76,6 +76,18 @@ void TimelineSemaphore::wait(uint64_t value, uint64_t timeoutNs) const {
     check(r, "vkWaitSemaphores '" + name_ + "'");
 }
 
+bool TimelineSemaphore::reached(uint64_t value) const {
+    VkSemaphore s = semaphore_.get();
+    VkSemaphoreWaitInfo info{VK_STRUCTURE_TYPE_SEMAPHORE_WAIT_INFO};
+    info.semaphoreCount = 1;
+    info.pSemaphores = &s;
+    info.pValues = &value;
+    const VkResult r = vkWaitSemaphores(device_, &info, 0);
+    if (r == VK_TIMEOUT) return false;
+    check(r, "vkWaitSemaphores '" + name_ + "'");
+    return true;
+}
+
 // ---------------------------------------------------------------- submission
 
 void submitAndWait(Context& ctx, const Queue& queue, std::string_view what,

@@ -48,6 +48,10 @@ public:
     // Waits on the host; throws GpuError naming the semaphore on timeout
     // or failure.
     void wait(uint64_t value, uint64_t timeoutNs = 10'000'000'000ull) const;
+    // Whether the semaphore has reached `value`, without waiting. A host
+    // wait when it has: what the device made available to the host before
+    // signalling it is then visible (a readback's bytes).
+    bool reached(uint64_t value) const;
 
 private:
     VkDevice device_ = VK_NULL_HANDLE;

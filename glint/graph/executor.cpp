@@ -50,16 +50,19 @@ void FrameResources::bind(AccelStruct handle, const gpu::AccelerationStructure& 
 
 void FrameResources::waitSemaphore(Texture image, VkSemaphore semaphore, VkPipelineStageFlags2 stages,
                                    uint64_t value) {
-    waits_.push_back({image.index, semaphore, stages, value});
+    waits_.push_back({image.index, ResourceKind::Texture, semaphore, stages, value});
 }
 void FrameResources::waitSemaphore(VkSemaphore semaphore, VkPipelineStageFlags2 stages, uint64_t value) {
-    waits_.push_back({kNoIndex, semaphore, stages, value});
+    waits_.push_back({kNoIndex, ResourceKind::Texture, semaphore, stages, value});
 }
 void FrameResources::signalSemaphore(Texture image, VkSemaphore semaphore, uint64_t value) {
-    signals_.push_back({image.index, semaphore, kSemaphoreSignalStages, value});
+    signals_.push_back({image.index, ResourceKind::Texture, semaphore, kSemaphoreSignalStages, value});
+}
+void FrameResources::signalSemaphore(Buffer buffer, VkSemaphore semaphore, uint64_t value) {
+    signals_.push_back({buffer.index, ResourceKind::Buffer, semaphore, kSemaphoreSignalStages, value});
 }
 void FrameResources::signalSemaphore(VkSemaphore semaphore, uint64_t value) {
-    signals_.push_back({kNoIndex, semaphore, kSemaphoreSignalStages, value});
+    signals_.push_back({kNoIndex, ResourceKind::Texture, semaphore, kSemaphoreSignalStages, value});
 }
 
 // ---------------------------------------------------------------- internal state
@@ -235,11 +238,12 @@ Executor::ExternalSync Executor::placeSemaphores(const Plan& plan, const FrameRe
     out.waits.resize(plan.batches.size());
     out.signals.resize(plan.batches.size());
     const auto& decl = *plan.declaration;
-    const auto importedTexture = [&](uint32_t r, const char* what) -> const ir::Resource& {
-        if (r >= decl.resources.size() || decl.resources[r].kind != ResourceKind::Texture ||
+    const auto imported = [&](uint32_t r, ResourceKind kind, const char* what) -> const ir::Resource& {
+        if (r >= decl.resources.size() || decl.resources[r].kind != kind ||
             decl.resources[r].origin != ir::Origin::Imported) {
-            throw gpu::GpuError(std::string("render graph: FrameResources::") + what +
-                                " names a texture that is not an import of this plan");
+            throw gpu::GpuError(std::string("render graph: FrameResources::") + what + " names a " +
+                                (kind == ResourceKind::Buffer ? "buffer" : "texture") +
+                                " that is not an import of this plan");
         }
         return decl.resources[r];
     };
@@ -255,9 +259,9 @@ Executor::ExternalSync Executor::placeSemaphores(const Plan& plan, const FrameRe
     for (const FrameResources::SemaphoreUse& w : imports.waits_) {
         uint32_t batch = plan.batches.empty() ? kNoIndex : 0;
         VkPipelineStageFlags2 stages = w.stages;
-        if (w.texture != kNoIndex) {
-            const ir::Resource& res = importedTexture(w.texture, "waitSemaphore");
-            const Plan::WaitPoint point = plan.firstUseOf(w.texture);
+        if (w.resource != kNoIndex) {
+            const ir::Resource& res = imported(w.resource, w.kind, "waitSemaphore");
+            const Plan::WaitPoint point = plan.firstUseOf(w.resource);
             if (point.batch != kNoIndex) batch = point.batch;
             if (stages == 0) {
                 if (!res.hasInitial || boundaryScope(res.initial, ResourceKind::Texture).stages == 0) {
@@ -277,9 +281,9 @@ Executor::ExternalSync Executor::placeSemaphores(const Plan& plan, const FrameRe
 
     for (const FrameResources::SemaphoreUse& sg : imports.signals_) {
         uint32_t batch = lastBatch;
-        if (sg.texture != kNoIndex) {
-            importedTexture(sg.texture, "signalSemaphore");
-            if (const uint32_t ending = plan.batchEnding(sg.texture); ending != kNoIndex) batch = ending;
+        if (sg.resource != kNoIndex) {
+            imported(sg.resource, sg.kind, "signalSemaphore");
+            if (const uint32_t ending = plan.batchEnding(sg.resource); ending != kNoIndex) batch = ending;
         }
         (batch == kNoIndex ? out.unplacedSignals : out.signals[batch]).push_back(info(sg, sg.stages));
     }

@@ -93,6 +93,10 @@ public:
     // barrier, or else holds its last use) signals `semaphore` at
     // kSemaphoreSignalStages. An import no pass uses: the frame's last batch.
     void signalSemaphore(Texture image, VkSemaphore semaphore, uint64_t value = 0);
+    // The same for an imported buffer: the batch that leaves it in its final
+    // state (a host read: the host may read it once the semaphore is
+    // signalled, rg::FrameReadback) signals `semaphore`.
+    void signalSemaphore(Buffer buffer, VkSemaphore semaphore, uint64_t value = 0);
     // The frame's last batch (submission order) signals `semaphore`. With
     // two queues the other queue may still be working: wait for a
     // SubmittedFrame to know the whole frame is done.
@@ -101,7 +105,8 @@ public:
 private:
     friend class Executor;
     struct SemaphoreUse {
-        uint32_t texture = kNoIndex;  // kNoIndex: the frame's first / last batch
+        uint32_t resource = kNoIndex;  // an imported texture or buffer; kNoIndex: the frame's first / last batch
+        ResourceKind kind = ResourceKind::Texture;
         VkSemaphore semaphore = VK_NULL_HANDLE;
         VkPipelineStageFlags2 stages = 0;
         uint64_t value = 0;  // timeline semaphores only

@@ -100,4 +100,46 @@ std::span<const std::byte> HostReadback::bytes() const {
     return {buffer_.mapped(), static_cast<size_t>(buffer_.size())};
 }
 
+FrameReadback::FrameReadback(gpu::Context& ctx, VkDeviceSize bytes, std::string name, uint32_t depth)
+    : done_(ctx, name + ".done"), name_(std::move(name)) {
+    if (depth < 2 || bytes == 0) {
+        throw GraphError(ErrorKind::InvalidDescription, name_, "",
+                         "a frame readback needs at least 2 buffers of at least one byte (got " +
+                             std::to_string(depth) + " of " + std::to_string(bytes) + ")");
+    }
+    buffers_.reserve(depth);
+    for (uint32_t i = 0; i < depth; ++i) {
+        buffers_.emplace_back(ctx, gpu::BufferDesc{bytes,
+                                                   VK_BUFFER_USAGE_TRANSFER_DST_BIT | VK_BUFFER_USAGE_STORAGE_BUFFER_BIT,
+                                                   gpu::MemoryUsage::Readback, name_ + "." + std::to_string(i)});
+    }
+}
+
+std::optional<FrameReadback::Target> FrameReadback::declare(Graph& graph) {
+    const uint64_t sequence = declared_ + 1;
+    // The buffer's last frame (depth sequences ago) must have finished: the
+    // host read it, and a new frame may write it.
+    if (sequence > depth() && !done_.reached(sequence - depth())) {
+        return std::nullopt;
+    }
+    declared_ = sequence;
+    // Left, by its last frame, as this frame leaves it: to the host's read
+    // (the barrier from there orders this frame's write after that frame's).
+    const Buffer buffer = graph.importBuffer(name_, {{buffers_.front().size()}, kHostRead, kHostRead});
+    return Target{buffer, sequence};
+}
+
+void FrameReadback::bind(FrameResources& resources, const Target& target) const {
+    resources.bind(target.buffer, buffers_[target.sequence % depth()]);
+    resources.signalSemaphore(target.buffer, done_.handle(), target.sequence);
+}
+
+std::optional<std::span<const std::byte>> FrameReadback::read(uint64_t sequence) const {
+    if (sequence == 0 || sequence > declared_ || overwritten(sequence) || !done_.reached(sequence)) {
+        return std::nullopt;
+    }
+    const gpu::Buffer& buffer = buffers_[sequence % depth()];
+    return std::span<const std::byte>(buffer.mapped(), static_cast<size_t>(buffer.size()));
+}
+
 } // namespace glint::rg

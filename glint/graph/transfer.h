@@ -12,17 +12,23 @@
 //   executor.run(graph.compile(...), resources);
 //   executor.waitIdle();
 //   std::span<const uint8_t> rgba = readback.bytes();
+//
+//   // a few bytes of each frame, read some frames later without a wait:
+//   rg::FrameReadback (below)
 
+#include "glint/gpu/commands.h"
 #include "glint/gpu/resources.h"
 #include "glint/graph/executor.h"
 #include "glint/graph/graph.h"
 
 #include <cstddef>
 #include <cstdint>
+#include <optional>
 #include <span>
 #include <string>
 #include <string_view>
 #include <type_traits>
+#include <vector>
 
 namespace glint::rg {
 
@@ -74,6 +80,55 @@ private:
 
     gpu::Buffer buffer_;
     std::string name_;
+};
+
+// A few bytes out of each frame that asks, read by the host some frames
+// later without waiting for the GPU: a frame's own statistics steering the
+// frames after it (passes::ReflectionRenderer's SSLR gate).
+//
+//   rg::FrameReadback readback(ctx, 4, "gate");
+//   each frame:
+//     if (const auto target = readback.declare(graph))   // an import
+//         ... a pass writes target->buffer (TransferDst or a storage write) ...
+//     ... then, with the frame's resources: readback.bind(resources, *target);
+//   a later frame, with a sequence an earlier declare() returned:
+//     if (const auto bytes = readback.read(sequence)) use(*bytes);
+//
+// `depth` host-visible buffers take turns; a timeline semaphore, signalled
+// by the batch that leaves the frame's buffer in its final state (a host
+// read), says which frames have finished. A frame that declares a target
+// and is never run leaves a gap, nothing else.
+class FrameReadback {
+public:
+    // `depth` must exceed the frames in flight, or declare() finds every
+    // buffer still in use and declares nothing.
+    FrameReadback(gpu::Context& ctx, VkDeviceSize bytes, std::string name, uint32_t depth = 4);
+
+    struct Target {
+        Buffer buffer;          // the import a pass of this frame writes
+        uint64_t sequence = 0;  // 1, 2, ...: what read() takes
+    };
+    // This frame's target; nullopt while every buffer awaits a frame still
+    // on the GPU (no host wait).
+    std::optional<Target> declare(Graph& graph);
+    // Binds the target's buffer and the semaphore its frame signals.
+    void bind(FrameResources& resources, const Target& target) const;
+
+    // What the frame of `sequence` wrote, once it has finished (no wait):
+    // nullopt before, and once its buffer has been declared again. Valid
+    // until the next declare().
+    std::optional<std::span<const std::byte>> read(uint64_t sequence) const;
+    // Whether read(sequence) can no longer answer: declared again since.
+    bool overwritten(uint64_t sequence) const { return declared_ >= sequence + depth(); }
+
+    uint32_t depth() const { return uint32_t(buffers_.size()); }
+    const std::string& name() const { return name_; }
+
+private:
+    std::vector<gpu::Buffer> buffers_;
+    gpu::TimelineSemaphore done_;
+    std::string name_;
+    uint64_t declared_ = 0;  // the last sequence declared
 };
 
 } // namespace glint::rg

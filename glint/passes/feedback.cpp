@@ -28,6 +28,10 @@ FeedbackPipelines::FeedbackPipelines(gpu::Context& ctx)
       nearest_(ctx, {VK_FILTER_NEAREST, VK_SAMPLER_MIPMAP_MODE_NEAREST, VK_SAMPLER_ADDRESS_MODE_CLAMP_TO_EDGE, 0.0f,
                      "feedback.nearest"}) {}
 
+uint32_t feedbackMinFrameHits(const FeedbackSettings& settings, uint32_t width, uint32_t height) {
+    return uint32_t(std::ceil(double(settings.sslrMinHitShare) * double(width) * double(height)));
+}
+
 FeedbackOutputs addFeedbackPass(rg::Graph& graph, FeedbackPipelines& pipelines, const FeedbackInputs& inputs,
                                 const FeedbackSettings& settings) {
     const GBufferOutputs& gbuf = inputs.gbuffer;
@@ -50,8 +54,7 @@ FeedbackOutputs addFeedbackPass(rg::Graph& graph, FeedbackPipelines& pipelines, 
     out.tilesY = (gbuf.height + shader::kTileSize - 1) / shader::kTileSize;
     const uint32_t tiles = out.tilesX * out.tilesY;
     const uint64_t tileBytes = uint64_t(tiles) * sizeof(uint32_t);
-    out.minFrameHits =
-        uint32_t(std::ceil(double(settings.sslrMinHitShare) * double(gbuf.width) * double(gbuf.height)));
+    out.minFrameHits = feedbackMinFrameHits(settings, gbuf.width, gbuf.height);
     // The tiles' counters and the frame's sum of hits. A resize starts the
     // pair afresh (zeroed); the shaders still bound their indices by the
     // buffer's own length.
@@ -72,7 +75,7 @@ FeedbackOutputs addFeedbackPass(rg::Graph& graph, FeedbackPipelines& pipelines, 
 
     struct ReprojectData {
         rg::Texture motion;
-        rg::Buffer previous;
+        rg::Buffer previous, report;
         FeedbackOutputs out;
     };
     const ReprojectData& reproject = graph.addPass<ReprojectData>(
@@ -80,6 +83,10 @@ FeedbackOutputs addFeedbackPass(rg::Graph& graph, FeedbackPipelines& pipelines, 
         [&](rg::Builder& b, ReprojectData& d) {
             d.motion = b.read(gbuf.motion, rg::Access::SampledRead);
             d.previous = b.read(out.counters.previous, rg::Access::StorageRead);
+            if (inputs.report.valid()) {
+                b.read(out.counters.previous, rg::Access::TransferSrc);
+                d.report = b.write(inputs.report, rg::Access::TransferDst);
+            }
             d.out = out;
             // Starts the frame's sum of hits; integrate writes the rest.
             d.out.counters.current = b.write(out.counters.current, rg::Access::StorageWrite);
@@ -87,7 +94,13 @@ FeedbackOutputs addFeedbackPass(rg::Graph& graph, FeedbackPipelines& pipelines, 
                 b.write(b.createBuffer("feedback.reprojected", {tileBytes}), rg::Access::StorageWrite);
             d.out.tileModes = b.write(b.createBuffer("feedback.tile_modes", {tileBytes}), rg::Access::StorageWrite);
         },
-        [&pipelines, constants, tiles](const ReprojectData& d, rg::PassContext& pc) {
+        [&pipelines, constants, tiles, decide = inputs.decide, report = inputs.reportLastFrame](
+            const ReprojectData& d, rg::PassContext& pc) {
+            if (d.report.valid() && report) {
+                const VkBufferCopy word{uint64_t(tiles) * sizeof(uint32_t), 0, sizeof(uint32_t)};
+                vkCmdCopyBuffer(pc.cmd(), pc.buffer(d.previous).handle(), pc.buffer(d.report).handle(), 1, &word);
+            }
+            if (!decide) return;
             const gpu::Pipeline& pipeline = pipelines.reproject_;
             pipeline.bind(pc.cmd());
             gpu::PushDescriptors(pipeline)

@@ -50,6 +50,19 @@ struct FeedbackInputs {
     // history is discarded with them): every tile starts hybrid, without
     // evidence, as on the first frame.
     bool resetHistory = false;
+    // The host's side of the gate (ReflectionRenderer, FeedbackSettings::
+    // hostGate). When valid (4 bytes), the pass first copies the counters'
+    // word after the tiles of last frame (`previous`: its SSLR hits) into
+    // it, for the host to read once the frame has finished.
+    rg::Buffer report;
+    // False: the copy is declared but not recorded (last frame wrote no
+    // counters, so there is nothing to report).
+    bool reportLastFrame = true;
+    // False on a frame the host renders as rt (ray generation reads no tile
+    // modes, integrate writes no counters): the pass records only the copy
+    // into `report`, if any. Its declarations stay the same, so that the
+    // frame keeps the plan of the frames that decide.
+    bool decide = true;
 };
 
 struct FeedbackSettings {
@@ -78,6 +91,15 @@ struct FeedbackSettings {
     // pixel again, so that the frame comes back to SSLR when it starts to
     // hit. 1: every frame.
     uint32_t sslrProbeInterval = 8;
+    // The same gate on the host (passes/reflection_frame.h): once the hits
+    // of a frame that tried SSLR, read back a few frames later, fall short
+    // of sslrMinHitShare, the frames that are not probe frames render as rt
+    // (ray generation sends every traced pixel to RT, and the feedback, the
+    // pyramid and the SSLR pass record nothing), until a probe frame's hits
+    // reach the share again. Removes what the GPU gate still pays on such
+    // frames: this pass, SSLR's empty dispatches, integrate's hybrid
+    // variant. Off: only the GPU gate.
+    bool hostGate = true;
     // Off: every tile hybrid, as if there were no feedback (the bench's
     // baseline); the counters are still carried.
     bool adaptive = true;
@@ -96,6 +118,9 @@ struct FeedbackOutputs {
     // once it reaches them.
     uint32_t minFrameHits = 0;
 };
+
+// FeedbackOutputs::minFrameHits for a frame of width x height pixels.
+uint32_t feedbackMinFrameHits(const FeedbackSettings& settings, uint32_t width, uint32_t height);
 
 // The pipeline and the sampler the pass records with; created once.
 class FeedbackPipelines {

@@ -76,8 +76,11 @@ IntegrateOutputs addIntegratePass(rg::Graph& graph, IntegratePipelines& pipeline
     }
     const bool hasRt = inputs.rtRadiance.valid();
     const bool hasParticles = inputs.particles.valid();
-    const uint32_t variant = (inputs.sslr ? kVariantSslr : 0u) | (hasRt ? kVariantRt : 0u) |
-                             (hasFeedback ? kVariantFeedback : 0u);
+    // A frame the host renders as rt records rt mode's variant; it declares
+    // what the frames around it declare (their plan).
+    const bool idle = inputs.screenSpaceIdle;
+    const uint32_t variant = (inputs.sslr && !idle ? kVariantSslr : 0u) | (hasRt ? kVariantRt : 0u) |
+                             (hasFeedback && !idle ? kVariantFeedback : 0u);
 
     IntegrateOutputs out;
     out.width = gbuf.width;
@@ -98,7 +101,7 @@ IntegrateOutputs addIntegratePass(rg::Graph& graph, IntegratePipelines& pipeline
     constants.particlesBound = hasParticles ? 1u : 0u;
     constants.rtMissesTrusted = settings.rtMissesTrusted ? 1u : 0u;
     constants.rtHitMotionBound = inputs.rtHitMotion.valid() ? 1u : 0u;
-    constants.minFrameHits = hasFeedback ? feedback.minFrameHits : 0u;
+    constants.minFrameHits = (variant & kVariantFeedback) != 0 ? feedback.minFrameHits : 0u;
 
     // The constants outgrow push constants (glint/integrate_shared.h); a
     // transfer inside the frame keeps their lifetime the graph's.

@@ -86,6 +86,11 @@ struct IntegrateInputs {
     // Optional, with them: the ray tracer's hit motion (RtTraceOutputs::
     // hitMotion); without it the traced hits count as still.
     rg::Texture rtHitMotion;
+    // A hybrid frame the host renders as rt (ReflectionRenderer's SSLR
+    // gate): rt mode's variant runs, reading neither `sslr` nor the
+    // feedback and writing no counters; both stay declared, so that the
+    // frame keeps its plan.
+    bool screenSpaceIdle = false;
 };
 
 struct IntegrateSettings {

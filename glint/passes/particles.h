@@ -94,6 +94,9 @@ struct ParticleTraceInputs {
     rg::Texture rtHitDistance;
     BvhUpdateOutputs bvh;              // particleTlas (AccelRead), particles (StorageRead)
     scene::Camera camera;              // the G-buffer's; unjittered, as integrate reconstructs
+    // A hybrid frame the host renders as rt (ReflectionRenderer's SSLR
+    // gate): `sslr`, declared but not traced this frame, is not read.
+    bool screenSpaceIdle = false;
 };
 
 struct ParticleTraceSettings {

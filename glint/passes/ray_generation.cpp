@@ -129,8 +129,9 @@ RayGenerationOutputs addRayGenerationPass(rg::Graph& graph, RayGenerationPipelin
     constants.reuseRoughness = settings.reuseRoughness;
     constants.rtMaxDistance = settings.rtMaxDistance;
     constants.sslrMinDistance = inputs.sslrMinDistance;
-    constants.flags = uint32_t(inputs.mode) | (settings.reuse ? shader::kRayGenReuse : 0u) |
-                      (inputs.tileModes.valid() ? shader::kRayGenTileModes : 0u) |
+    const bool idle = inputs.screenSpaceIdle;
+    constants.flags = uint32_t(idle ? ReflectionMode::Rt : inputs.mode) | (settings.reuse ? shader::kRayGenReuse : 0u) |
+                      (inputs.tileModes.valid() && !idle ? shader::kRayGenTileModes : 0u) |
                       (settings.checkerboard ? shader::kRayGenCheckerboard : 0u) |
                       (settings.blueNoise ? shader::kRayGenBlueNoise : 0u) |
                       (settings.sslrFirst ? shader::kRayGenSslrFirst : 0u);
@@ -167,7 +168,7 @@ RayGenerationOutputs addRayGenerationPass(rg::Graph& graph, RayGenerationPipelin
                                                         .format = kRayClassDebugFormat}),
                                        rg::Access::StorageWrite);
         },
-        [&pipelines, constants](const ClassifyData& d, rg::PassContext& pc) {
+        [&pipelines, constants, idle](const ClassifyData& d, rg::PassContext& pc) {
             const gpu::Pipeline& pipeline = pipelines.classify_;
             const VkSampler sampler = pipelines.nearest_.handle();
             pipeline.bind(pc.cmd());
@@ -188,7 +189,7 @@ RayGenerationOutputs addRayGenerationPass(rg::Graph& graph, RayGenerationPipelin
                 // set. (A buffer of the graph would be a read it does not
                 // know of: sync validation takes a bound readonly buffer as
                 // read, and the class buffer may alias memory a pass wrote.)
-                .storageBuffer("TileModes", d.tileModes.valid() ? pc.buffer(d.tileModes) : pipelines.blueNoise_)
+                .storageBuffer("TileModes", d.tileModes.valid() && !idle ? pc.buffer(d.tileModes) : pipelines.blueNoise_)
                 .storageBuffer("BlueNoise", pipelines.blueNoise_)
                 .push(pipelines.ctx_, pc.cmd());
             pipeline.pushConstants(pc.cmd(), constants);

@@ -59,6 +59,11 @@ struct RayGenerationInputs {
     // the BVH holds nothing farther (ReflectionFrameSettings::reach; Far
     // Cry 6: 100 around the camera).
     float sslrMinDistance = scene::kDefaultBvhRadius;
+    // A hybrid frame the host renders as rt (ReflectionRenderer's SSLR
+    // gate, FeedbackSettings::hostGate): every traced pixel goes to RT, as
+    // in rt mode, and `tileModes`, still declared so that the frame keeps
+    // its plan, is not read.
+    bool screenSpaceIdle = false;
 };
 
 struct RayGenerationSettings {

@@ -5,12 +5,14 @@
 #include "glint/graph/executor.h"
 #include "glint/passes/lighting.h"
 
+#include "glint/feedback_shared.h"
 #include "glint/reflection_frame_shared.h"
 
 #include <spdlog/spdlog.h>
 
 #include <algorithm>
 #include <array>
+#include <cstring>
 #include <memory>
 #include <stdexcept>
 
@@ -76,7 +78,10 @@ ReflectionRenderer::ReflectionRenderer(gpu::Context& ctx, const scene::Scene& sc
       classCount_(gpu::createComputePipeline(ctx, {"reflection_frame/class_count.comp", {},
                                                    uint32_t(sizeof(shader::ClassCountConstants)),
                                                    "reflection_frame.class_count"})) {
-    if (!rt_) {
+    if (rt_) {
+        gateReadback_ = std::make_unique<rg::FrameReadback>(ctx, sizeof(uint32_t), "reflections.sslr_gate",
+                                                            options.framesInFlight + 2);
+    } else {
         spdlog::warn("device '{}' has no ray tracing{}: hybrid and rt reflections render as ssr, and no BVH is built",
                      ctx.caps().deviceName,
                      ctx.caps().accelerationStructure ? " (acceleration structures but neither ray query nor ray "
@@ -103,6 +108,38 @@ void ReflectionRenderer::bind(rg::FrameResources& resources, const ReflectionFra
         bvh_->bind(resources, *frame.bvh);
     }
     environment_.bind(resources, frame.environment);
+    if (frame.gateReport) {
+        gateReadback_->bind(resources, *frame.gateReport);
+    }
+}
+
+bool ReflectionRenderer::screenSpaceIdle(const ReflectionFrameSettings& settings, uint64_t frameIndex,
+                                         uint32_t width, uint32_t height) {
+    const FeedbackSettings& feedback = settings.feedback;
+    if (settings.resetHistory) {
+        // A cut: what earlier frames said no longer holds.
+        gatePending_ = 0;
+        sslrPays_ = true;
+    }
+    if (gatePending_ != 0) {
+        if (const auto bytes = gateReadback_->read(gatePending_)) {
+            uint32_t word = 0;
+            std::memcpy(&word, bytes->data(), sizeof(word));
+            sslrPays_ = shader::sslrPays(word, feedbackMinFrameHits(feedback, width, height), false, false);
+            spdlog::debug("SSLR gate: frame {} read report {}: {} SSLR hits last frame, SSLR {}", frameIndex,
+                          gatePending_, word - std::min(word, shader::kFeedbackFrameHitsStart),
+                          sslrPays_ ? "pays" : "does not pay");
+            gatePending_ = 0;
+        } else if (gateReadback_->overwritten(gatePending_)) {
+            gatePending_ = 0;
+        }
+    }
+    // Views of what the feedback and SSLR write need them written.
+    const std::string_view view = settings.debugView;
+    const bool viewsScreenSpace = view.substr(0, 5) == "sslr_" || view == "lit_pyramid" || view == "tile_modes" ||
+                                  view == "feedback_counters";
+    return !sslrPays_ && !settings.resetHistory && !viewsScreenSpace &&
+           !shader::feedbackProbeFrame(uint32_t(frameIndex), feedback.sslrProbeInterval);
 }
 
 ReflectionFrame ReflectionRenderer::addFrame(rg::Graph& graph, const scene::Camera& camera,
@@ -149,14 +186,37 @@ ReflectionFrame ReflectionRenderer::addFrame(rg::Graph& graph, const scene::Came
     RayGenerationInputs rayInputs{f.gbuffer, frameIndex, camera};
     rayInputs.mode = mode;
     rayInputs.sslrMinDistance = settings.reach;
+    const bool sslrFallback = !f.bvhComplete && settings.sslrWhileBvhBuilds && screenSpace;
     if (mode == ReflectionMode::Hybrid) {
-        f.feedback =
-            addFeedbackPass(graph, feedback_, {f.gbuffer, frameIndex, settings.resetHistory}, settings.feedback);
+        const FeedbackSettings& fs = settings.feedback;
+        // The host's gate: where SSLR did not pay on the last frame read
+        // back, a frame that is not a probe frame renders as rt.
+        const bool gated = fs.hostGate && fs.adaptive && fs.sslrMinHitShare > 0.0f;
+        FeedbackInputs feedbackInputs{f.gbuffer, frameIndex, settings.resetHistory};
+        if (gated) {
+            f.screenSpaceIdle = screenSpaceIdle(settings, frameIndex, f.width, f.height) && !sslrFallback;
+            f.gateReport = gateReadback_->declare(graph);
+            // The report holds last frame's hits when last frame tried SSLR
+            // (else the copy is not recorded).
+            const bool reports = lastTriedSslr_ && !settings.resetHistory;
+            if (f.gateReport) {
+                feedbackInputs.report = f.gateReport->buffer;
+                feedbackInputs.reportLastFrame = reports;
+                if (reports) gatePending_ = f.gateReport->sequence;
+            }
+            feedbackInputs.decide = !f.screenSpaceIdle;
+            // A frame rendered as rt wrote no counters: the next one that
+            // decides starts without evidence, as after a cut.
+            feedbackInputs.resetHistory = feedbackInputs.resetHistory || (lastIdle_ && !f.screenSpaceIdle);
+        }
+        f.feedback = addFeedbackPass(graph, feedback_, feedbackInputs, fs);
         rayInputs.tileModes = f.feedback->tileModes;
+        rayInputs.screenSpaceIdle = f.screenSpaceIdle;
     }
+    lastTriedSslr_ = mode == ReflectionMode::Hybrid && !f.screenSpaceIdle;
+    lastIdle_ = f.screenSpaceIdle;
     // 2. Ray generation and tile classification.
     RayGenerationSettings raySettings = settings.rays;
-    const bool sslrFallback = !f.bvhComplete && settings.sslrWhileBvhBuilds && screenSpace;
     raySettings.sslrFirst = raySettings.sslrFirst || (sslrFallback && mode == ReflectionMode::Hybrid);
     // The traces write only their rays' pixels; a debug view of their raw
     // outputs shows the rest cleared rather than stale.
@@ -171,7 +231,7 @@ ReflectionFrame ReflectionRenderer::addFrame(rg::Graph& graph, const scene::Came
         sslrSettings.clearUntraced = sslrSettings.clearUntraced || viewsSslr;
         f.sslr = addSslrPass(graph, sslr_,
                              {f.gbuffer, f.rays, frameIndex, camera.view, camera.projection,
-                              settings.confidenceThreshold},
+                              settings.confidenceThreshold, f.screenSpaceIdle},
                              sslrSettings);
         rtList = f.sslr->rtRayList;
         rtArgs = f.sslr->rtArgs;
@@ -206,6 +266,7 @@ ReflectionFrame ReflectionRenderer::addFrame(rg::Graph& graph, const scene::Came
         }
         particleInputs.bvh = *f.bvh;
         particleInputs.camera = camera;
+        particleInputs.screenSpaceIdle = f.screenSpaceIdle;
         ParticleTraceSettings particleSettings;
         particleSettings.backend = rt_->backend();
         particleSettings.confidenceThreshold = settings.confidenceThreshold;
@@ -231,6 +292,7 @@ ReflectionFrame ReflectionRenderer::addFrame(rg::Graph& graph, const scene::Came
     integrateInputs.environment = f.environment;
     integrateInputs.camera = camera;
     integrateInputs.confidenceThreshold = settings.confidenceThreshold;
+    integrateInputs.screenSpaceIdle = f.screenSpaceIdle;
     if (f.particles) {
         integrateInputs.particles = f.particles->radiance;
     }

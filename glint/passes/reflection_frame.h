@@ -26,6 +26,7 @@
 #include "glint/gpu/context.h"
 #include "glint/gpu/pipeline.h"
 #include "glint/graph/graph.h"
+#include "glint/graph/transfer.h"
 #include "glint/passes/bvh_update.h"
 #include "glint/passes/composite.h"
 #include "glint/passes/environment.h"
@@ -131,6 +132,11 @@ struct ReflectionFrame {
     // false while first builds wait for their budget.
     bool bvhComplete = true;
     std::optional<FeedbackOutputs> feedback;
+    // A hybrid frame the host rendered as rt (FeedbackSettings::hostGate):
+    // its feedback, pyramid and SSLR passes recorded nothing.
+    bool screenSpaceIdle = false;
+    // Where the feedback pass copied last frame's SSLR hits for the gate.
+    std::optional<rg::FrameReadback::Target> gateReport;
     RayGenerationOutputs rays;
     std::optional<SslrOutputs> sslr;
     std::optional<RtTraceOutputs> rt;
@@ -207,6 +213,10 @@ private:
     void addStatsPasses(rg::Graph& graph, ReflectionFrame& f, rg::Buffer rtArgs);
     void addOutput(rg::Graph& graph, ReflectionFrame& f, const scene::Camera& camera,
                    const ReflectionFrameSettings& settings);
+    // The host's side of the SSLR gate (FeedbackSettings::hostGate): learns
+    // from the newest report read back, then says whether this hybrid frame
+    // renders as rt.
+    bool screenSpaceIdle(const ReflectionFrameSettings& settings, uint64_t frameIndex, uint32_t width, uint32_t height);
 
     gpu::Context& ctx_;
     const scene::Scene& scene_;
@@ -227,6 +237,13 @@ private:
     gpu::Pipeline tileView_;
     gpu::Pipeline classCount_;
     scene::BvhStats lastPlanStats_;
+    // The SSLR gate's state: each hybrid frame's feedback pass copies last
+    // frame's SSLR hits into gateReadback_ (null without ray tracing).
+    std::unique_ptr<rg::FrameReadback> gateReadback_;
+    uint64_t gatePending_ = 0;   // the newest report of a frame after one that tried SSLR, not yet read (0: none)
+    bool sslrPays_ = true;       // what the newest report read said (true until one says otherwise)
+    bool lastTriedSslr_ = false;  // the last frame declared was hybrid and not rendered as rt
+    bool lastIdle_ = false;       // the last frame declared was hybrid and rendered as rt
 };
 
 } // namespace glint::passes

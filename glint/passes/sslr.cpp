@@ -151,7 +151,9 @@ SslrOutputs addSslrPass(rg::Graph& graph, SslrPipelines& pipelines, const SslrIn
                     d.first = first;
                     d.outputs = end - first;
                 },
-                [&pipelines, constants, pass](const PyramidData& d, rg::PassContext& pc) {
+                [&pipelines, constants, pass, idle = inputs.screenSpaceIdle](const PyramidData& d,
+                                                                              rg::PassContext& pc) {
+                    if (idle) return;
                     const gpu::Pipeline& pipeline = d.fromLit ? pipelines.pyramidBase_ : pipelines.pyramidDown_;
                     const gpu::Image& image = pc.image(d.pyramid);
                     pipeline.bind(pc.cmd());
@@ -221,7 +223,9 @@ SslrOutputs addSslrPass(rg::Graph& graph, SslrPipelines& pipelines, const SslrIn
             d.out.rtArgs = b.write(rays.rtArgs, rg::Access::StorageReadWrite);
             d.out.litPyramid = d.pyramid;
         },
-        [&pipelines, constants, blueNoise = rays.blueNoiseBuffer](const TraceData& d, rg::PassContext& pc) {
+        [&pipelines, constants, blueNoise = rays.blueNoiseBuffer, idle = inputs.screenSpaceIdle](const TraceData& d,
+                                                                                                rg::PassContext& pc) {
+            if (idle) return;
             const gpu::Pipeline& pipeline = pipelines.trace_;
             const VkSampler sampler = pipelines.nearest_.handle();
             pipeline.bind(pc.cmd());

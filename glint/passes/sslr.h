@@ -55,6 +55,11 @@ struct SslrInputs {
     // the confidence image stores it (sslrStoredThreshold); integrate and
     // the particle trace must compare with the same value.
     float confidenceThreshold = kDefaultConfidenceThreshold;
+    // A hybrid frame the host renders as rt (ReflectionRenderer's SSLR
+    // gate): ray generation listed no SSLR ray, and the pyramid and the
+    // trace record nothing (they are still declared, so that the frame
+    // keeps its plan); the RT list stays ray generation's.
+    bool screenSpaceIdle = false;
 };
 
 struct SslrSettings {

@@ -60,7 +60,7 @@ constexpr std::array<bool, 3> kEveryMode{true, true, true};
 
 // The one table of parameters: name, field, the viewer's range, the
 // bench's sweep, and where the value lives.
-const std::array<ParameterSlot, 25> kParameters = {{
+const std::array<ParameterSlot, 26> kParameters = {{
     // A confidence; the talk's 0.9 (default) bracketed from "trust SSLR
     // often" to "almost never".
     {{"sslr_threshold", "ReflectionFrameSettings::confidenceThreshold", 0.0f, 1.0f, false, {0.5, 0.7, 0.8, 0.95, 0.99},
@@ -126,6 +126,11 @@ const std::array<ParameterSlot, 25> kParameters = {{
     // While SSLR does not pay, one frame in this many tries it again (default 8).
     {{"feedback_sslr_probe_interval", "FeedbackSettings::sslrProbeInterval", 1.0f, 64.0f, true, {4, 16}, {}, kHybrid},
      nullptr, [](ReflectionRunOptions& o) { return &o.frame.feedback.sslrProbeInterval; }},
+    // The same gate on the host (default on): frames where SSLR does not
+    // pay render as rt, with no feedback, pyramid or SSLR work; 0: the GPU's
+    // gate alone, which still runs those passes empty.
+    {{"feedback_host_gate", "FeedbackSettings::hostGate (0 or 1)", 0.0f, 1.0f, true, {0}, {}, kHybrid}, nullptr,
+     nullptr, [](ReflectionRunOptions& o) { return &o.frame.feedback.hostGate; }},
     // Particles drawn before SSLR, which reflects them where it resolves
     // the ray; the particle trace only where it does not (default off:
     // every particle traced).
@@ -437,6 +442,8 @@ ReflectionRunResult runReflections(gpu::Context& ctx, scene::Scene& scene, const
         const passes::ReflectionFrame frame = renderer.addFrame(graph, camera, settings);
         rg::FrameResources resources;
         renderer.bind(resources, frame);
+        result.screenSpaceIdleFrames += frame.screenSpaceIdle ? 1u : 0u;
+        result.lastScreenSpaceIdle = frame.screenSpaceIdle;
         if (last) {
             image.copy(graph, resources, frame.output.color);
             counts.copy(graph, resources, frame.counts);
@@ -620,6 +627,8 @@ std::string statsJson(const gpu::Context& ctx, const ReflectionRunOptions& optio
     j["total_ms"] = r.totalMs ? json(*r.totalMs) : json(nullptr);
     j["frame_wall_ms"] = r.frameWallMs ? json(*r.frameWallMs) : json(nullptr);
     j["rays"] = {{"sslr", r.sslrRays}, {"rt", r.rtRays}};
+    // Hybrid frames rendered as rt because SSLR did not pay (FeedbackSettings::hostGate).
+    j["screen_space_idle_frames"] = r.screenSpaceIdleFrames;
     // Host-blocking submissions after the first frame (uploads, one-off
     // work): a steady frame makes none.
     j["blocking_submits"] = r.blockingSubmits;

@@ -142,6 +142,10 @@ struct ReflectionRunResult {
     // Reference runs: frames accumulated, whether the tolerance was met
     // (else maxFrames stopped it), and the last relative change measured.
     uint32_t framesRun = 0;
+    // Hybrid frames the host rendered as rt (passes::FeedbackSettings::
+    // hostGate), and whether the last frame was one.
+    uint32_t screenSpaceIdleFrames = 0;
+    bool lastScreenSpaceIdle = false;
     bool converged = false;
     double lastChange = 0.0;
 };

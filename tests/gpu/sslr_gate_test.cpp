@@ -4,6 +4,8 @@
 // fewer than sslrMinHitShare of the pixels, so after the first frames the
 // hybrid traces exactly what rt mode traces and lists no SSLR ray, except
 // on probe frames; with the gate off it keeps trying SSLR every frame.
+// The host's side of the gate then renders those frames as rt: no feedback,
+// pyramid or SSLR work, and rt mode's reflections exactly.
 #include "support/gpu_test.h"
 
 #include "common/reflection_run.h"
@@ -20,7 +22,8 @@ namespace {
 constexpr uint32_t kSize = 128;
 
 app::ReflectionRunResult run(test::GpuTest& gpu, passes::ReflectionMode mode, uint32_t frames,
-                             float minHitShare = passes::FeedbackSettings{}.sslrMinHitShare) {
+                             float minHitShare = passes::FeedbackSettings{}.sslrMinHitShare, bool hostGate = true,
+                             std::string_view debugView = {}) {
     const std::filesystem::path file = std::filesystem::path(GLINT_SCENES_DIR) / "DamagedHelmet" / "DamagedHelmet.gltf";
     REQUIRE_MESSAGE(std::filesystem::exists(file), "shared scene missing: " << file.string());
     scene::Scene scene = scene::loadScene(file.string());
@@ -31,6 +34,8 @@ app::ReflectionRunResult run(test::GpuTest& gpu, passes::ReflectionMode mode, ui
     options.timeEveryFrame = false;
     options.frame.mode = mode;
     options.frame.feedback.sslrMinHitShare = minHitShare;
+    options.frame.feedback.hostGate = hostGate;
+    options.frame.debugView = debugView;
     return app::runReflections(gpu.ctx(), scene, options);
 }
 
@@ -62,4 +67,48 @@ TEST_CASE("the hybrid stops trying SSLR where it resolves too little, and tries 
     // A probe frame tries SSLR on every hybrid pixel again.
     const app::ReflectionRunResult probe = run(gpu, passes::ReflectionMode::Hybrid, framesEndingOn(true, gated));
     CHECK(probe.sslrRays > always.sslrRays);
+}
+
+TEST_CASE("the host renders the hybrid's frames as rt where SSLR does not pay: rt's reflections, probes aside") {
+    test::GpuTest gpu;
+    const uint32_t gated = framesEndingOn(false, 10);
+    // Integrate's output of the last frame: this frame's rays alone, before
+    // the temporal history mixes in the earlier (hybrid, probe) frames.
+    const app::ReflectionRunResult hybrid =
+        run(gpu, passes::ReflectionMode::Hybrid, gated, passes::FeedbackSettings{}.sslrMinHitShare, true, "reflections");
+    const app::ReflectionRunResult rt =
+        run(gpu, passes::ReflectionMode::Rt, gated, passes::FeedbackSettings{}.sslrMinHitShare, true, "reflections");
+    CHECK(hybrid.lastScreenSpaceIdle);
+    // The first frames try SSLR until a report of one says it does not pay
+    // (read back some frames later); then every frame but the probes.
+    CHECK(hybrid.screenSpaceIdleFrames >= gated - 6);
+    CHECK(hybrid.sslrRays == 0);
+    CHECK(hybrid.rtRays == rt.rtRays);
+    REQUIRE(hybrid.rgba.size() == rt.rgba.size());
+    CHECK(hybrid.rgba == rt.rgba);
+    // The GPU's gate alone: the same rays, but the hybrid's passes ran.
+    const app::ReflectionRunResult gpuGate =
+        run(gpu, passes::ReflectionMode::Hybrid, gated, passes::FeedbackSettings{}.sslrMinHitShare, false);
+    CHECK(gpuGate.screenSpaceIdleFrames == 0);
+    CHECK(gpuGate.rtRays == rt.rtRays);
+    // A probe frame tries SSLR again, as the hybrid.
+    const app::ReflectionRunResult probe = run(gpu, passes::ReflectionMode::Hybrid, framesEndingOn(true, gated));
+    CHECK_FALSE(probe.lastScreenSpaceIdle);
+    CHECK(probe.sslrRays > 100);
+}
+
+TEST_CASE("where SSLR pays, the host renders no hybrid frame as rt") {
+    test::GpuTest gpu;
+    scene::Scene scene = scene::makePlaza();
+    app::ReflectionRunOptions options;
+    options.width = kSize;
+    options.height = kSize;
+    options.frames = 16;
+    options.timeEveryFrame = false;
+    // glint-render's pose: wet ground reflecting the buildings on screen
+    // (at 0 s, at this size, SSLR resolves just under the 2% it must).
+    options.startSeconds = 3.0f;
+    const app::ReflectionRunResult plaza = app::runReflections(gpu.ctx(), scene, options);
+    CHECK(plaza.screenSpaceIdleFrames == 0);
+    CHECK(plaza.sslrRays > 100);
 }

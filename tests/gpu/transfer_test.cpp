@@ -5,6 +5,8 @@
 // upload or the readback.
 #include "support/gpu_test.h"
 
+#include "glint/gpu/commands.h"
+#include "glint/gpu/error.h"
 #include "glint/graph/error.h"
 #include "glint/graph/executor.h"
 #include "glint/graph/graph.h"
@@ -14,6 +16,7 @@
 
 #include <cstddef>
 #include <cstdint>
+#include <cstring>
 #include <memory>
 #include <string>
 #include <vector>
@@ -153,4 +156,100 @@ TEST_CASE("uploads under a new name every frame do not pile up: a name unused fo
     // 150 more names, 600 KB had they been kept; the same set of recent
     // ones at both points.
     CHECK(used[1] == used[0]);
+}
+
+namespace {
+
+// A pass copying `source` into a frame readback's target; the target as written.
+rg::Buffer copyInto(rg::Graph& graph, rg::Buffer source, rg::Buffer target, VkDeviceSize bytes) {
+    struct Data {
+        rg::Buffer source, target;
+    };
+    const Data& data = graph.addPass<Data>(
+        "transfer_test.copy", rg::Queue::Graphics,
+        [&](rg::Builder& b, Data& d) {
+            d.source = b.read(source, rg::Access::TransferSrc);
+            d.target = b.write(target, rg::Access::TransferDst);
+        },
+        [bytes](const Data& d, rg::PassContext& pc) {
+            const VkBufferCopy region{0, 0, bytes};
+            vkCmdCopyBuffer(pc.cmd(), pc.buffer(d.source).handle(), pc.buffer(d.target).handle(), 1, &region);
+        });
+    return data.target;
+}
+
+} // namespace
+
+TEST_CASE("a frame readback gives each frame's bytes once that frame has finished, and never another frame's") {
+    test::GpuTest gpu;
+    constexpr uint32_t kFrames = 12;
+    constexpr uint32_t kDepth = 3;
+    rg::Executor executor(gpu.ctx(), 2);
+    rg::PlanCache cache(4);
+    rg::FrameReadback readback(gpu.ctx(), 64, "transfer_test.frames", kDepth);
+    const auto expect = [](uint64_t sequence, std::span<const std::byte> bytes) {
+        REQUIRE(bytes.size() == 64);
+        std::vector<uint32_t> words(16);
+        std::memcpy(words.data(), bytes.data(), 64);
+        for (uint32_t i = 0; i < words.size(); ++i) CHECK(words[i] == sequence * 1000u + i);
+    };
+    uint32_t readEarly = 0;
+    for (uint32_t frame = 0; frame < kFrames; ++frame) {
+        rg::Graph graph(executor.queueCaps());
+        // More buffers than frames in flight: one is always free.
+        const auto target = readback.declare(graph);
+        REQUIRE(target);
+        CHECK(target->sequence == frame + 1);
+        std::vector<uint32_t> words(16);
+        for (uint32_t i = 0; i < words.size(); ++i) words[i] = uint32_t(target->sequence) * 1000u + i;
+        graph.markOutput(copyInto(graph, rg::addUpload(graph, "transfer_test.words", std::as_bytes(std::span(words))),
+                                  target->buffer, 64));
+        rg::FrameResources resources;
+        readback.bind(resources, *target);
+        const rg::Plan& plan = cache.compile(graph, executor.compileOptions());
+        const rg::VerifyReport report = rg::verify(plan);
+        REQUIRE_MESSAGE(report.ok(), report.text());
+        executor.run(plan, resources);
+        // Without waiting: an earlier frame is either not read yet or right.
+        for (uint64_t s = target->sequence >= kDepth ? target->sequence - kDepth + 1 : 1; s <= target->sequence; ++s) {
+            CAPTURE(s);
+            if (const auto bytes = readback.read(s)) {
+                expect(s, *bytes);
+                ++readEarly;
+            }
+        }
+    }
+    executor.waitIdle();
+    // The last kDepth frames can still be read; older buffers took newer frames.
+    for (uint64_t s = 1; s <= kFrames; ++s) {
+        CAPTURE(s);
+        const bool kept = s + kDepth > kFrames;
+        CHECK(readback.overwritten(s) == !kept);
+        const auto bytes = readback.read(s);
+        REQUIRE(bytes.has_value() == kept);
+        if (bytes) expect(s, *bytes);
+    }
+    CHECK(readback.read(kFrames + 1) == std::nullopt);
+    MESSAGE(readEarly << " reads answered before waiting");
+}
+
+TEST_CASE("a semaphore signalled by a buffer that is not an import of the plan is refused by name") {
+    test::GpuTest gpu;
+    rg::Executor executor(gpu.ctx());
+    rg::FrameReadback readback(gpu.ctx(), 4, "transfer_test.gate");
+    rg::Graph graph(executor.queueCaps());
+    const auto target = readback.declare(graph);
+    REQUIRE(target);
+    const std::vector<uint32_t> word{7};
+    const rg::Buffer uploaded = rg::addUpload(graph, "transfer_test.word", std::as_bytes(std::span(word)));
+    graph.markOutput(copyInto(graph, uploaded, target->buffer, 4));
+    rg::FrameResources resources;
+    readback.bind(resources, *target);
+    gpu::TimelineSemaphore other(gpu.ctx(), "transfer_test.other");
+    resources.signalSemaphore(rg::Buffer{target->buffer.index + 100, 0, target->buffer.graph}, other.handle(), 1);
+    const rg::Plan plan = graph.compile(executor.compileOptions());
+    CHECK_THROWS_WITH_AS(executor.run(plan, resources), doctest::Contains("names a buffer that is not an import"),
+                         gpu::GpuError);
+    CHECK_THROWS_WITH_AS(rg::FrameReadback(gpu.ctx(), 4, "transfer_test.shallow", 1),
+                         doctest::Contains("transfer_test.shallow"), rg::GraphError);
 }
