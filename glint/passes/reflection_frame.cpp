@@ -191,9 +191,9 @@ ReflectionFrame ReflectionRenderer::addFrame(rg::Graph& graph, const scene::Came
         const FeedbackSettings& fs = settings.feedback;
         // The host's gate: where SSLR did not pay on the last frame read
         // back, a frame that is not a probe frame renders as rt.
-        const bool gated = fs.hostGate && fs.adaptive && fs.sslrMinHitShare > 0.0f;
+        const bool hostGate = fs.hostGate && fs.adaptive && fs.sslrMinHitShare > 0.0f;
         FeedbackInputs feedbackInputs{f.gbuffer, frameIndex, settings.resetHistory};
-        if (gated) {
+        if (hostGate) {
             f.screenSpaceIdle = screenSpaceIdle(settings, frameIndex, f.width, f.height) && !sslrFallback;
             f.gateReport = gateReadback_->declare(graph);
             // The report holds last frame's hits when last frame tried SSLR
