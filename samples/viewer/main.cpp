@@ -553,6 +553,11 @@ private:
         // -- rays and pixel classes
         if (ImGui::CollapsingHeader("rays", ImGuiTreeNodeFlags_DefaultOpen)) {
             ImGui::Checkbox("count rays", &countRays_);
+            if (options_.frame.mode == passes::ReflectionMode::Hybrid) {
+                // FeedbackSettings::hostGate: the last frame's decision.
+                ImGui::TextUnformatted(screenSpaceIdle_ ? "SSLR does not pay: frame rendered as rt (probes aside)"
+                                                        : "SSLR tried on hybrid pixels");
+            }
             if (countRays_ && counts_.valid) {
                 const double pixels = double(swapchain_.extent().width) * swapchain_.extent().height;
                 ImGui::Text("SSLR rays %u, RT rays %u", counts_.sslrRays, counts_.rtRays);
@@ -660,6 +665,7 @@ private:
         resetHistory_ = false;
         rg::Graph graph(executor_->queueCaps());
         const passes::ReflectionFrame reflections = renderer_->addFrame(graph, camera_, settings);
+        screenSpaceIdle_ = reflections.screenSpaceIdle;
         rg::FrameResources resources;
         renderer_->bind(resources, reflections);
 
@@ -710,6 +716,7 @@ private:
     Window& window_;
     scene::Scene& scene_;
     const std::vector<viewer::ParameterSlider> sliders_;
+    bool screenSpaceIdle_ = false;  // the last hybrid frame was rendered as rt (FeedbackSettings::hostGate)
     app::ReflectionRunOptions options_;            // what the panel edits
     passes::ReflectionRendererOptions builtWith_;  // what renderer_ was built with
     viewer::Swapchain swapchain_;
