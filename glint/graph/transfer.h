@@ -96,8 +96,9 @@ private:
 //
 // `depth` host-visible buffers take turns; a timeline semaphore, signalled
 // by the batch that leaves the frame's buffer in its final state (a host
-// read), says which frames have finished. A frame that declares a target
-// and is never run leaves a gap, nothing else.
+// read), says which frames have finished. Run every frame that declares a
+// target: one that is not leaves its sequence to read the bytes an older
+// frame left in that buffer once a later frame has finished.
 class FrameReadback {
 public:
     // `depth` must exceed the frames in flight, or declare() finds every
