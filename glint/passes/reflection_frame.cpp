@@ -134,11 +134,7 @@ bool ReflectionRenderer::screenSpaceIdle(const ReflectionFrameSettings& settings
             gatePending_ = 0;
         }
     }
-    // Views of what the feedback and SSLR write need them written.
-    const std::string_view view = settings.debugView;
-    const bool viewsScreenSpace = view.substr(0, 5) == "sslr_" || view == "lit_pyramid" || view == "tile_modes" ||
-                                  view == "feedback_counters";
-    return !sslrPays_ && !settings.resetHistory && !viewsScreenSpace &&
+    return !sslrPays_ && !settings.resetHistory &&
            !shader::feedbackProbeFrame(uint32_t(frameIndex), feedback.sslrProbeInterval);
 }
 
@@ -187,6 +183,10 @@ ReflectionFrame ReflectionRenderer::addFrame(rg::Graph& graph, const scene::Came
     rayInputs.mode = mode;
     rayInputs.sslrMinDistance = settings.reach;
     const bool sslrFallback = !f.bvhComplete && settings.sslrWhileBvhBuilds && screenSpace;
+    // The traces write only their rays' pixels; a debug view of their raw
+    // outputs shows the rest cleared rather than stale.
+    const bool viewsSslr = view.substr(0, 5) == "sslr_" || view == "lit_pyramid";
+    const bool viewsRt = view.substr(0, 3) == "rt_";
     if (mode == ReflectionMode::Hybrid) {
         const FeedbackSettings& fs = settings.feedback;
         // The host's gate: where SSLR did not pay on the last frame read
@@ -194,7 +194,10 @@ ReflectionFrame ReflectionRenderer::addFrame(rg::Graph& graph, const scene::Came
         const bool hostGate = fs.hostGate && fs.adaptive && fs.sslrMinHitShare > 0.0f;
         FeedbackInputs feedbackInputs{f.gbuffer, frameIndex, settings.resetHistory};
         if (hostGate) {
-            f.screenSpaceIdle = screenSpaceIdle(settings, frameIndex, f.width, f.height) && !sslrFallback;
+            // Views of what the feedback and SSLR write need them written.
+            const bool viewsScreenSpace = viewsSslr || view == "tile_modes" || view == "feedback_counters";
+            f.screenSpaceIdle =
+                screenSpaceIdle(settings, frameIndex, f.width, f.height) && !sslrFallback && !viewsScreenSpace;
             f.gateReport = gateReadback_->declare(graph);
             // The report holds last frame's hits when last frame tried SSLR
             // (else the copy is not recorded).
@@ -218,10 +221,6 @@ ReflectionFrame ReflectionRenderer::addFrame(rg::Graph& graph, const scene::Came
     // 2. Ray generation and tile classification.
     RayGenerationSettings raySettings = settings.rays;
     raySettings.sslrFirst = raySettings.sslrFirst || (sslrFallback && mode == ReflectionMode::Hybrid);
-    // The traces write only their rays' pixels; a debug view of their raw
-    // outputs shows the rest cleared rather than stale.
-    const bool viewsSslr = view.substr(0, 5) == "sslr_" || view == "lit_pyramid";
-    const bool viewsRt = view.substr(0, 3) == "rt_";
     f.rays = addRayGenerationPass(graph, rays_, rayInputs, raySettings);
     // 3. SSLR, extending the RT list with what it cannot resolve.
     rg::Buffer rtList = f.rays.rtRays;

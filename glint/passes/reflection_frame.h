@@ -215,7 +215,7 @@ private:
                    const ReflectionFrameSettings& settings);
     // The host's side of the SSLR gate (FeedbackSettings::hostGate): learns
     // from the newest report read back, then says whether this hybrid frame
-    // renders as rt.
+    // may render as rt (not after a cut, nor on a probe frame).
     bool screenSpaceIdle(const ReflectionFrameSettings& settings, uint64_t frameIndex, uint32_t width, uint32_t height);
 
     gpu::Context& ctx_;
