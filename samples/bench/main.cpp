@@ -374,10 +374,13 @@ int main(int argc, char** argv) {
             row.height = height;
             row.reflectionMs = result.reflectionMs;
             row.reflectionMeanMs = result.reflectionMeanMs;
+            row.reflectionSpanMs = result.reflectionSpanMs;
+            row.reflectionSpanMeanMs = result.reflectionSpanMeanMs;
             row.totalMs = result.totalMs;
             row.frameWallMs = result.frameWallMs;
             row.sslrRays = result.sslrRays;
             row.rtRays = result.rtRays;
+            row.screenSpaceIdleFrames = result.screenSpaceIdleFrames;
             row.image = bench::measure(referenceImage, image, ppd);
             row.reflection =
                 bench::measure(referenceTerm.display, term.display, ppd, &referenceTerm.radiance, &term.radiance);

@@ -78,7 +78,8 @@ std::string toCsv(std::span<const Row> rows) {
         out += scene + ',' + r.mode + ',' + r.param + ',' + formatValue(r.value) + ',' + std::to_string(r.width) +
                ',' + std::to_string(r.height) + ',' + number(r.reflectionMs) + ',' + number(r.totalMs) + ',' +
                std::to_string(r.rtRays) + ',' + number(r.image.flipMean) + ',' + number(r.image.relMse) + ',' +
-               number(r.image.psnr) + ',' + number(r.image.ssim) + ',' + number(r.reflectionMeanMs) + '\n';
+               number(r.image.psnr) + ',' + number(r.image.ssim) + ',' + number(r.reflectionMeanMs) + ',' +
+               number(r.reflectionSpanMs) + ',' + std::to_string(r.screenSpaceIdleFrames) + '\n';
     }
     return out;
 }
@@ -116,10 +117,13 @@ std::string toJson(const RunInfo& info, std::span<const Row> rows) {
         row["height"] = r.height;
         row["reflection_ms"] = jsonNumber(r.reflectionMs);
         row["reflection_mean_ms"] = jsonNumber(r.reflectionMeanMs);
+        row["reflection_span_ms"] = jsonNumber(r.reflectionSpanMs);
+        row["reflection_span_mean_ms"] = jsonNumber(r.reflectionSpanMeanMs);
         row["total_ms"] = jsonNumber(r.totalMs);
         row["frame_wall_ms"] = jsonNumber(r.frameWallMs);
         row["rt_rays"] = r.rtRays;
         row["sslr_rays"] = r.sslrRays;
+        row["screen_space_idle_frames"] = r.screenSpaceIdleFrames;
         row["flip_mean"] = jsonNumber(r.image.flipMean);
         row["relmse"] = jsonNumber(r.image.relMse);
         row["psnr"] = jsonNumber(r.image.psnr);
@@ -134,17 +138,19 @@ std::string toJson(const RunInfo& info, std::span<const Row> rows) {
 std::string toTable(std::span<const Row> rows) {
     char line[512];
     std::string out;
-    const char* header = "%-7s %-17s %8s %9s %9s %9s %8s | %7s %8s %6s %6s | %7s %8s %6s %6s\n";
-    std::snprintf(line, sizeof line, header, "mode", "param", "value", "refl_ms", "total_ms", "wall_ms", "rt_rays",
+    const char* header = "%-7s %-17s %8s %9s %9s %9s %9s %8s | %7s %8s %6s %6s | %7s %8s %6s %6s\n";
+    std::snprintf(line, sizeof line, header, "mode", "param", "value", "refl_ms", "span_ms", "total_ms", "wall_ms",
+                  "rt_rays",
                   "flip", "relmse", "psnr", "ssim", "r.flip", "r.relmse", "r.psnr", "r.ssim");
     out += line;
     out += std::string(std::strlen(line) - 1, '-') + '\n';
     for (const Row& r : rows) {
         const auto cell = [](const std::optional<double>& v) { return v ? number(v, "%.3f") : std::string("-"); };
         std::snprintf(line, sizeof line,
-                      "%-7s %-17s %8s %9s %9s %9s %8llu | %7.4f %8.4f %6.2f %6.4f | %7.4f %8.4f %6.2f %6.4f\n",
+                      "%-7s %-17s %8s %9s %9s %9s %9s %8llu | %7.4f %8.4f %6.2f %6.4f | %7.4f %8.4f %6.2f %6.4f\n",
                       r.mode.c_str(), r.param.c_str(), r.value ? formatValue(r.value).c_str() : "-",
-                      cell(r.reflectionMs).c_str(), cell(r.totalMs).c_str(), cell(r.frameWallMs).c_str(),
+                      cell(r.reflectionMs).c_str(), cell(r.reflectionSpanMs).c_str(), cell(r.totalMs).c_str(),
+                      cell(r.frameWallMs).c_str(),
                       static_cast<unsigned long long>(r.rtRays), r.image.flipMean, r.image.relMse, r.image.psnr,
                       r.image.ssim, r.reflection.flipMean, r.reflection.relMse, r.reflection.psnr, r.reflection.ssim);
         out += line;

@@ -19,7 +19,8 @@ namespace glint::bench {
 // The CSV header, column for column (docs/results.md reads these files). The metric columns
 // are the final image's; the reflection term's go to the JSON only.
 inline constexpr std::string_view kCsvHeader =
-    "scene,mode,param,value,width,height,reflection_ms,total_ms,rt_rays,flip_mean,relmse,psnr,ssim,reflection_mean_ms";
+    "scene,mode,param,value,width,height,reflection_ms,total_ms,rt_rays,flip_mean,relmse,psnr,ssim,reflection_mean_ms,"
+    "reflection_span_ms,screen_space_idle_frames";
 
 // The baseline row of each mode has this as its param (and no value).
 inline constexpr std::string_view kDefaultParam = "default";
@@ -44,10 +45,17 @@ struct Row {
     // Their mean: work done on some frames only (the hybrid's SSLR probe
     // frames, passes/feedback.h) counts here and not in the median.
     std::optional<double> reflectionMeanMs;
+    // The same chain timed as one span (no per-pass timestamps), median and
+    // mean over the other half of the frames.
+    std::optional<double> reflectionSpanMs;
+    std::optional<double> reflectionSpanMeanMs;
     std::optional<double> totalMs;       // median GPU time of all passes
     std::optional<double> frameWallMs;   // median host time of a frame (a CPU device's real cost)
     uint64_t sslrRays = 0;               // last frame
     uint64_t rtRays = 0;                 // last frame
+    // Hybrid frames rendered as rt because SSLR did not pay
+    // (passes::FeedbackSettings::hostGate), of the run's frames.
+    uint32_t screenSpaceIdleFrames = 0;
     ErrorMetrics image;       // the final image against the reference's
     ErrorMetrics reflection;  // the resolved reflection term against the reference's
 };

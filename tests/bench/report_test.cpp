@@ -47,6 +47,8 @@ Row makeRow(const std::string& mode, const std::string& param, std::optional<dou
     r.height = 48;
     r.reflectionMs = ms;
     r.reflectionMeanMs = ms * 1.1;
+    r.reflectionSpanMs = ms * 1.05;
+    r.screenSpaceIdleFrames = 3;
     r.totalMs = ms * 3.0;
     r.frameWallMs = ms * 10.0;
     r.rtRays = 1234;
@@ -64,10 +66,11 @@ TEST_CASE("the CSV has the stated header and one parseable row per configuration
                                    makeRow("hybrid", "sslr_steps", 32.0, 0.9, 0.055)};
     const std::vector<std::string> out = lines(toCsv(rows));
     REQUIRE(out.size() == rows.size() + 1);
-    CHECK(out[0] == "scene,mode,param,value,width,height,reflection_ms,total_ms,rt_rays,flip_mean,relmse,psnr,ssim,reflection_mean_ms");
+    CHECK(out[0] == "scene,mode,param,value,width,height,reflection_ms,total_ms,rt_rays,flip_mean,relmse,psnr,ssim,"
+                    "reflection_mean_ms,reflection_span_ms,screen_space_idle_frames");
     for (size_t i = 0; i < rows.size(); ++i) {
         const std::vector<std::string> cells = split(out[i + 1], ',');
-        REQUIRE(cells.size() == 14);
+        REQUIRE(cells.size() == 16);
         CHECK(cells[0] == "plaza");
         CHECK(cells[1] == rows[i].mode);
         CHECK(cells[2] == rows[i].param);
@@ -88,6 +91,8 @@ TEST_CASE("the CSV has the stated header and one parseable row per configuration
     CHECK(split(out[3], ',')[3] == "0.7");
     CHECK(split(out[4], ',')[3] == "32");
     CHECK(std::stod(split(out[1], ',')[9]) == doctest::Approx(0.05));
+    CHECK(std::stod(split(out[1], ',')[14]) == doctest::Approx(1.05));
+    CHECK(split(out[1], ',')[15] == "3");
 }
 
 TEST_CASE("parameter values print as typed: whole numbers without exponents, floats without float noise") {
@@ -104,7 +109,7 @@ TEST_CASE("the CSV writes a missing time as an empty cell and identical images' 
     r.reflectionMs.reset();
     r.image.psnr = std::numeric_limits<double>::infinity();
     const std::vector<std::string> cells = split(lines(toCsv(std::vector<Row>{r}))[1], ',');
-    REQUIRE(cells.size() == 14);
+    REQUIRE(cells.size() == 16);
     CHECK(cells[6].empty());
     CHECK(cells[11] == "inf");
     CHECK(std::isinf(std::stod(cells[11])));
