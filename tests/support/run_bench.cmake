@@ -1,6 +1,7 @@
 # Runs glint-bench (BENCH) as a quick smoke test: --quick on the plaza, tiny
 # and short, validation on, writing CSV, JSON and plot under OUT. Checks the
 # exit code, that the three files exist, the CSV header report.h states,
+# no frame of ssr or rt rendered "as rt" by the hybrid's gate,
 # a row per configuration (three mode defaults and the quick sweeps), and
 # the JSON's provenance keys.
 cmake_policy(SET CMP0054 NEW)
@@ -19,7 +20,7 @@ foreach(f bench.csv bench.json bench.png bench.svg bench.plot.json bench.plot.py
 endforeach()
 file(STRINGS ${OUT}/bench.csv lines)
 list(GET lines 0 header)
-set(expected "scene,mode,param,value,width,height,reflection_ms,total_ms,rt_rays,flip_mean,relmse,psnr,ssim,reflection_mean_ms")
+set(expected "scene,mode,param,value,width,height,reflection_ms,total_ms,rt_rays,flip_mean,relmse,psnr,ssim,reflection_mean_ms,reflection_span_ms,screen_space_idle_frames")
 if(NOT header STREQUAL expected)
   message(FATAL_ERROR "${OUT}/bench.csv: header '${header}', expected '${expected}'")
 endif()
@@ -31,6 +32,12 @@ endif()
 foreach(mode hybrid ssr rt)
   if(NOT "${lines}" MATCHES "plaza,${mode},default,,64,48,")
     message(FATAL_ERROR "${OUT}/bench.csv: no default row for ${mode}")
+  endif()
+endforeach()
+# Only the hybrid renders frames as rt (FeedbackSettings::hostGate).
+foreach(mode ssr rt)
+  if(NOT "${lines}" MATCHES "plaza,${mode},default,,64,48,[^;]*,0(;|$)")
+    message(FATAL_ERROR "${OUT}/bench.csv: the ${mode} default row has screen_space_idle_frames other than 0")
   endif()
 endforeach()
 file(READ ${OUT}/bench.json json)
