@@ -94,13 +94,13 @@ FeedbackOutputs addFeedbackPass(rg::Graph& graph, FeedbackPipelines& pipelines, 
                 b.write(b.createBuffer("feedback.reprojected", {tileBytes}), rg::Access::StorageWrite);
             d.out.tileModes = b.write(b.createBuffer("feedback.tile_modes", {tileBytes}), rg::Access::StorageWrite);
         },
-        [&pipelines, constants, tiles, decide = inputs.decide, report = inputs.reportLastFrame](
+        [&pipelines, constants, tiles, idle = inputs.screenSpaceIdle, report = inputs.reportLastFrame](
             const ReprojectData& d, rg::PassContext& pc) {
             if (d.report.valid() && report) {
                 const VkBufferCopy word{uint64_t(tiles) * sizeof(uint32_t), 0, sizeof(uint32_t)};
                 vkCmdCopyBuffer(pc.cmd(), pc.buffer(d.previous).handle(), pc.buffer(d.report).handle(), 1, &word);
             }
-            if (!decide) return;
+            if (idle) return;
             const gpu::Pipeline& pipeline = pipelines.reproject_;
             pipeline.bind(pc.cmd());
             gpu::PushDescriptors(pipeline)

@@ -58,11 +58,11 @@ struct FeedbackInputs {
     // False: the copy is declared but not recorded (last frame wrote no
     // counters, so there is nothing to report).
     bool reportLastFrame = true;
-    // False on a frame the host renders as rt (ray generation reads no tile
-    // modes, integrate writes no counters): the pass records only the copy
-    // into `report`, if any. Its declarations stay the same, so that the
-    // frame keeps the plan of the frames that decide.
-    bool decide = true;
+    // A hybrid frame the host renders as rt (ReflectionRenderer's SSLR
+    // gate: ray generation reads no tile modes, integrate writes no
+    // counters): the pass records only the copy into `report`, if any. Its
+    // declarations stay the same, so that the frame keeps its plan.
+    bool screenSpaceIdle = false;
 };
 
 struct FeedbackSettings {

@@ -201,23 +201,25 @@ ReflectionFrame ReflectionRenderer::addFrame(rg::Graph& graph, const scene::Came
             f.gateReport = gateReadback_->declare(graph);
             // The report holds last frame's hits when last frame tried SSLR
             // (else the copy is not recorded).
-            const bool reports = lastTriedSslr_ && !settings.resetHistory;
+            const bool reports = lastFrame_ == LastFrame::TriedSslr && !settings.resetHistory;
             if (f.gateReport) {
                 feedbackInputs.report = f.gateReport->buffer;
                 feedbackInputs.reportLastFrame = reports;
                 if (reports) gatePending_ = f.gateReport->sequence;
             }
-            feedbackInputs.decide = !f.screenSpaceIdle;
+            feedbackInputs.screenSpaceIdle = f.screenSpaceIdle;
             // A frame rendered as rt wrote no counters: the next one that
             // decides starts without evidence, as after a cut.
-            feedbackInputs.resetHistory = feedbackInputs.resetHistory || (lastIdle_ && !f.screenSpaceIdle);
+            feedbackInputs.resetHistory = feedbackInputs.resetHistory ||
+                                          (lastFrame_ == LastFrame::RenderedAsRt && !f.screenSpaceIdle);
         }
         f.feedback = addFeedbackPass(graph, feedback_, feedbackInputs, fs);
         rayInputs.tileModes = f.feedback->tileModes;
         rayInputs.screenSpaceIdle = f.screenSpaceIdle;
     }
-    lastTriedSslr_ = mode == ReflectionMode::Hybrid && !f.screenSpaceIdle;
-    lastIdle_ = f.screenSpaceIdle;
+    lastFrame_ = mode != ReflectionMode::Hybrid ? LastFrame::Other
+                 : f.screenSpaceIdle            ? LastFrame::RenderedAsRt
+                                                : LastFrame::TriedSslr;
     // 2. Ray generation and tile classification.
     RayGenerationSettings raySettings = settings.rays;
     raySettings.sslrFirst = raySettings.sslrFirst || (sslrFallback && mode == ReflectionMode::Hybrid);

@@ -242,8 +242,11 @@ private:
     std::unique_ptr<rg::FrameReadback> gateReadback_;
     uint64_t gatePending_ = 0;   // the newest report of a frame after one that tried SSLR, not yet read (0: none)
     bool sslrPays_ = true;       // what the newest report read said (true until one says otherwise)
-    bool lastTriedSslr_ = false;  // the last frame declared was hybrid and not rendered as rt
-    bool lastIdle_ = false;       // the last frame declared was hybrid and rendered as rt
+    // What the last frame declared did with SSLR: its counters hold a
+    // report worth reading (TriedSslr) or none (RenderedAsRt: the next
+    // frame that decides starts without evidence).
+    enum class LastFrame { Other, TriedSslr, RenderedAsRt };
+    LastFrame lastFrame_ = LastFrame::Other;
 };
 
 } // namespace glint::passes
