@@ -7,6 +7,7 @@
 #include "glint/feedback_shared.h"
 #include "glint/ray_generation_shared.h"
 
+#include <algorithm>
 #include <cmath>
 #include <vector>
 
@@ -32,6 +33,11 @@ uint32_t feedbackMinFrameHits(const FeedbackSettings& settings, uint32_t width, 
     return uint32_t(std::ceil(double(settings.sslrMinHitShare) * double(width) * double(height)));
 }
 
+bool hostProbeFrame(uint64_t frame, uint32_t probeInterval, uint32_t stride) {
+    const uint64_t block = frame / std::max(probeInterval, 1u);
+    return shader::feedbackProbeFrame(uint32_t(frame), probeInterval) && block % std::max(stride, 1u) == 0;
+}
+
 FeedbackOutputs addFeedbackPass(rg::Graph& graph, FeedbackPipelines& pipelines, const FeedbackInputs& inputs,
                                 const FeedbackSettings& settings) {
     const GBufferOutputs& gbuf = inputs.gbuffer;
@@ -48,6 +54,10 @@ FeedbackOutputs addFeedbackPass(rg::Graph& graph, FeedbackPipelines& pipelines, 
         throw gpu::GpuError("addFeedbackPass: sslrMinHitShare must lie in [0, 1] and sslrProbeInterval be at least 1 "
                             "(got " + std::to_string(settings.sslrMinHitShare) + ", " +
                             std::to_string(settings.sslrProbeInterval) + ")");
+    }
+    if (settings.sslrProbeIntervalMax < settings.sslrProbeInterval) {
+        throw gpu::GpuError("addFeedbackPass: sslrProbeIntervalMax (" + std::to_string(settings.sslrProbeIntervalMax) +
+                            ") must be at least sslrProbeInterval (" + std::to_string(settings.sslrProbeInterval) + ")");
     }
     FeedbackOutputs out;
     out.tilesX = (gbuf.width + shader::kTileSize - 1) / shader::kTileSize;

@@ -100,6 +100,17 @@ struct FeedbackSettings {
     // frames: this pass, SSLR's empty dispatches, integrate's hybrid
     // variant. Off: only the GPU gate.
     bool hostGate = true;
+    // The host's gate backs off: each probe whose report says SSLR still
+    // does not pay halves how often the next ones come (only one probe
+    // frame of feedbackProbeFrame's in 2, 4, ... is kept), until one in
+    // this many frames; a report that says SSLR pays, or a cut, goes back
+    // to sslrProbeInterval. A probe frame costs what the hybrid costs
+    // without the gate (on the H200 at 1080p about 0.1-0.15 ms more than
+    // rt where SSLR resolves nothing); the frames between render as rt, so
+    // backing off costs no accuracy, only the time SSLR takes to come back
+    // where it starts to pay. At least sslrProbeInterval; equal: no
+    // backing off.
+    uint32_t sslrProbeIntervalMax = 32;
     // Off: every tile hybrid, as if there were no feedback (the bench's
     // baseline); the counters are still carried.
     bool adaptive = true;
@@ -121,6 +132,12 @@ struct FeedbackOutputs {
 
 // FeedbackOutputs::minFrameHits for a frame of width x height pixels.
 uint32_t feedbackMinFrameHits(const FeedbackSettings& settings, uint32_t width, uint32_t height);
+
+// Whether the host's gate keeps `frame` as a probe frame at backing-off
+// `stride` (1, 2, 4, ..., FeedbackSettings::sslrProbeIntervalMax /
+// sslrProbeInterval): feedbackProbeFrame's probe of every stride-th block
+// of sslrProbeInterval frames.
+bool hostProbeFrame(uint64_t frame, uint32_t probeInterval, uint32_t stride);
 
 // The pipeline and the sampler the pass records with; created once.
 class FeedbackPipelines {

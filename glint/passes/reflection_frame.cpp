@@ -120,22 +120,29 @@ bool ReflectionRenderer::screenSpaceIdle(const ReflectionFrameSettings& settings
         // A cut: what earlier frames said no longer holds.
         gatePending_ = 0;
         sslrPays_ = true;
+        probeStride_ = 1;
     }
     if (gatePending_ != 0) {
         if (const auto bytes = gateReadback_->read(gatePending_)) {
             uint32_t word = 0;
             std::memcpy(&word, bytes->data(), sizeof(word));
-            sslrPays_ = shader::sslrPays(word, feedbackMinFrameHits(feedback, width, height), false, false);
-            spdlog::debug("SSLR gate: frame {} read report {}: {} SSLR hits last frame, SSLR {}", frameIndex,
-                          gatePending_, word - std::min(word, shader::kFeedbackFrameHitsStart),
-                          sslrPays_ ? "pays" : "does not pay");
+            const bool pays = shader::sslrPays(word, feedbackMinFrameHits(feedback, width, height), false, false);
+            // A probe that found SSLR still not paying: the next ones come
+            // half as often, down to one in sslrProbeIntervalMax frames.
+            const uint32_t maxStride =
+                std::max(feedback.sslrProbeIntervalMax / std::max(feedback.sslrProbeInterval, 1u), 1u);
+            probeStride_ = pays ? 1 : sslrPays_ ? probeStride_ : std::min(probeStride_ * 2, maxStride);
+            sslrPays_ = pays;
+            spdlog::debug("SSLR gate: frame {} read report {}: {} SSLR hits last frame, SSLR {}; a probe every {} frames",
+                          frameIndex, gatePending_, word - std::min(word, shader::kFeedbackFrameHitsStart),
+                          sslrPays_ ? "pays" : "does not pay", feedback.sslrProbeInterval * probeStride_);
             gatePending_ = 0;
         } else if (gateReadback_->overwritten(gatePending_)) {
             gatePending_ = 0;
         }
     }
     return !sslrPays_ && !settings.resetHistory &&
-           !shader::feedbackProbeFrame(uint32_t(frameIndex), feedback.sslrProbeInterval);
+           !hostProbeFrame(frameIndex, feedback.sslrProbeInterval, probeStride_);
 }
 
 ReflectionFrame ReflectionRenderer::addFrame(rg::Graph& graph, const scene::Camera& camera,

@@ -242,6 +242,7 @@ private:
     std::unique_ptr<rg::FrameReadback> gateReadback_;
     uint64_t gatePending_ = 0;   // the newest report of a frame after one that tried SSLR, not yet read (0: none)
     bool sslrPays_ = true;       // what the newest report read said (true until one says otherwise)
+    uint32_t probeStride_ = 1;   // hostProbeFrame's: 2, 4, ... after probes that found SSLR still not paying
     // What the last frame declared did with SSLR: its counters hold a
     // report worth reading (TriedSslr) or none (RenderedAsRt: the next
     // frame that decides starts without evidence).

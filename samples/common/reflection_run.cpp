@@ -60,7 +60,7 @@ constexpr std::array<bool, 3> kEveryMode{true, true, true};
 
 // The one table of parameters: name, field, the viewer's range, the
 // bench's sweep, and where the value lives.
-const std::array<ParameterSlot, 26> kParameters = {{
+const std::array<ParameterSlot, 27> kParameters = {{
     // A confidence; the talk's 0.9 (default) bracketed from "trust SSLR
     // often" to "almost never".
     {{"sslr_threshold", "ReflectionFrameSettings::confidenceThreshold", 0.0f, 1.0f, false, {0.5, 0.7, 0.8, 0.95, 0.99},
@@ -126,6 +126,11 @@ const std::array<ParameterSlot, 26> kParameters = {{
     // While SSLR does not pay, one frame in this many tries it again (default 8).
     {{"feedback_sslr_probe_interval", "FeedbackSettings::sslrProbeInterval", 1.0f, 64.0f, true, {4, 16}, {}, kHybrid},
      nullptr, [](ReflectionRunOptions& o) { return &o.frame.feedback.sslrProbeInterval; }},
+    // The host's gate backs off to one probe in this many frames (default
+    // 32); the probe interval: no backing off.
+    {{"feedback_sslr_probe_interval_max", "FeedbackSettings::sslrProbeIntervalMax", 1.0f, 256.0f, true, {8}, {},
+      kHybrid},
+     nullptr, [](ReflectionRunOptions& o) { return &o.frame.feedback.sslrProbeIntervalMax; }},
     // The same gate on the host (default on): frames where SSLR does not
     // pay render as rt, with no feedback, pyramid or SSLR work; 0: the GPU's
     // gate alone, which still runs those passes empty.

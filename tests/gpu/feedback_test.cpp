@@ -322,4 +322,9 @@ TEST_CASE("feedback refuses hit and miss fractions outside [0, 1]") {
     settings.sslrProbeInterval = 0;
     CHECK_THROWS_WITH_AS(harness.runFeedback(testCamera(), 0, counters, settings),
                          doctest::Contains("sslrProbeInterval be at least 1"), gpu::GpuError);
+    settings.sslrProbeInterval = 8;
+    settings.sslrProbeIntervalMax = 4;
+    CHECK_THROWS_WITH_AS(harness.runFeedback(testCamera(), 0, counters, settings),
+                         doctest::Contains("sslrProbeIntervalMax (4) must be at least sslrProbeInterval (8)"),
+                         gpu::GpuError);
 }

@@ -22,8 +22,7 @@ namespace {
 constexpr uint32_t kSize = 128;
 
 app::ReflectionRunResult run(test::GpuTest& gpu, passes::ReflectionMode mode, uint32_t frames,
-                             float minHitShare = passes::FeedbackSettings{}.sslrMinHitShare, bool hostGate = true,
-                             std::string_view debugView = {}) {
+                             const passes::FeedbackSettings& feedback = {}, std::string_view debugView = {}) {
     const std::filesystem::path file = std::filesystem::path(GLINT_SCENES_DIR) / "DamagedHelmet" / "DamagedHelmet.gltf";
     REQUIRE_MESSAGE(std::filesystem::exists(file), "shared scene missing: " << file.string());
     scene::Scene scene = scene::loadScene(file.string());
@@ -33,10 +32,27 @@ app::ReflectionRunResult run(test::GpuTest& gpu, passes::ReflectionMode mode, ui
     options.frames = frames;
     options.timeEveryFrame = false;
     options.frame.mode = mode;
-    options.frame.feedback.sslrMinHitShare = minHitShare;
-    options.frame.feedback.hostGate = hostGate;
+    options.frame.feedback = feedback;
     options.frame.debugView = debugView;
     return app::runReflections(gpu.ctx(), scene, options);
+}
+
+// The gate's settings with one change.
+passes::FeedbackSettings noMinHitShare() {
+    passes::FeedbackSettings s;
+    s.sslrMinHitShare = 0.0f;
+    return s;
+}
+passes::FeedbackSettings gpuGateOnly() {
+    passes::FeedbackSettings s;
+    s.hostGate = false;
+    return s;
+}
+// Probes at feedbackProbeFrame's every block, as the GPU's gate has them.
+passes::FeedbackSettings noBackingOff() {
+    passes::FeedbackSettings s;
+    s.sslrProbeIntervalMax = s.sslrProbeInterval;
+    return s;
 }
 
 // The smallest frame count from `least` on whose last frame (index
@@ -61,11 +77,13 @@ TEST_CASE("the hybrid stops trying SSLR where it resolves too little, and tries 
     CHECK(hybrid.sslrRays == 0);
     CHECK(hybrid.rtRays == rt.rtRays);
     // With the gate off the same frame tries SSLR on its hybrid pixels.
-    const app::ReflectionRunResult always = run(gpu, passes::ReflectionMode::Hybrid, gated, 0.0f);
+    const app::ReflectionRunResult always = run(gpu, passes::ReflectionMode::Hybrid, gated, noMinHitShare());
     CHECK(always.sslrRays > 100);
     CHECK(always.rtRays < rt.rtRays);
-    // A probe frame tries SSLR on every hybrid pixel again.
-    const app::ReflectionRunResult probe = run(gpu, passes::ReflectionMode::Hybrid, framesEndingOn(true, gated));
+    // A probe frame tries SSLR on every hybrid pixel again (the host's
+    // gate keeping every one of the GPU's probe frames).
+    const app::ReflectionRunResult probe =
+        run(gpu, passes::ReflectionMode::Hybrid, framesEndingOn(true, gated), noBackingOff());
     CHECK(probe.sslrRays > always.sslrRays);
 }
 
@@ -74,10 +92,8 @@ TEST_CASE("the host renders the hybrid's frames as rt where SSLR does not pay: r
     const uint32_t gated = framesEndingOn(false, 10);
     // Integrate's output of the last frame: this frame's rays alone, before
     // the temporal history mixes in the earlier (hybrid, probe) frames.
-    const app::ReflectionRunResult hybrid =
-        run(gpu, passes::ReflectionMode::Hybrid, gated, passes::FeedbackSettings{}.sslrMinHitShare, true, "reflections");
-    const app::ReflectionRunResult rt =
-        run(gpu, passes::ReflectionMode::Rt, gated, passes::FeedbackSettings{}.sslrMinHitShare, true, "reflections");
+    const app::ReflectionRunResult hybrid = run(gpu, passes::ReflectionMode::Hybrid, gated, {}, "reflections");
+    const app::ReflectionRunResult rt = run(gpu, passes::ReflectionMode::Rt, gated, {}, "reflections");
     CHECK(hybrid.lastScreenSpaceIdle);
     // The first frames try SSLR until a report of one says it does not pay
     // (read back some frames later); then every frame but the probes.
@@ -87,14 +103,37 @@ TEST_CASE("the host renders the hybrid's frames as rt where SSLR does not pay: r
     REQUIRE(hybrid.rgba.size() == rt.rgba.size());
     CHECK(hybrid.rgba == rt.rgba);
     // The GPU's gate alone: the same rays, but the hybrid's passes ran.
-    const app::ReflectionRunResult gpuGate =
-        run(gpu, passes::ReflectionMode::Hybrid, gated, passes::FeedbackSettings{}.sslrMinHitShare, false);
+    const app::ReflectionRunResult gpuGate = run(gpu, passes::ReflectionMode::Hybrid, gated, gpuGateOnly());
     CHECK(gpuGate.screenSpaceIdleFrames == 0);
     CHECK(gpuGate.rtRays == rt.rtRays);
     // A probe frame tries SSLR again, as the hybrid.
-    const app::ReflectionRunResult probe = run(gpu, passes::ReflectionMode::Hybrid, framesEndingOn(true, gated));
+    const app::ReflectionRunResult probe =
+        run(gpu, passes::ReflectionMode::Hybrid, framesEndingOn(true, gated), noBackingOff());
     CHECK_FALSE(probe.lastScreenSpaceIdle);
     CHECK(probe.sslrRays > 100);
+}
+
+TEST_CASE("the host's gate probes less often while SSLR keeps not paying") {
+    test::GpuTest gpu;
+    // Probes in every block of 2 frames at first; backing off to one in 16.
+    passes::FeedbackSettings often;
+    often.sslrProbeInterval = 2;
+    often.sslrProbeIntervalMax = 2;
+    passes::FeedbackSettings backingOff = often;
+    backingOff.sslrProbeIntervalMax = 16;
+    constexpr uint32_t kFrames = 40;
+    const app::ReflectionRunResult fixed = run(gpu, passes::ReflectionMode::Hybrid, kFrames, often);
+    const app::ReflectionRunResult backed = run(gpu, passes::ReflectionMode::Hybrid, kFrames, backingOff);
+    MESSAGE("frames rendered as rt of " << kFrames << ": " << fixed.screenSpaceIdleFrames << " probing every block, "
+                                        << backed.screenSpaceIdleFrames << " backing off");
+    CHECK(fixed.screenSpaceIdleFrames > 0);
+    CHECK(backed.screenSpaceIdleFrames > fixed.screenSpaceIdleFrames + 8);
+    // The probe frames as hostProbeFrame places them: strides 1, 2, 4, 8 and
+    // 8 from then on, one of which is still kept in every 16 frames.
+    uint32_t probesAtMost = 0;
+    for (uint64_t frame = 0; frame < kFrames; ++frame) probesAtMost += passes::hostProbeFrame(frame, 2, 1);
+    CHECK(kFrames - backed.screenSpaceIdleFrames < probesAtMost / 2);
+    CHECK(kFrames - backed.screenSpaceIdleFrames >= kFrames / 16);
 }
 
 TEST_CASE("where SSLR pays, the host renders no hybrid frame as rt") {
