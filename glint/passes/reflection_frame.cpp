@@ -205,6 +205,7 @@ ReflectionFrame ReflectionRenderer::addFrame(rg::Graph& graph, const scene::Came
             const bool viewsScreenSpace = viewsSslr || view == "tile_modes" || view == "feedback_counters";
             f.screenSpaceIdle =
                 screenSpaceIdle(settings, frameIndex, f.width, f.height) && !sslrFallback && !viewsScreenSpace;
+            f.sslrProbeSpacing = sslrPays_ ? 0 : fs.sslrProbeInterval * probeStride_;
             f.gateReport = gateReadback_->declare(graph);
             // The report holds last frame's hits when last frame tried SSLR
             // (else the copy is not recorded).

@@ -135,6 +135,10 @@ struct ReflectionFrame {
     // A hybrid frame the host rendered as rt (FeedbackSettings::hostGate):
     // its feedback, pyramid and SSLR passes recorded nothing.
     bool screenSpaceIdle = false;
+    // While the host's gate holds SSLR back: frames between its probes
+    // (sslrProbeInterval, backing off to sslrProbeIntervalMax); 0 while
+    // SSLR pays, or without the host's gate.
+    uint32_t sslrProbeSpacing = 0;
     // Where the feedback pass copied last frame's SSLR hits for the gate.
     std::optional<rg::FrameReadback::Target> gateReport;
     RayGenerationOutputs rays;

@@ -449,6 +449,7 @@ ReflectionRunResult runReflections(gpu::Context& ctx, scene::Scene& scene, const
         renderer.bind(resources, frame);
         result.screenSpaceIdleFrames += frame.screenSpaceIdle ? 1u : 0u;
         result.lastScreenSpaceIdle = frame.screenSpaceIdle;
+        result.lastSslrProbeSpacing = frame.sslrProbeSpacing;
         if (last) {
             image.copy(graph, resources, frame.output.color);
             counts.copy(graph, resources, frame.counts);

@@ -146,6 +146,7 @@ struct ReflectionRunResult {
     // hostGate), and whether the last frame was one.
     uint32_t screenSpaceIdleFrames = 0;
     bool lastScreenSpaceIdle = false;
+    uint32_t lastSslrProbeSpacing = 0;  // ReflectionFrame::sslrProbeSpacing of the last frame
     bool converged = false;
     double lastChange = 0.0;
 };

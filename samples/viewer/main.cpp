@@ -555,8 +555,12 @@ private:
             ImGui::Checkbox("count rays", &countRays_);
             if (options_.frame.mode == passes::ReflectionMode::Hybrid) {
                 // FeedbackSettings::hostGate: the last frame's decision.
-                ImGui::TextUnformatted(screenSpaceIdle_ ? "SSLR does not pay: frame rendered as rt (probes aside)"
-                                                        : "SSLR tried on hybrid pixels");
+                if (sslrProbeSpacing_ == 0) {
+                    ImGui::TextUnformatted("SSLR tried on hybrid pixels");
+                } else {
+                    ImGui::Text("SSLR does not pay: %s; a probe about every %u frames",
+                                screenSpaceIdle_ ? "frame rendered as rt" : "probe frame", sslrProbeSpacing_);
+                }
             }
             if (countRays_ && counts_.valid) {
                 const double pixels = double(swapchain_.extent().width) * swapchain_.extent().height;
@@ -666,6 +670,7 @@ private:
         rg::Graph graph(executor_->queueCaps());
         const passes::ReflectionFrame reflections = renderer_->addFrame(graph, camera_, settings);
         screenSpaceIdle_ = reflections.screenSpaceIdle;
+        sslrProbeSpacing_ = reflections.sslrProbeSpacing;
         rg::FrameResources resources;
         renderer_->bind(resources, reflections);
 
@@ -717,6 +722,7 @@ private:
     scene::Scene& scene_;
     const std::vector<viewer::ParameterSlider> sliders_;
     bool screenSpaceIdle_ = false;  // the last hybrid frame was rendered as rt (FeedbackSettings::hostGate)
+    uint32_t sslrProbeSpacing_ = 0; // ReflectionFrame::sslrProbeSpacing of the last frame
     app::ReflectionRunOptions options_;            // what the panel edits
     passes::ReflectionRendererOptions builtWith_;  // what renderer_ was built with
     viewer::Swapchain swapchain_;

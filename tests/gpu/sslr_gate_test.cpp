@@ -127,6 +127,9 @@ TEST_CASE("the host's gate probes less often while SSLR keeps not paying") {
     MESSAGE("frames rendered as rt of " << kFrames << ": " << fixed.screenSpaceIdleFrames << " probing every block, "
                                         << backed.screenSpaceIdleFrames << " backing off");
     CHECK(fixed.screenSpaceIdleFrames > 0);
+    // The spacing the renderer reports: the interval, and backed off all the way.
+    CHECK(fixed.lastSslrProbeSpacing == 2);
+    CHECK(backed.lastSslrProbeSpacing == 16);
     CHECK(backed.screenSpaceIdleFrames > fixed.screenSpaceIdleFrames + 8);
     // The probe frames as hostProbeFrame places them: strides 1, 2, 4, 8 and
     // 8 from then on, one of which is still kept in every 16 frames.
