@@ -211,8 +211,11 @@ void main() {
             }
         }
         // A ray that cone-traces needs SSLR's colour pyramid: its two passes'
-        // dispatches get their z (glint/ray_generation_shared.h).
-        if (sharedCone != 0u) {
+        // dispatches get their z (glint/ray_generation_shared.h). Read
+        // first: once a tile has set them, the others leave the two words
+        // alone, rather than queue two atomics each on the same addresses
+        // (a stale 0 read costs only a redundant atomicMax).
+        if (sharedCone != 0u && sslrArgs[kSslrArgsPyramidOffset + 5u] == 0u) {
             atomicMax(sslrArgs[kSslrArgsPyramidOffset + 2u], 1u);
             atomicMax(sslrArgs[kSslrArgsPyramidOffset + 5u], 1u);
         }
