@@ -257,20 +257,6 @@ Reflection integratePixel(uvec2 pixel) {
 void main() {
     const uvec2 pixel = gl_GlobalInvocationID.xy;
     const uint lane = gl_LocalInvocationIndex;
-#if GLINT_INTEGRATE_FEEDBACK
-    // The tile's carried counter and the frame's sum so far, read before
-    // the pixel's work, so that their latency hides behind its reads
-    // instead of holding up the tile at its end (a sum read early only
-    // makes a tile add when the sum was already enough: no harm).
-    const uint tile = gl_WorkGroupID.y * C.tiles.x + gl_WorkGroupID.x;
-    const uint total = C.tiles.x * C.tiles.y;
-    uint carried = 0u;
-    uint frameHits = 0u;
-    if (lane == 0u) {
-        carried = tile < uint(reprojected.length()) ? reprojected[tile] : 0u;
-        frameHits = total < uint(counters.length()) ? counters[total] : 0u;
-    }
-#endif
     if (lane == 0u) {
         sharedHits = 0u;
         sharedMisses = 0u;
@@ -294,6 +280,8 @@ void main() {
     // the feedback pass carried here from last frame (glint/feedback_shared.h).
     // length(): the buffers are bound whole, whatever the image's size.
     if (lane == 0u) {
+        const uint tile = gl_WorkGroupID.y * C.tiles.x + gl_WorkGroupID.x;
+        const uint carried = tile < uint(reprojected.length()) ? reprojected[tile] : 0u;
         if (tile < uint(counters.length())) {
             counters[tile] = rotateFeedback(carried, sharedHits, sharedMisses);
         }
@@ -301,8 +289,9 @@ void main() {
         // minFrameHits: once it holds that many the answer is known, and
         // the tiles stop adding (one atomic on one word per tile would
         // queue up behind each other).
+        const uint total = C.tiles.x * C.tiles.y;
         if (sharedHits != 0u && total < uint(counters.length()) &&
-            frameHits < kFeedbackFrameHitsStart + C.minFrameHits) {
+            counters[total] < kFeedbackFrameHitsStart + C.minFrameHits) {
             atomicAdd(counters[total], sharedHits);
         }
     }

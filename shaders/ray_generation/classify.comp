@@ -95,17 +95,10 @@ void main() {
     const uvec2 pixel = gl_GlobalInvocationID.xy;
     const uint lane = gl_LocalInvocationIndex;
     const bool inside = pixel.x < pc.size.x && pixel.y < pc.size.y;
-    // Whether an earlier tile has opened SSLR's colour pyramid (below),
-    // read before the G-buffer, so that the read's latency hides behind
-    // theirs instead of holding up the tile at its end.
-    uint pyramidOpen = 0u;
     if (lane == 0u) {
         sharedSslrCount = 0u;
         sharedRtCount = 0u;
         sharedCone = 0u;
-        if ((pc.flags & kRayGenModeMask) != kModeRt) {
-            pyramidOpen = sslrArgs[kSslrArgsPyramidOffset + 5u];
-        }
     }
 
     uint pixelClass = kPixelSky;
@@ -218,12 +211,11 @@ void main() {
             }
         }
         // A ray that cone-traces needs SSLR's colour pyramid: its two passes'
-        // dispatches get their z (glint/ray_generation_shared.h). Once a
-        // tile has set them, the later ones leave the two words alone,
-        // rather than queue two atomics each on the same addresses (a
-        // stale 0, read while the first tiles run, costs only a redundant
-        // atomicMax).
-        if (sharedCone != 0u && pyramidOpen == 0u) {
+        // dispatches get their z (glint/ray_generation_shared.h). Read
+        // first: once a tile has set them, the others leave the two words
+        // alone, rather than queue two atomics each on the same addresses
+        // (a stale 0 read costs only a redundant atomicMax).
+        if (sharedCone != 0u && sslrArgs[kSslrArgsPyramidOffset + 5u] == 0u) {
             atomicMax(sslrArgs[kSslrArgsPyramidOffset + 2u], 1u);
             atomicMax(sslrArgs[kSslrArgsPyramidOffset + 5u], 1u);
         }
