@@ -127,7 +127,7 @@ const std::array<ParameterSlot, 27> kParameters = {{
     {{"feedback_sslr_probe_interval", "FeedbackSettings::sslrProbeInterval", 1.0f, 64.0f, true, {4, 16}, {}, kHybrid},
      nullptr, [](ReflectionRunOptions& o) { return &o.frame.feedback.sslrProbeInterval; }},
     // The host's gate backs off to one probe in this many frames (default
-    // 32); the probe interval: no backing off.
+    // 32); equal to the probe interval, it does not back off.
     {{"feedback_sslr_probe_interval_max", "FeedbackSettings::sslrProbeIntervalMax", 1.0f, 256.0f, true, {8}, {},
       kHybrid},
      nullptr, [](ReflectionRunOptions& o) { return &o.frame.feedback.sslrProbeIntervalMax; }},
