@@ -441,7 +441,7 @@ ReflectionRunResult runReflections(gpu::Context& ctx, scene::Scene& scene, const
         const bool check = reference && (i + 1) % options.reference.checkEvery == 0;
         const bool last = i + 1 == options.frames || check;
         passes::ReflectionFrameSettings settings = options.frame;
-        settings.resetHistory = i == 0;
+        settings.resetHistory = i == 0 || std::ranges::find(options.cutFrames, i) != options.cutFrames.end();
         settings.countRays = last;
         rg::Graph graph(executor.queueCaps());
         const passes::ReflectionFrame frame = renderer.addFrame(graph, camera, settings);

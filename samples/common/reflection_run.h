@@ -58,6 +58,9 @@ struct ReflectionRunOptions {
     // roughness are read back into ReflectionRunResult::captures, waiting
     // for each: the per-frame error of a sequence in motion.
     std::vector<uint32_t> captureFrames;
+    // Frames (indices from 0) that start with a camera cut besides the
+    // first: ReflectionFrameSettings::resetHistory, as an engine sets it.
+    std::vector<uint32_t> cutFrames;
     // A still camera at this pose on every frame (else the scene's path).
     std::optional<scene::CameraPose> stillPose;
     // The scene stays at startSeconds on every frame (else it is animated

@@ -22,7 +22,8 @@ namespace {
 constexpr uint32_t kSize = 128;
 
 app::ReflectionRunResult run(test::GpuTest& gpu, passes::ReflectionMode mode, uint32_t frames,
-                             const passes::FeedbackSettings& feedback = {}, std::string_view debugView = {}) {
+                             const passes::FeedbackSettings& feedback = {}, std::string_view debugView = {},
+                             std::vector<uint32_t> cutFrames = {}) {
     const std::filesystem::path file = std::filesystem::path(GLINT_SCENES_DIR) / "DamagedHelmet" / "DamagedHelmet.gltf";
     REQUIRE_MESSAGE(std::filesystem::exists(file), "shared scene missing: " << file.string());
     scene::Scene scene = scene::loadScene(file.string());
@@ -34,6 +35,7 @@ app::ReflectionRunResult run(test::GpuTest& gpu, passes::ReflectionMode mode, ui
     options.frame.mode = mode;
     options.frame.feedback = feedback;
     options.frame.debugView = debugView;
+    options.cutFrames = std::move(cutFrames);
     return app::runReflections(gpu.ctx(), scene, options);
 }
 
@@ -138,6 +140,13 @@ TEST_CASE("the host's gate probes less often while SSLR keeps not paying") {
     for (uint64_t frame = 0; frame < kFrames; ++frame) everyBlock += passes::hostProbeFrame(frame, 2, 1);
     CHECK(kFrames - backed.screenSpaceIdleFrames < everyBlock / 2);
     CHECK(kFrames - backed.screenSpaceIdleFrames >= kFrames / 16);
+    // A cut forgets the backing off: SSLR is tried again, and once a report
+    // says it still does not pay the probes start at every block again.
+    const app::ReflectionRunResult cut =
+        run(gpu, passes::ReflectionMode::Hybrid, kFrames, backingOff, {}, {kFrames - 6});
+    MESSAGE("after a cut 6 frames before the end: a probe every " << cut.lastSslrProbeSpacing << " frames");
+    CHECK(cut.lastSslrProbeSpacing > 0);
+    CHECK(cut.lastSslrProbeSpacing < backed.lastSslrProbeSpacing);
 }
 
 TEST_CASE("where SSLR pays, the host renders no hybrid frame as rt") {
