@@ -105,10 +105,10 @@ struct FeedbackSettings {
     // frame of feedbackProbeFrame's in 2, 4, ... is kept), until one in
     // this many frames; a report that says SSLR pays, or a cut, goes back
     // to sslrProbeInterval. A probe frame costs what the hybrid costs
-    // without the gate (on the H200 at 1080p about 0.1-0.15 ms more than
-    // rt where SSLR resolves nothing); the frames between render as rt, so
-    // backing off costs no accuracy, only the time SSLR takes to come back
-    // where it starts to pay. At least sslrProbeInterval; equal: no
+    // without the gate (on the H200 at 1080p 0.085-0.11 ms more than rt
+    // where SSLR resolves nothing, docs/results.md); the frames between
+    // render as rt, so backing off costs no accuracy, only the time SSLR
+    // takes to come back where it starts to pay. At least sslrProbeInterval; equal: no
     // backing off.
     uint32_t sslrProbeIntervalMax = 32;
     // Off: every tile hybrid, as if there were no feedback (the bench's
