@@ -6,6 +6,7 @@
 
 #include "glint/graph/executor.h"
 #include "glint/graph/executor_internal.h"
+#include "glint/graph/skip.h"
 
 #include "glint/gpu/error.h"
 
@@ -324,10 +325,31 @@ bool Executor::finished(const SubmittedFrame& frame) const {
     return true;
 }
 
-SubmittedFrame Executor::run(const Plan& plan, const FrameResources& imports) {
-    if (!plan.declaration) {
+SubmittedFrame Executor::run(const Plan& declared, const FrameResources& imports) {
+    if (!declared.declaration) {
         throw gpu::GpuError("render graph: run() got an empty Plan");
     }
+    // Passes skipped this frame (Builder::skip): recorded without their
+    // execute callbacks, their barriers carried on and merged (skip.h).
+    // The caller's semaphores go where the declared plan puts them: the
+    // batches are the same.
+    std::optional<Plan> carried;
+    if (carrySkippedBarriers_ && hasSkippedPasses(declared)) {
+        carried = skipPasses(declared);
+        if (spdlog::should_log(spdlog::level::debug)) {
+            const auto calls = [](const Plan& p) {
+                size_t n = 0;
+                for (const PlannedPass& pass : p.passes) n += pass.barrierCount > 0;
+                for (const Batch& b : p.batches) n += b.endBarrierCount > 0;
+                return n;
+            };
+            const auto skipped = std::count_if(carried->passes.begin(), carried->passes.end(),
+                                               [](const PlannedPass& p) { return p.skipped; });
+            spdlog::debug("render graph frame {}: {} passes skipped, barrier calls {} -> {}", frame_, skipped,
+                          calls(declared), calls(*carried));
+        }
+    }
+    const Plan& plan = carried ? *carried : declared;
     const QueueCaps caps = queueCaps();
     if (plan.caps.separateComputeFamily != caps.separateComputeFamily) {
         throw gpu::GpuError(std::string("render graph: the plan was compiled for ") +
@@ -386,7 +408,7 @@ SubmittedFrame Executor::run(const Plan& plan, const FrameResources& imports) {
     prepareHistory(plan);
     bindResources(plan, imports);
     bindUploads(plan, slot);
-    const ExternalSync external = placeSemaphores(plan, imports);
+    const ExternalSync external = placeSemaphores(declared, imports);
 
     // ---- timeline values: this frame's batches count up from where the
     // previous frame ended on each queue (the plan may change between frames,
@@ -511,7 +533,13 @@ SubmittedFrame Executor::run(const Plan& plan, const FrameResources& imports) {
             if (slot.passes.size() <= pair) {
                 slot.passes.resize(pair + 1);
             }
+            // A skipped pass records nothing and takes no time: no
+            // timestamps of its own (two around nothing still read a few
+            // tenths of a microsecond), 0 ms wherever passes are timed.
+            const bool skipped = plan.declaration->passes[p.pass].skipped;
             slot.passes[pair] = {ctx.name_, p.queue, std::nullopt, frame_};
+            slot.passes[pair].skipped = skipped;
+            if (skipped && perPass && !hostTimed) slot.passes[pair].milliseconds = 0.0;
             {
                 gpu::ScopedLabel label(gpu_, cmd, ctx.name_);
                 // ALL_COMMANDS: written once every earlier command of the queue
@@ -523,13 +551,13 @@ SubmittedFrame Executor::run(const Plan& plan, const FrameResources& imports) {
                     slot.timer.begin(cmd, slot.spanPair, VK_PIPELINE_STAGE_2_ALL_COMMANDS_BIT);
                     slot.spanRecorded = true;
                 }
-                if (!hostTimed && perPass) {
+                if (!hostTimed && perPass && !skipped) {
                     slot.timer.begin(cmd, pair, VK_PIPELINE_STAGE_2_ALL_COMMANDS_BIT);
                 }
-                if (const ExecuteFn& execute = plan.execute(p)) {
+                if (const ExecuteFn& execute = plan.execute(p); execute && !skipped) {
                     execute(ctx);
                 }
-                if (!hostTimed && perPass) {
+                if (!hostTimed && perPass && !skipped) {
                     slot.timer.end(cmd, pair);
                 }
                 if (!hostTimed && &p == spanLast) {
@@ -567,6 +595,11 @@ SubmittedFrame Executor::run(const Plan& plan, const FrameResources& imports) {
                 slot.passes[pair].milliseconds =
                     std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
                 slot.passes[pair].cpuMilliseconds = processCpuMilliseconds() - cpuStart;
+                if (skipped) {
+                    // What was measured is an empty submission's overhead.
+                    slot.passes[pair].milliseconds = 0.0;
+                    slot.passes[pair].cpuMilliseconds = 0.0;
+                }
             }
         }
         if (!alone && cmd != VK_NULL_HANDLE) {
@@ -652,7 +685,7 @@ std::vector<PassTiming> Executor::timings() const {
     }
     const auto ms = best->timer.readMilliseconds();
     for (size_t i = 0; i < out.size() && i < ms.size(); ++i) {
-        out[i].milliseconds = ms[i];
+        if (!out[i].skipped) out[i].milliseconds = ms[i];
         out[i].frame = best->frame;
     }
     return out;

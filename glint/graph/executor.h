@@ -171,6 +171,9 @@ struct PassTiming {
     // threads, the CPU implementation's included): what the pass costs on a
     // CPU device even when other processes share the cores.
     std::optional<double> cpuMilliseconds;
+    // Builder::skip(): the pass recorded nothing this frame; its times are
+    // 0 wherever passes were timed.
+    bool skipped = false;
 };
 
 // How per-pass times are taken.
@@ -218,8 +221,14 @@ public:
     // outlive the executor.
     CompileOptions compileOptions(bool aliasing = true) const;
 
-    // Records and submits one frame of `plan`.
+    // Records and submits one frame of `plan`. Passes the declaration
+    // skips (Builder::skip) run no execute callback; their barriers are
+    // carried on to the next pass that runs (rg::skipPasses).
     SubmittedFrame run(const Plan& plan, const FrameResources& imports = {});
+    // Off: a skipped pass's barriers stay where the plan put them, each its
+    // own call (the executor still records no execute callback for it):
+    // what carrying them saves, measured (default on).
+    void setCarrySkippedBarriers(bool carry) { carrySkippedBarriers_ = carry; }
     // Waits for every submitted frame.
     void waitIdle();
     // Waits until `frame`'s work is done on every queue (its semaphore
@@ -282,6 +291,7 @@ private:
     PassTimer passTimer_ = PassTimer::GpuTimestamps;
     std::optional<TimedSpan> span_;
     bool perPassTiming_ = true;
+    bool carrySkippedBarriers_ = true;
 };
 
 }  // namespace glint::rg

@@ -258,7 +258,8 @@ std::string Plan::toText() const {
         for (const SemaphoreWait& w : waitsOf(batch)) out += "  wait " + waitText(w) + "\n";
         for (const PlannedPass& p : passesOf(batch)) {
             out += "  pass '" + std::string(passName(p)) + "' (" + std::string(toString(pipeline(p))) + ", timestamps " +
-                   std::to_string(p.timestampQuery) + "-" + std::to_string(p.timestampQuery + 1) + ")\n";
+                   std::to_string(p.timestampQuery) + "-" + std::to_string(p.timestampQuery + 1) +
+                   (p.skipped ? ", skipped" : "") + ")\n";
             for (const Barrier& br : barriersBefore(p)) out += "    barrier " + barrierText(*this, br) + "\n";
             for (const ir::Use& u : uses(p))
                 out += std::string("    ") + (u.writes ? "write " : "read  ") + "'" + std::string(resourceName(u.resource)) + "' " +

@@ -85,6 +85,14 @@ public:
     void setPipeline(Pipeline pipeline);
     // Never culled: uploads, readbacks, anything observable outside the graph.
     void markSideEffects();
+    // This frame the pass has nothing to do: the executor calls no execute
+    // callback for it and carries its barriers on to the next pass of its
+    // batch that runs, merged with that pass's own (rg::skipPasses), so a
+    // pass idle for a frame costs no pipeline barrier of its own. Its uses
+    // stay declared (the frame keeps its plan and transient memory); what
+    // it would have written keeps whatever it held, and readers of it are
+    // the caller's to keep from relying on that.
+    void skip();
 
 private:
     friend class Graph;
@@ -251,6 +259,8 @@ private:
 inline void Builder::setPipeline(Pipeline pipeline) { graph_.mutableDecl().passes[pass_].pipeline = pipeline; }
 
 inline void Builder::markSideEffects() { graph_.mutableDecl().passes[pass_].sideEffects = true; }
+
+inline void Builder::skip() { graph_.mutableDecl().passes[pass_].skipped = true; }
 
 // Inline for the same reason as Graph::createTexture.
 inline Texture Builder::createTexture(std::string_view name, const TextureDesc& desc) {

@@ -90,6 +90,10 @@ struct Pass {
     Queue queue = Queue::Graphics; // as declared; compile() maps it to a family
     Pipeline pipeline = Pipeline::Compute;
     bool sideEffects = false;
+    // Builder::skip(): this frame the pass records nothing. Not part of the
+    // plan's shape (a reused plan serves frames that skip and frames that
+    // do not); the executor carries its barriers on (rg::skipPasses).
+    bool skipped = false;
     // Declaration bookkeeping: every access kind its uses take, so endPass
     // checks the pipeline without walking the uses again.
     AccessSet kinds = 0;

@@ -10,8 +10,9 @@
 //             batch to wait for)
 //     record: for p in passesOf(batch): barriersBefore(p) as one
 //             vkCmdPipelineBarrier2, then timestamp p.timestampQuery, the
-//             pass's execute callback, timestamp p.timestampQuery + 1;
-//             then barriersAfter(batch) as one vkCmdPipelineBarrier2
+//             pass's execute callback (none where p.skipped), timestamp
+//             p.timestampQuery + 1; then barriersAfter(batch) as one
+//             vkCmdPipelineBarrier2
 //     signal: the timeline semaphore of batch.queue at
 //             signalValue(frame, batch), stage ALL_COMMANDS
 // One timeline semaphore per queue; every batch signals. History pairs swap
@@ -76,6 +77,10 @@ struct PlannedPass {
     uint32_t firstBarrier = 0;     // barriersBefore(): [firstBarrier, +barrierCount) of Plan::barriers
     uint32_t barrierCount = 0;
     uint32_t timestampQuery = 0; // begin query; end is +1
+    // Runs no execute callback this frame: set by skipPasses() (skip.h) for
+    // the passes Builder::skip() named, whose barriers it has carried on;
+    // compile() never sets it.
+    bool skipped = false;
 };
 
 struct Batch {

@@ -80,6 +80,7 @@ std::vector<PassId> declare(Graph& graph, const Script& script) {
             [&](Builder& b) {
                 b.setPipeline(pass.pipeline);
                 if (pass.sideEffects) b.markSideEffects();
+                if (pass.skipped) b.skip();
                 for (const ScriptUse& u : pass.uses) {
                     const Slot& s = slots[u.slot];
                     if (!accessWrites(u.access)) {

@@ -39,6 +39,7 @@ struct ScriptPass {
     Queue queue = Queue::Graphics;
     Pipeline pipeline = Pipeline::Compute;
     bool sideEffects = false;
+    bool skipped = false; // Builder::skip(): this frame it records nothing
     std::vector<ScriptUse> uses;
 };
 

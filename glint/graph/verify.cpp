@@ -229,22 +229,34 @@ bool Replay::checkStructure() {
 
 // Which pass's data each use must find in each subresource: the last
 // writer before it in declaration order (versions follow declarations),
-// counting surviving passes only.
+// counting the passes that run only. A skipped pass writes nothing, so its
+// readers find the writer before it -- or discarded contents, which they
+// are allowed (Builder::skip: what they read is the caller's concern).
 void Replay::expectWriters() {
-    std::vector<uint8_t> alive(d_.passes.size(), 0);
-    for (const PlannedPass& p : plan_.passes) alive[p.pass] = 1;
+    enum : uint8_t { Culled, Runs, Skipped };
+    std::vector<uint8_t> state(d_.passes.size(), Culled);
+    for (const PlannedPass& p : plan_.passes) state[p.pass] = p.skipped ? Skipped : Runs;
     std::vector<uint32_t> last(d_.cellCount, kNoIndex);
+    std::vector<uint8_t> lastSkipped(d_.cellCount, 0);
     expected_.assign(d_.uses.size(), {});
+    staleAllowed_.assign(d_.uses.size(), 0);
     for (uint32_t p = 0; p < d_.passes.size(); ++p) {
-        if (!alive[p]) continue;
+        if (state[p] == Culled) continue;
         const ir::Pass& pass = d_.passes[p];
         for (uint32_t u = pass.firstUse; u < pass.firstUse + pass.useCount; ++u) {
             const ir::Use& use = d_.uses[u];
-            forCells(d_.resources[use.resource], use.range, [&](uint32_t c) { expected_[u].push_back(last[c]); });
+            forCells(d_.resources[use.resource], use.range, [&](uint32_t c) {
+                expected_[u].push_back(last[c]);
+                if (lastSkipped[c]) staleAllowed_[u] = 1;
+            });
         }
         for (uint32_t u = pass.firstUse; u < pass.firstUse + pass.useCount; ++u) {
             const ir::Use& use = d_.uses[u];
-            if (use.writes) forCells(d_.resources[use.resource], use.range, [&](uint32_t c) { last[c] = p; });
+            if (!use.writes) continue;
+            forCells(d_.resources[use.resource], use.range, [&](uint32_t c) {
+                if (state[p] == Runs) last[c] = p;
+                lastSkipped[c] = state[p] == Skipped;
+            });
         }
     }
 }

@@ -215,6 +215,9 @@ void Replay::replayFrame(uint32_t f) {
             const uint32_t planned = batch.firstPass + i;
             const PlannedPass& p = plan_.passes[planned];
             applyBarriers(p.firstBarrier, p.barrierCount, q, f);
+            // A skipped pass records nothing: its barriers (carried ones,
+            // where merging was refused) are all it does.
+            if (p.skipped) continue;
             const ir::Pass& pass = d_.passes[p.pass];
             for (uint32_t u = pass.firstUse; u < pass.firstUse + pass.useCount; ++u) checkOrder(planned, u, f);
             for (const ir::Use& u : plan_.uses(p)) use(planned, pass.pipeline, u, q, f);
@@ -511,7 +514,8 @@ void Replay::use(uint32_t planned, Pipeline pipeline, const ir::Use& u, uint32_t
     const VkPipelineStageFlags2 stages = expandStages(need.stages);
     const VkAccessFlags2 access = expandAccess(need.reads | need.writes);
     const VkAccessFlags2 readBits = access & kReadBits, writeBits = access & kWriteBits;
-    const bool needsContents = need.needsContents;
+    // A reader of what a skipped pass would have written may find it gone.
+    const bool needsContents = need.needsContents && !staleAllowed_[static_cast<size_t>(&u - d_.uses.data())];
     const std::string who = "pass " + passName(planned);
 
     auto checkAgainst = [&](Cell& cell, uint32_t cellPhys, uint32_t c) {

@@ -117,6 +117,9 @@ private:
     std::vector<Cell> cells_;
     std::vector<uint8_t> useful_;
     std::vector<std::vector<uint32_t>> expected_; // per use, per cell: the writing pass (declaration index)
+    // Per use: a cell's declared writer is skipped (PlannedPass::skipped),
+    // so the use may find older or discarded contents (Builder::skip).
+    std::vector<uint8_t> staleAllowed_;
     std::vector<uint32_t> writer_;                // per cell: last writer in the replay of this frame
     std::vector<std::vector<uint32_t>> segmentsOf_;
     std::vector<uint32_t> owner_;

@@ -82,6 +82,11 @@ FeedbackOutputs addFeedbackPass(rg::Graph& graph, FeedbackPipelines& pipelines, 
     constants.resetHistory = inputs.resetHistory ? 1u : 0u;
     constants.minFrameHits = out.minFrameHits;
     constants.probeInterval = settings.sslrProbeInterval;
+    // The report holds last frame's hits when last frame wrote counters.
+    const bool reports = inputs.report.valid() && inputs.reportLastFrame;
+    constants.report = !reports                  ? shader::kFeedbackReportNone
+                       : inputs.screenSpaceIdle ? shader::kFeedbackReportOnly
+                                                : shader::kFeedbackReport;
 
     struct ReprojectData {
         rg::Texture motion;
@@ -93,24 +98,18 @@ FeedbackOutputs addFeedbackPass(rg::Graph& graph, FeedbackPipelines& pipelines, 
         [&](rg::Builder& b, ReprojectData& d) {
             d.motion = b.read(gbuf.motion, rg::Access::SampledRead);
             d.previous = b.read(out.counters.previous, rg::Access::StorageRead);
-            if (inputs.report.valid()) {
-                b.read(out.counters.previous, rg::Access::TransferSrc);
-                d.report = b.write(inputs.report, rg::Access::TransferDst);
-            }
+            if (inputs.report.valid()) d.report = b.write(inputs.report, rg::Access::StorageWrite);
             d.out = out;
             // Starts the frame's sum of hits; integrate writes the rest.
             d.out.counters.current = b.write(out.counters.current, rg::Access::StorageWrite);
             d.out.reprojected =
                 b.write(b.createBuffer("feedback.reprojected", {tileBytes}), rg::Access::StorageWrite);
             d.out.tileModes = b.write(b.createBuffer("feedback.tile_modes", {tileBytes}), rg::Access::StorageWrite);
+            // A frame rendered as rt reads no counter: nothing to do unless
+            // the report goes out (rg::Builder::skip: no barrier either).
+            if (inputs.screenSpaceIdle && !reports) b.skip();
         },
-        [&pipelines, constants, tiles, idle = inputs.screenSpaceIdle, report = inputs.reportLastFrame](
-            const ReprojectData& d, rg::PassContext& pc) {
-            if (d.report.valid() && report) {
-                const VkBufferCopy word{uint64_t(tiles) * sizeof(uint32_t), 0, sizeof(uint32_t)};
-                vkCmdCopyBuffer(pc.cmd(), pc.buffer(d.previous).handle(), pc.buffer(d.report).handle(), 1, &word);
-            }
-            if (idle) return;
+        [&pipelines, constants, tiles](const ReprojectData& d, rg::PassContext& pc) {
             const gpu::Pipeline& pipeline = pipelines.reproject_;
             pipeline.bind(pc.cmd());
             gpu::PushDescriptors(pipeline)
@@ -119,9 +118,11 @@ FeedbackOutputs addFeedbackPass(rg::Graph& graph, FeedbackPipelines& pipelines, 
                 .storageBuffer("Reprojected", pc.buffer(d.out.reprojected))
                 .storageBuffer("TileModes", pc.buffer(d.out.tileModes))
                 .storageBuffer("Current", pc.buffer(d.out.counters.current))
+                .storageBuffer("Report", pc.buffer(d.report.valid() ? d.report : d.out.counters.current))
                 .push(pipelines.ctx_, pc.cmd());
             pipeline.pushConstants(pc.cmd(), constants);
-            pc.dispatch(pipeline, (tiles + kGroupSize - 1) / kGroupSize);
+            const bool reportOnly = constants.report == shader::kFeedbackReportOnly;
+            pc.dispatch(pipeline, reportOnly ? 1u : (tiles + kGroupSize - 1) / kGroupSize);
         });
     return reproject.out;
 }

@@ -51,17 +51,19 @@ struct FeedbackInputs {
     // evidence, as on the first frame.
     bool resetHistory = false;
     // The host's side of the gate (ReflectionRenderer, FeedbackSettings::
-    // hostGate). When valid (4 bytes), the pass first copies the counters'
-    // word after the tiles of last frame (`previous`: its SSLR hits) into
-    // it, for the host to read once the frame has finished.
+    // hostGate). When valid (4 bytes), the pass's shader writes the
+    // counters' word after the tiles of last frame (`previous`: its SSLR
+    // hits) into it (a storage write), for the host to read once the frame
+    // has finished.
     rg::Buffer report;
-    // False: the copy is declared but not recorded (last frame wrote no
+    // False: the report is declared but not written (last frame wrote no
     // counters, so there is nothing to report).
     bool reportLastFrame = true;
     // A hybrid frame the host renders as rt (ReflectionRenderer's SSLR
     // gate: ray generation reads no tile modes, integrate writes no
-    // counters): the pass records only the copy into `report`, if any. Its
-    // declarations stay the same, so that the frame keeps its plan.
+    // counters): the pass writes only the report, if any (one workgroup),
+    // and is skipped without one (rg::Builder::skip: no barriers of its own).
+    // Its declarations stay the same, so that the frame keeps its plan.
     bool screenSpaceIdle = false;
 };
 
@@ -100,6 +102,15 @@ struct FeedbackSettings {
     // frames: this pass, SSLR's empty dispatches, integrate's hybrid
     // variant. Off: only the GPU gate.
     bool hostGate = true;
+    // While the host's gate holds SSLR back, its probe frames render as rt
+    // too: SSLR traces every hybrid ray and its hits are counted for the
+    // report, but it hands every ray on to RT and integrate takes the ray
+    // tracer's result, so the frame's reflections are rt mode's exactly.
+    // The probe then measures without adding SSLR's less accurate hits to
+    // the history of a scene where it does not pay (it costs the RT rays
+    // of what SSLR resolved: few, or the gate would be open). Off: a probe
+    // uses what SSLR resolves, as a hybrid frame does.
+    bool probesRenderAsRt = true;
     // The host's gate backs off: each probe whose report says SSLR still
     // does not pay halves how often the next ones come (only one probe
     // frame of feedbackProbeFrame's in 2, 4, ... is kept), until one in

@@ -102,6 +102,7 @@ IntegrateOutputs addIntegratePass(rg::Graph& graph, IntegratePipelines& pipeline
     constants.rtMissesTrusted = settings.rtMissesTrusted ? 1u : 0u;
     constants.rtHitMotionBound = inputs.rtHitMotion.valid() ? 1u : 0u;
     constants.minFrameHits = (variant & kVariantFeedback) != 0 ? feedback.minFrameHits : 0u;
+    constants.sslrCountsOnly = inputs.sslrCountsOnly && (variant & kVariantSslr) != 0 ? 1u : 0u;
 
     // The constants outgrow push constants (glint/integrate_shared.h); a
     // transfer inside the frame keeps their lifetime the graph's.

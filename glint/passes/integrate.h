@@ -91,6 +91,10 @@ struct IntegrateInputs {
     // feedback and writing no counters; both stay declared, so that the
     // frame keeps its plan.
     bool screenSpaceIdle = false;
+    // A probe frame that renders as rt (FeedbackSettings::probesRenderAsRt:
+    // SSLR handed every ray on): SSLR's hits are counted into the feedback,
+    // and the reflection is the ray tracer's, as in rt mode.
+    bool sslrCountsOnly = false;
 };
 
 struct IntegrateSettings {

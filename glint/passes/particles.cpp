@@ -160,7 +160,7 @@ ParticleTraceOutputs addParticleTracePass(rg::Graph& graph, ParticlePipelines& p
     constants.size = {gbuf.width, gbuf.height};
     constants.confidenceThreshold = sslrStoredThreshold(settings.confidenceThreshold);
     constants.maxDistance = settings.maxDistance;
-    constants.sslrBound = hasSslr && !inputs.screenSpaceIdle ? 1u : 0u;
+    constants.sslrBound = !hasSslr || inputs.screenSpaceIdle ? 0u : inputs.sslrCountsOnly ? 2u : 1u;
     constants.rtBound = hasRt ? 1u : 0u;
     constants.sslrSeesParticles = settings.sslrSeesParticles ? 1u : 0u;
     constants.rtMissesTrusted = settings.rtMissesTrusted ? 1u : 0u;

@@ -97,6 +97,9 @@ struct ParticleTraceInputs {
     // A hybrid frame the host renders as rt (ReflectionRenderer's SSLR
     // gate): `sslr`, declared but not traced this frame, is not read.
     bool screenSpaceIdle = false;
+    // A probe frame that renders as rt (IntegrateInputs::sslrCountsOnly):
+    // hybrid pixels' reflections end where the ray tracer's do.
+    bool sslrCountsOnly = false;
 };
 
 struct ParticleTraceSettings {

@@ -206,9 +206,12 @@ ReflectionFrame ReflectionRenderer::addFrame(rg::Graph& graph, const scene::Came
             f.screenSpaceIdle =
                 screenSpaceIdle(settings, frameIndex, f.width, f.height) && !sslrFallback && !viewsScreenSpace;
             f.sslrProbeSpacing = sslrPays_ ? 0 : fs.sslrProbeInterval * probeStride_;
+            // A probe while the gate is closed: counted, rendered as rt.
+            f.sslrCountsOnly = fs.probesRenderAsRt && !sslrPays_ && !f.screenSpaceIdle && !sslrFallback &&
+                               !viewsScreenSpace;
             f.gateReport = gateReadback_->declare(graph);
             // The report holds last frame's hits when last frame tried SSLR
-            // (else the copy is not recorded).
+            // (else it is not written).
             const bool reports = lastFrame_ == LastFrame::TriedSslr && !settings.resetHistory;
             if (f.gateReport) {
                 feedbackInputs.report = f.gateReport->buffer;
@@ -240,7 +243,7 @@ ReflectionFrame ReflectionRenderer::addFrame(rg::Graph& graph, const scene::Came
         sslrSettings.clearUntraced = sslrSettings.clearUntraced || viewsSslr;
         f.sslr = addSslrPass(graph, sslr_,
                              {f.gbuffer, f.rays, frameIndex, camera.view, camera.projection,
-                              settings.confidenceThreshold, f.screenSpaceIdle},
+                              settings.confidenceThreshold, f.screenSpaceIdle, f.sslrCountsOnly},
                              sslrSettings);
         rtList = f.sslr->rtRayList;
         rtArgs = f.sslr->rtArgs;
@@ -276,6 +279,7 @@ ReflectionFrame ReflectionRenderer::addFrame(rg::Graph& graph, const scene::Came
         particleInputs.bvh = *f.bvh;
         particleInputs.camera = camera;
         particleInputs.screenSpaceIdle = f.screenSpaceIdle;
+        particleInputs.sslrCountsOnly = f.sslrCountsOnly;
         ParticleTraceSettings particleSettings;
         particleSettings.backend = rt_->backend();
         particleSettings.confidenceThreshold = settings.confidenceThreshold;
@@ -302,6 +306,7 @@ ReflectionFrame ReflectionRenderer::addFrame(rg::Graph& graph, const scene::Came
     integrateInputs.camera = camera;
     integrateInputs.confidenceThreshold = settings.confidenceThreshold;
     integrateInputs.screenSpaceIdle = f.screenSpaceIdle;
+    integrateInputs.sslrCountsOnly = f.sslrCountsOnly;
     if (f.particles) {
         integrateInputs.particles = f.particles->radiance;
     }

@@ -139,6 +139,9 @@ struct ReflectionFrame {
     // (sslrProbeInterval, backing off to sslrProbeIntervalMax); 0 while
     // SSLR pays, or without the host's gate.
     uint32_t sslrProbeSpacing = 0;
+    // A probe frame of the host's closed gate that renders as rt
+    // (FeedbackSettings::probesRenderAsRt): SSLR's hits counted, not used.
+    bool sslrCountsOnly = false;
     // Where the feedback pass copied last frame's SSLR hits for the gate.
     std::optional<rg::FrameReadback::Target> gateReport;
     RayGenerationOutputs rays;

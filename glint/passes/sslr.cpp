@@ -150,10 +150,10 @@ SslrOutputs addSslrPass(rg::Graph& graph, SslrPipelines& pipelines, const SslrIn
                                         rg::Subresource{first, end - first, 0, rg::Subresource::kAll});
                     d.first = first;
                     d.outputs = end - first;
+                    // A frame rendered as rt traces no SSLR ray.
+                    if (inputs.screenSpaceIdle) b.skip();
                 },
-                [&pipelines, constants, pass, idle = inputs.screenSpaceIdle](const PyramidData& d,
-                                                                              rg::PassContext& pc) {
-                    if (idle) return;
+                [&pipelines, constants, pass](const PyramidData& d, rg::PassContext& pc) {
                     const gpu::Pipeline& pipeline = d.fromLit ? pipelines.pyramidBase_ : pipelines.pyramidDown_;
                     const gpu::Image& image = pc.image(d.pyramid);
                     pipeline.bind(pc.cmd());
@@ -191,7 +191,9 @@ SslrOutputs addSslrPass(rg::Graph& graph, SslrPipelines& pipelines, const SslrIn
     constants.thickness = settings.thickness;
     constants.maxDistance = settings.maxDistance;
     constants.edgeFade = settings.edgeFade;
-    constants.confidenceThreshold = sslrStoredThreshold(inputs.confidenceThreshold);
+    // The shader hands a hybrid ray on below this confidence; above any
+    // confidence (at most 1) it hands every one on.
+    constants.confidenceThreshold = inputs.handEveryRay ? 2.0f : sslrStoredThreshold(inputs.confidenceThreshold);
     constants.pyramidMips = pyramidMips;
     constants.blueNoise = rays.blueNoise ? 1u : 0u;
 
@@ -222,10 +224,10 @@ SslrOutputs addSslrPass(rg::Graph& graph, SslrPipelines& pipelines, const SslrIn
             d.out.rtRayList = b.write(rays.rtRays, rg::Access::StorageReadWrite);
             d.out.rtArgs = b.write(rays.rtArgs, rg::Access::StorageReadWrite);
             d.out.litPyramid = d.pyramid;
+            // A frame rendered as rt traces no SSLR ray.
+            if (inputs.screenSpaceIdle) b.skip();
         },
-        [&pipelines, constants, blueNoise = rays.blueNoiseBuffer, idle = inputs.screenSpaceIdle](const TraceData& d,
-                                                                                                rg::PassContext& pc) {
-            if (idle) return;
+        [&pipelines, constants, blueNoise = rays.blueNoiseBuffer](const TraceData& d, rg::PassContext& pc) {
             const gpu::Pipeline& pipeline = pipelines.trace_;
             const VkSampler sampler = pipelines.nearest_.handle();
             pipeline.bind(pc.cmd());

@@ -57,9 +57,14 @@ struct SslrInputs {
     float confidenceThreshold = kDefaultConfidenceThreshold;
     // A hybrid frame the host renders as rt (ReflectionRenderer's SSLR
     // gate): ray generation listed no SSLR ray, and the pyramid and the
-    // trace record nothing (they are still declared, so that the frame
-    // keeps its plan); the RT list stays ray generation's.
+    // trace are skipped (rg::Builder::skip: still declared, so that the
+    // frame keeps its plan, but neither recorded nor given barriers of
+    // their own); the RT list stays ray generation's.
     bool screenSpaceIdle = false;
+    // A probe frame that renders as rt (FeedbackSettings::probesRenderAsRt):
+    // every hybrid ray is handed on to RT, whatever its confidence (which
+    // is still stored, for integrate to count).
+    bool handEveryRay = false;
 };
 
 struct SslrSettings {

@@ -4,6 +4,7 @@
 #include "glint/graph/transfer.h"
 #include "glint/graph/graph.h"
 #include "glint/graph/plan_cache.h"
+#include "glint/graph/skip.h"
 #include "glint/graph/verify.h"
 #include "glint/scene/animation.h"
 
@@ -60,7 +61,7 @@ constexpr std::array<bool, 3> kEveryMode{true, true, true};
 
 // The one table of parameters: name, field, the viewer's range, the
 // bench's sweep, and where the value lives.
-const std::array<ParameterSlot, 27> kParameters = {{
+const std::array<ParameterSlot, 29> kParameters = {{
     // A confidence; the talk's 0.9 (default) bracketed from "trust SSLR
     // often" to "almost never".
     {{"sslr_threshold", "ReflectionFrameSettings::confidenceThreshold", 0.0f, 1.0f, false, {0.5, 0.7, 0.8, 0.95, 0.99},
@@ -136,6 +137,17 @@ const std::array<ParameterSlot, 27> kParameters = {{
     // gate alone, which still runs those passes empty.
     {{"feedback_host_gate", "FeedbackSettings::hostGate (0 or 1)", 0.0f, 1.0f, true, {0}, {}, kHybrid}, nullptr,
      nullptr, [](ReflectionRunOptions& o) { return &o.frame.feedback.hostGate; }},
+    // While the host's gate is closed its probes render as rt, SSLR's hits
+    // counted but not used (default on); 0: a probe uses what SSLR resolves.
+    {{"feedback_probes_render_as_rt", "FeedbackSettings::probesRenderAsRt (0 or 1)", 0.0f, 1.0f, true, {0}, {},
+      kHybrid},
+     nullptr, nullptr, [](ReflectionRunOptions& o) { return &o.frame.feedback.probesRenderAsRt; }},
+    // The frames the host renders as rt skip the feedback, pyramid and SSLR
+    // passes, whose barriers are carried on into the next pass's (default
+    // on); 0: each stays a barrier call of its own, as before.
+    {{"graph_carry_skipped_barriers", "rg::Executor::setCarrySkippedBarriers (0 or 1)", 0.0f, 1.0f, true, {0}, {},
+      kHybrid},
+     nullptr, nullptr, [](ReflectionRunOptions& o) { return &o.carrySkippedBarriers; }},
     // Particles drawn before SSLR, which reflects them where it resolves
     // the ray; the particle trace only where it does not (default off:
     // every particle traced).
@@ -340,6 +352,7 @@ ReflectionRunResult runReflections(gpu::Context& ctx, scene::Scene& scene, const
     const ReflectionRunOptions options = reference ? referenceSettings(requested) : requested;
     if (options.frames == 0) throw std::invalid_argument("--frames must be at least 1");
     rg::Executor executor(ctx, options.renderer.framesInFlight);
+    executor.setCarrySkippedBarriers(options.carrySkippedBarriers);
     const bool cpuDevice = ctx.caps().deviceType == VK_PHYSICAL_DEVICE_TYPE_CPU;
     executor.setPassTimer(options.passTimer.value_or(cpuDevice ? rg::PassTimer::HostSerial
                                                                : rg::PassTimer::GpuTimestamps));
@@ -481,6 +494,18 @@ ReflectionRunResult runReflections(gpu::Context& ctx, scene::Scene& scene, const
         if (ctx.validationEnabled()) {
             const rg::VerifyReport report = rg::verify(plan);
             if (!report.ok()) throw std::runtime_error("render graph plan of frame " + std::to_string(i) + ": " + report.text());
+            // A frame that skips passes (the host's SSLR gate) runs with
+            // their barriers carried on: that plan is checked too (a
+            // carried barrier may serve only the pass that skipped, so
+            // without the redundancy rule).
+            if (rg::hasSkippedPasses(plan)) {
+                rg::VerifyOptions carried;
+                carried.checkRedundancy = false;
+                const rg::VerifyReport skipped = rg::verify(rg::skipPasses(plan), carried);
+                if (!skipped.ok())
+                    throw std::runtime_error("render graph plan of frame " + std::to_string(i) +
+                                             " with its skipped passes: " + skipped.text());
+            }
         }
         executor.run(plan, resources);
         // Every frame's pass times: waiting here serialises frames on the

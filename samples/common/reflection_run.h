@@ -69,6 +69,9 @@ struct ReflectionRunOptions {
     // How pass times are taken; none: host-serial on a CPU device (lavapipe's
     // timestamps do not cover compute dispatches), GPU timestamps elsewhere.
     std::optional<rg::PassTimer> passTimer;
+    // Skipped passes' barriers carried on to the next pass that runs
+    // (rg::Executor::setCarrySkippedBarriers; default on).
+    bool carrySkippedBarriers = true;
     passes::ReflectionRendererOptions renderer;
     passes::ReflectionFrameSettings frame;
     ReferenceOptions reference;  // when enabled, `frames` and `mode` are ignored

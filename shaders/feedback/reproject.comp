@@ -7,7 +7,9 @@
 // the carried counter holds (glint/feedback_shared.h), unless last frame's
 // SSLR hits, summed over the frame, say that SSLR does not pay: then every
 // tile goes to RT with no pixel kept hybrid (kTileModeRtOnly), except on
-// probe frames. Starts this frame's sum for integrate to add to.
+// probe frames. Starts this frame's sum for integrate to add to, and hands
+// last frame's sum to the host's report (a storage write: a copy command
+// between the dispatches cost the pass about 5 us).
 #extension GL_GOOGLE_include_directive : require
 #extension GL_EXT_scalar_block_layout : require
 
@@ -22,6 +24,9 @@ layout(set = 0, binding = 3, scalar) writeonly buffer TileModes { uint tileModes
 // This frame's counters (integrate writes the tiles): only the total word
 // after the tiles is written here.
 layout(set = 0, binding = 4, scalar) writeonly buffer Current { uint current[]; };
+// The host's report of last frame's hits (pc.report; bound to something
+// else when there is none, and then not written).
+layout(set = 0, binding = 5, scalar) writeonly buffer Report { uint report[]; };
 
 layout(push_constant, scalar) uniform Constants { FeedbackConstants pc; };
 
@@ -33,6 +38,12 @@ bool isFinite(vec2 v) {
 void main() {
     const uint tileIndex = gl_GlobalInvocationID.x;
     const uint tiles = pc.tiles.x * pc.tiles.y;
+    if (tileIndex == 0u && pc.report != kFeedbackReportNone) {
+        report[0] = tiles < uint(previous.length()) ? previous[tiles] : 0u;
+    }
+    if (pc.report == kFeedbackReportOnly) {
+        return;
+    }
     if (tileIndex == 0u && tiles < uint(current.length())) {
         current[tiles] = kFeedbackFrameHitsStart;
     }

@@ -178,7 +178,9 @@ Reflection integratePixel(uvec2 pixel) {
     if (traced && (pixelClass == kPixelSslr || pixelClass == kPixelHybrid)) {
         const vec4 radiance = texelFetch(sslrRadianceTexture, leader, 0);
         const float c = texelFetch(sslrConfidenceTexture, leader, 0).x;
-        handedToRt = pixelClass == kPixelHybrid && !(c >= C.confidenceThreshold);
+        // A probe that renders as rt: SSLR handed every hybrid ray on
+        // (beyond the reach, kPixelSslr, it still stands alone).
+        handedToRt = pixelClass == kPixelHybrid && (C.sslrCountsOnly != 0u || !(c >= C.confidenceThreshold));
         const vec2 hitUv = texelFetch(sslrHitTexture, leader, 0).xy;
         // A non-finite result is no hit: the pixel falls through to the
         // next source rather than carrying NaN into temporal accumulation.
@@ -195,6 +197,10 @@ Reflection integratePixel(uvec2 pixel) {
             atomicAdd(sharedMisses, 1u);
         }
 #endif
+        // Counted, not used: the ray tracer's result stands (rt's image).
+        if (C.sslrCountsOnly != 0u && pixelClass == kPixelHybrid) {
+            confidence = 0.0;
+        }
     }
 #endif
 

@@ -11,6 +11,7 @@
 #include "glint/graph/error.h"
 #include "glint/graph/graph.h"
 #include "glint/graph/plan.h"
+#include "glint/graph/skip.h"
 #include "glint/graph/synthetic.h"
 #include "glint/graph/verify.h"
 
@@ -86,7 +87,10 @@ extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
     fuzz::Input in(data, size);
     const QueueCaps caps = in.flag() ? synthetic::twoQueueCaps() : synthetic::oneQueueCaps();
     const bool aliasing = in.flag();
-    const synthetic::Script script = decode(in);
+    synthetic::Script script = decode(in);
+    // What is left of the input says which passes this frame skips.
+    bool skips = false;
+    for (synthetic::ScriptPass& pass : script.passes) skips |= pass.skipped = in.flag();
     try {
         Graph graph(caps);
         synthetic::declare(graph, script);
@@ -98,6 +102,20 @@ extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
             std::fprintf(stderr, "graph fuzz: the verifier rejects a compiled plan:\n%s\n%s\n", report.text().c_str(),
                          plan.toText().c_str());
             std::abort();
+        }
+        if (skips) {
+            // The frame as the executor runs it: the skipped passes'
+            // barriers carried on and merged. Redundancy is not asked: a
+            // carried barrier may have served only the pass that skipped.
+            const Plan frame = skipPasses(plan);
+            VerifyOptions noRedundancy;
+            noRedundancy.checkRedundancy = false;
+            const VerifyReport skipped = verify(frame, noRedundancy);
+            if (!skipped.ok()) {
+                std::fprintf(stderr, "graph fuzz: the verifier rejects a plan with skipped passes:\n%s\n%s\n",
+                             skipped.text().c_str(), frame.toText().c_str());
+                std::abort();
+            }
         }
     } catch (const GraphError&) {
         // An illegal declaration, said so: what the graph must do.

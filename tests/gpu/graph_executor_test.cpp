@@ -9,6 +9,7 @@
 #include "glint/gpu/pipeline.h"
 #include "glint/graph/executor.h"
 #include "glint/graph/graph.h"
+#include "glint/graph/skip.h"
 #include "glint/graph/verify.h"
 
 #include <set>
@@ -48,13 +49,15 @@ struct OpData {
     rg::Buffer dst;
 };
 
+// `skip`: rg::Builder::skip() this frame (dst keeps what it held).
 rg::Buffer addOp(rg::Graph& g, const Pipelines& p, const char* name, rg::Queue queue, rg::Buffer src, rg::Buffer dst,
-                 uint32_t mul, uint32_t add) {
+                 uint32_t mul, uint32_t add, bool skip = false) {
     const OpData& data = g.addPass<OpData>(
         name, queue,
         [&](rg::Builder& b, OpData& d) {
             if (src.valid()) d.src = b.read(src, rg::Access::StorageRead);
             d.dst = b.write(dst, rg::Access::StorageWrite);
+            if (skip) b.skip();
         },
         [&p, mul, add](const OpData& d, rg::PassContext& ctx) {
             // An unused source binding still needs a buffer: the destination.
@@ -211,6 +214,133 @@ TEST_CASE("a multi-pass compute graph with aliased transients computes the right
         }
     }
     CHECK(names == std::set<std::string>{"fill", "double", "to-image", "from-image", "async-add", "post", "copy-out"});
+}
+
+TEST_CASE("skipped passes record nothing, and the barriers they carry still order the frame") {
+    test::GpuTest gpu;
+    auto& ctx = gpu.ctx();
+    const Pipelines pipelines(ctx);
+    rg::Executor executor(ctx);
+    rg::PassTimer timer = rg::PassTimer::GpuTimestamps;
+    SUBCASE("passes timed by GPU timestamps") {}
+    SUBCASE("passes submitted alone and timed on the host") { timer = rg::PassTimer::HostSerial; }
+    executor.setPassTimer(timer);
+    gpu::Buffer results[2] = {readbackTarget(ctx, "skip.results0"), readbackTarget(ctx, "skip.results1")};
+
+    // Odd frames skip "overwrite" (the buffer rewritten) and "probe"
+    // (the image copied out as a transfer source: a layout of its own
+    // between the storage write and the storage read around it).
+    uint32_t probes = 0;
+    constexpr uint32_t kFrames = 6;
+    for (uint32_t frame = 0; frame < kFrames; ++frame) {
+        const bool skip = frame % 2 == 1;
+        rg::Graph g(executor.queueCaps());
+        const rg::BufferDesc words{kCount * 4};
+        rg::Buffer a = addOp(g, pipelines, "fill", rg::Queue::Graphics, {}, g.createBuffer("a", words), 1, 5 + frame);
+        const rg::Buffer seed = addOp(g, pipelines, "seed", rg::Queue::Graphics, {}, g.createBuffer("seed", words), 0, 7);
+        a = addOp(g, pipelines, "overwrite", rg::Queue::Graphics, seed, a, 1, 0, skip);
+        struct ImageData {
+            rg::Buffer src;
+            rg::Texture image;
+        };
+        const ImageData& toImage = g.addPass<ImageData>(
+            "to-image", rg::Queue::Graphics,
+            [&](rg::Builder& b, ImageData& d) {
+                d.src = b.read(a, rg::Access::StorageRead);
+                d.image = b.write(b.createTexture("image", {kWidth, kCount / kWidth, 1, 1, 1, VK_FORMAT_R32_UINT}),
+                                  rg::Access::StorageWrite);
+            },
+            [&pipelines](const ImageData& d, rg::PassContext& pc) {
+                gpu::PushDescriptors(pipelines.imageWrite)
+                    .storageBuffer(0, pc.buffer(d.src))
+                    .storageImage(1, pc.view(d.image))
+                    .push(pc.gpu(), pc.cmd());
+                pipelines.imageWrite.pushConstants(pc.cmd(), OpPush{kCount, kWidth, 1, 0});
+                pc.dispatch(pipelines.imageWrite, kCount / 64);
+            });
+        struct ProbeData {
+            rg::Texture image;
+            rg::Buffer copy;
+        };
+        g.addPass<ProbeData>(
+            "probe", rg::Queue::Graphics,
+            [&](rg::Builder& b, ProbeData& d) {
+                d.image = b.read(toImage.image, rg::Access::TransferSrc);
+                d.copy = b.write(b.createBuffer("probe.copy", words), rg::Access::TransferDst);
+                b.markSideEffects();
+                if (skip) b.skip();
+            },
+            [&probes](const ProbeData& d, rg::PassContext& pc) {
+                ++probes;
+                VkBufferImageCopy region{};
+                region.imageSubresource = {VK_IMAGE_ASPECT_COLOR_BIT, 0, 0, 1};
+                region.imageExtent = {kWidth, kCount / kWidth, 1};
+                vkCmdCopyImageToBuffer(pc.cmd(), pc.image(d.image).handle(), pc.layout(d.image),
+                                       pc.buffer(d.copy).handle(), 1, &region);
+            });
+        struct ReadData {
+            rg::Texture image;
+            rg::Buffer dst;
+        };
+        const ReadData& fromImage = g.addPass<ReadData>(
+            "from-image", rg::Queue::Graphics,
+            [&](rg::Builder& b, ReadData& d) {
+                d.image = b.read(toImage.image, rg::Access::StorageRead);
+                d.dst = b.write(b.createBuffer("c", words), rg::Access::StorageWrite);
+            },
+            [&pipelines](const ReadData& d, rg::PassContext& pc) {
+                gpu::PushDescriptors(pipelines.imageRead)
+                    .storageImage(0, pc.view(d.image))
+                    .storageBuffer(1, pc.buffer(d.dst))
+                    .push(pc.gpu(), pc.cmd());
+                pipelines.imageRead.pushConstants(pc.cmd(), OpPush{kCount, kWidth, 0, 0});
+                pc.dispatch(pipelines.imageRead, kCount / 64);
+            });
+        const rg::Buffer out =
+            g.importBuffer("results", {words, rg::BoundaryState::of(rg::Access::StorageWrite), kHostRead});
+        g.markOutput(addOp(g, pipelines, "copy-out", rg::Queue::Graphics, fromImage.dst, out, 1, 0));
+
+        const rg::Plan plan = g.compile(executor.compileOptions());
+        REQUIRE(rg::verify(plan).ok());
+        if (skip) {
+            // The frame as the executor runs it; a carried barrier may
+            // serve only the pass that skipped, so redundancy is not asked.
+            rg::VerifyOptions options;
+            options.checkRedundancy = false;
+            const rg::Plan carried = rg::skipPasses(plan);
+            const auto report = rg::verify(carried, options);
+            REQUIRE_MESSAGE(report.ok(), report.text());
+            CHECK(carried.findPass("probe")->skipped);
+            CHECK(carried.findPass("probe")->barrierCount == 0);
+        }
+        rg::FrameResources imports;
+        gpu::Buffer& target = results[frame % 2];
+        imports.bind(out, target);
+        executor.run(plan, imports);
+        executor.waitIdle();
+        const auto words32 = target.mappedSpan<uint32_t>();
+        for (uint32_t i = 0; i < kCount; ++i) {
+            INFO("frame " << frame << " word " << i);
+            REQUIRE(words32[i] == (skip ? i + 5 + frame : 7u) + 1);
+        }
+    }
+    CHECK(probes == kFrames / 2);
+    CHECK(executor.stats().transientRebuilds == 1); // skipping keeps the plan's memory
+    // The last frame skipped both: they took no time.
+    uint32_t skippedTimings = 0;
+    for (const rg::PassTiming& t : executor.timings()) {
+        INFO(t.name);
+        const bool skippedPass = t.name == "overwrite" || t.name == "probe";
+        CHECK(t.skipped == skippedPass);
+        if (skippedPass) {
+            ++skippedTimings;
+            REQUIRE(t.milliseconds.has_value());
+            CHECK(*t.milliseconds == 0.0);
+        } else if (timer == rg::PassTimer::HostSerial || ctx.caps().timestamps) {
+            CHECK(t.milliseconds.has_value());
+        }
+    }
+    CHECK(skippedTimings == 2);
 }
 
 TEST_CASE("a history buffer carries last frame's value into this frame, with two frames in flight") {

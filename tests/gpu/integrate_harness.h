@@ -380,6 +380,9 @@ struct Presence {
     bool sslr = true;
     bool rt = true;
     bool feedback = true;
+    // IntegrateInputs::sslrCountsOnly: SSLR handed every hybrid ray on;
+    // its hits are counted, the ray tracer's results used.
+    bool sslrCountsOnly = false;
 };
 
 // Everything one frame read back.
@@ -426,9 +429,9 @@ inline Expected expect(const Frame& f, const Traces& t, const Presence& present,
     if (present.sslr && traced && (cls == shader::kPixelSslr || cls == shader::kPixelHybrid)) {
         const glm::vec4 r = t.sslrRadiance[li];
         const float c = t.sslrConfidence[li];
-        handedToRt = cls == shader::kPixelHybrid && !(c >= threshold);
+        handedToRt = cls == shader::kPixelHybrid && (present.sslrCountsOnly || !(c >= threshold));
         if (r.a > 0.5f && finite(glm::vec3(r)) && std::isfinite(c) && std::isfinite(t.sslrHit[li].x) &&
-            std::isfinite(t.sslrHit[li].y)) {
+            std::isfinite(t.sslrHit[li].y) && !(present.sslrCountsOnly && cls == shader::kPixelHybrid)) {
             confidence = glm::clamp(c, 0.0f, 1.0f);
         }
     }
@@ -574,6 +577,7 @@ public:
         in.lighting = lighting_;
         in.camera = camera;
         in.confidenceThreshold = options.confidenceThreshold;
+        in.sslrCountsOnly = present.sslrCountsOnly;
         const passes::IntegrateOutputs out =
             passes::addIntegratePass(graph, integratePipelines_, in, options.integrate);
         REQUIRE(out.counters.valid() == present.feedback);

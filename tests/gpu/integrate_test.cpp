@@ -74,6 +74,25 @@ TEST_CASE("integrate without RT, without SSLR, without either and without feedba
     }
 }
 
+TEST_CASE("a probe that renders as rt counts SSLR's hits and takes the ray tracer's reflection") {
+    // FeedbackSettings::probesRenderAsRt: SSLR handed every hybrid ray on.
+    test::GpuTest gpu;
+    Harness harness(gpu, floorScene());
+    const Traces traces = makeTraces(0, false);
+    Presence countsOnly;
+    countsOnly.sslrCountsOnly = true;
+    const Frame f = harness.run(testCamera(), 0, traces, countsOnly);
+    const Coverage cov = checkFrame(f, traces, countsOnly, harness.lighting());
+    // The same counts as a frame that uses SSLR's hits.
+    checkCounters(f, traces, std::vector<uint32_t>(kTiles * kTiles, 0u));
+    CHECK(f.frameHitsWord > shader::kFeedbackFrameHitsStart);
+    using namespace shader;
+    CHECK(cov.count(kPixelHybrid, kSourceSslr) == 0);
+    CHECK(cov.count(kPixelHybrid, kSourceRt) > 0);
+    // Beyond the BVH's reach SSLR still stands alone.
+    CHECK(cov.count(kPixelSslr, kSourceSslr) > 0);
+}
+
 TEST_CASE("a lower confidence threshold trusts SSLR alone more often") {
     test::GpuTest gpu;
     Harness harness(gpu, floorScene());

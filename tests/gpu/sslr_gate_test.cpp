@@ -5,7 +5,8 @@
 // hybrid traces exactly what rt mode traces and lists no SSLR ray, except
 // on probe frames; with the gate off it keeps trying SSLR every frame.
 // The host's side of the gate then renders those frames as rt: no feedback,
-// pyramid or SSLR work, and rt mode's reflections exactly.
+// pyramid or SSLR work, and rt mode's reflections exactly; its probe frames
+// try SSLR and count its hits, and render as rt as well.
 #include "support/gpu_test.h"
 
 #include "common/reflection_run.h"
@@ -89,7 +90,7 @@ TEST_CASE("the hybrid stops trying SSLR where it resolves too little, and tries 
     CHECK(probe.sslrRays > always.sslrRays);
 }
 
-TEST_CASE("the host renders the hybrid's frames as rt where SSLR does not pay: rt's reflections, probes aside") {
+TEST_CASE("the host renders the hybrid's frames as rt where SSLR does not pay: rt's reflections, probes included") {
     test::GpuTest gpu;
     const uint32_t gated = framesEndingOn(false, 10);
     // Integrate's output of the last frame: this frame's rays alone, before
@@ -108,11 +109,26 @@ TEST_CASE("the host renders the hybrid's frames as rt where SSLR does not pay: r
     const app::ReflectionRunResult gpuGate = run(gpu, passes::ReflectionMode::Hybrid, gated, gpuGateOnly());
     CHECK(gpuGate.screenSpaceIdleFrames == 0);
     CHECK(gpuGate.rtRays == rt.rtRays);
-    // A probe frame tries SSLR again, as the hybrid.
+    // A probe frame tries SSLR again and counts its hits for the report,
+    // but while the gate is closed it renders as rt too
+    // (FeedbackSettings::probesRenderAsRt): SSLR hands every ray on.
+    const uint32_t probeFrames = framesEndingOn(true, gated);
     const app::ReflectionRunResult probe =
-        run(gpu, passes::ReflectionMode::Hybrid, framesEndingOn(true, gated), noBackingOff());
+        run(gpu, passes::ReflectionMode::Hybrid, probeFrames, noBackingOff(), "reflections");
+    const app::ReflectionRunResult rtProbe = run(gpu, passes::ReflectionMode::Rt, probeFrames, {}, "reflections");
     CHECK_FALSE(probe.lastScreenSpaceIdle);
     CHECK(probe.sslrRays > 100);
+    CHECK(probe.rtRays == rtProbe.rtRays);
+    REQUIRE(probe.rgba.size() == rtProbe.rgba.size());
+    CHECK(probe.rgba == rtProbe.rgba);
+    // A probe that uses what SSLR resolves: fewer RT rays, another image.
+    passes::FeedbackSettings usesSslr = noBackingOff();
+    usesSslr.probesRenderAsRt = false;
+    const app::ReflectionRunResult hybridProbe =
+        run(gpu, passes::ReflectionMode::Hybrid, probeFrames, usesSslr, "reflections");
+    CHECK_FALSE(hybridProbe.lastScreenSpaceIdle);
+    CHECK(hybridProbe.rtRays < rtProbe.rtRays);
+    CHECK(hybridProbe.rgba != rtProbe.rgba);
 }
 
 TEST_CASE("the host's gate probes less often while SSLR keeps not paying") {

@@ -139,12 +139,20 @@ struct FeedbackConstants {
     uint resetHistory;  // 1: carry nothing (a camera cut): every tile starts without evidence
     uint minFrameHits;  // SSLR hits of last frame below which SSLR does not pay (sslrPays); 0: it always does
     uint probeInterval; // feedbackProbeFrame's interval
+    uint report;        // kFeedbackReport*: last frame's SSLR hits into the host's report
 };
+
+// FeedbackConstants::report: none; the word of last frame's hits copied
+// into the report (the host's gate, passes/reflection_frame.h) by the
+// first invocation; only that (a frame the host renders as rt: one group).
+GLINT_CONST uint kFeedbackReportNone = 0u;
+GLINT_CONST uint kFeedbackReport = 1u;
+GLINT_CONST uint kFeedbackReportOnly = 2u;
 
 GLINT_END
 
 #ifdef __cplusplus
-static_assert(sizeof(glint::shader::FeedbackConstants) == 48);
+static_assert(sizeof(glint::shader::FeedbackConstants) == 52);
 #endif
 
 #endif

@@ -79,7 +79,7 @@ GLINT_FUNC uint chooseReflectionTrace(float sslrConfidence, float confidenceThre
 }
 
 // Per-frame constants (a storage buffer: with the lighting they outgrow the
-// 128 bytes of push constants every device has; 496 bytes).
+// 128 bytes of push constants every device has; 504 bytes).
 struct IntegrateConstants {
     mat4 inverseViewProjection;          // unjittered, the G-buffer's camera
     // Last frame's unjittered matrices and position: where an SSLR hit was
@@ -98,12 +98,15 @@ struct IntegrateConstants {
     // The feedback's minFrameHits (passes/feedback.h): tiles stop adding
     // their hits to the frame's sum once it holds this many.
     uint minFrameHits;
+    // 1: SSLR's hits are counted, not used (FeedbackSettings::
+    // probesRenderAsRt; SSLR handed every ray on).
+    uint sslrCountsOnly;
 };
 
 GLINT_END
 
 #ifdef __cplusplus
-static_assert(sizeof(glint::shader::IntegrateConstants) == 500);
+static_assert(sizeof(glint::shader::IntegrateConstants) == 504);
 #endif
 
 #endif

@@ -127,7 +127,9 @@ struct ParticleTraceConstants {
     uvec2 size;                  // pixels
     float confidenceThreshold;   // integrate's (which trace a pixel's reflection takes)
     float maxDistance;           // the longest particle ray (misses reach this far)
-    uint sslrBound;              // 1: the SSLR outputs are bound (else dummies)
+    // 1: the SSLR outputs are bound (else dummies); 2: bound, but hybrid
+    // pixels take the ray tracer's hit (integrate's sslrCountsOnly).
+    uint sslrBound;
     uint rtBound;                // 1: the RT outputs are bound (else dummies)
     // 1: SSLR sampled a lit colour with the particles drawn in, so rays
     // whose reflection integrate takes from SSLR carry them already and

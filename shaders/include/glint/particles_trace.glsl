@@ -151,11 +151,12 @@ float particleReflectionDistance(ivec2 p, uint pixelClass, vec3 position, out ui
     if (C.sslrBound != 0u && (pixelClass == kPixelSslr || pixelClass == kPixelHybrid)) {
         const vec4 radiance = texelFetch(sslrRadianceTexture, p, 0);
         const float c = texelFetch(sslrConfidenceTexture, p, 0).x;
-        handedToRt = pixelClass == kPixelHybrid && !(c >= C.confidenceThreshold);
+        const bool countsOnly = C.sslrBound == 2u && pixelClass == kPixelHybrid;
+        handedToRt = pixelClass == kPixelHybrid && (countsOnly || !(c >= C.confidenceThreshold));
         const vec2 hitUv = texelFetch(sslrHitTexture, p, 0).xy;
         if (radiance.a > 0.5 && particleFinite(radiance.rgb) && particleFinite(c) && particleFinite(hitUv.x) &&
             particleFinite(hitUv.y)) {
-            confidence = sslrHitConfidence(clamp(c, 0.0, 1.0), C.rtMissesTrusted != 0u);
+            confidence = countsOnly ? 0.0 : sslrHitConfidence(clamp(c, 0.0, 1.0), C.rtMissesTrusted != 0u);
             sslrHitUv = hitUv;
         }
     }

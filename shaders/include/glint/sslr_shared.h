@@ -39,7 +39,7 @@ struct SslrConstants {
     float thickness;
     float maxDistance;
     float edgeFade;
-    float confidenceThreshold;  // as stored (passes::sslrStoredThreshold)
+    float confidenceThreshold;  // as stored (passes::sslrStoredThreshold); hybrid rays below it go on to RT
     uint pyramidMips;           // levels of the colour pyramid; 0: no cone trace
     float minStepPixels;        // SslrSettings::minStepPixels
     uint blueNoise;             // 1: start offsets from the blue noise (ray generation's choice)
