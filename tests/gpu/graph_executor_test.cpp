@@ -71,6 +71,56 @@ rg::Buffer addOp(rg::Graph& g, const Pipelines& p, const char* name, rg::Queue q
     return data.dst;
 }
 
+// image = src + 1, word i at (i % kWidth, i / kWidth): a storage image
+// written in GENERAL.
+rg::Texture addToImage(rg::Graph& g, const Pipelines& p, rg::Buffer src) {
+    struct ImageData {
+        rg::Buffer src;
+        rg::Texture image;
+    };
+    const ImageData& data = g.addPass<ImageData>(
+        "to-image", rg::Queue::Graphics,
+        [&](rg::Builder& b, ImageData& d) {
+            d.src = b.read(src, rg::Access::StorageRead);
+            d.image = b.write(b.createTexture("image", {kWidth, kCount / kWidth, 1, 1, 1, VK_FORMAT_R32_UINT}),
+                              rg::Access::StorageWrite);
+        },
+        [&p](const ImageData& d, rg::PassContext& pc) {
+            CHECK(pc.layout(d.image) == VK_IMAGE_LAYOUT_GENERAL);  // storage images live in GENERAL
+            CHECK_THROWS_AS(pc.layout(rg::Texture{}), gpu::GpuError);
+            gpu::PushDescriptors(p.imageWrite)
+                .storageBuffer(0, pc.buffer(d.src))
+                .storageImage(1, pc.view(d.image))
+                .push(pc.gpu(), pc.cmd());
+            p.imageWrite.pushConstants(pc.cmd(), OpPush{kCount, kWidth, 1, 0});
+            pc.dispatch(p.imageWrite, kCount / 64);
+        });
+    return data.image;
+}
+
+// A new buffer "c" holding the image's words, read as a storage image.
+rg::Buffer addFromImage(rg::Graph& g, const Pipelines& p, rg::Texture image) {
+    struct ReadData {
+        rg::Texture image;
+        rg::Buffer dst;
+    };
+    const ReadData& data = g.addPass<ReadData>(
+        "from-image", rg::Queue::Graphics,
+        [&](rg::Builder& b, ReadData& d) {
+            d.image = b.read(image, rg::Access::StorageRead);
+            d.dst = b.write(b.createBuffer("c", {kCount * 4}), rg::Access::StorageWrite);
+        },
+        [&p](const ReadData& d, rg::PassContext& pc) {
+            gpu::PushDescriptors(p.imageRead)
+                .storageImage(0, pc.view(d.image))
+                .storageBuffer(1, pc.buffer(d.dst))
+                .push(pc.gpu(), pc.cmd());
+            p.imageRead.pushConstants(pc.cmd(), OpPush{kCount, kWidth, 0, 0});
+            pc.dispatch(p.imageRead, kCount / 64);
+        });
+    return data.dst;
+}
+
 constexpr rg::BoundaryState kHostRead =
     rg::BoundaryState::raw(VK_PIPELINE_STAGE_2_HOST_BIT, VK_ACCESS_2_HOST_READ_BIT, VK_IMAGE_LAYOUT_UNDEFINED);
 
@@ -120,47 +170,7 @@ TEST_CASE("a multi-pass compute graph with aliased transients computes the right
         const rg::BufferDesc words{kCount * 4};
         rg::Buffer a = addOp(g, pipelines, "fill", rg::Queue::Graphics, {}, g.createBuffer("a", words), 1, 5 + frame);
         rg::Buffer b = addOp(g, pipelines, "double", rg::Queue::Graphics, a, g.createBuffer("b", words), 2, 0);
-        struct ImageData {
-            rg::Buffer src;
-            rg::Texture image;
-        };
-        const ImageData& toImage = g.addPass<ImageData>(
-            "to-image", rg::Queue::Graphics,
-            [&](rg::Builder& builder, ImageData& d) {
-                d.src = builder.read(b, rg::Access::StorageRead);
-                d.image = builder.write(
-                    builder.createTexture("image", {kWidth, kCount / kWidth, 1, 1, 1, VK_FORMAT_R32_UINT}),
-                    rg::Access::StorageWrite);
-            },
-            [&pipelines](const ImageData& d, rg::PassContext& pc) {
-                CHECK(pc.layout(d.image) == VK_IMAGE_LAYOUT_GENERAL);  // storage images live in GENERAL
-                CHECK_THROWS_AS(pc.layout(rg::Texture{}), gpu::GpuError);
-                gpu::PushDescriptors(pipelines.imageWrite)
-                    .storageBuffer(0, pc.buffer(d.src))
-                    .storageImage(1, pc.view(d.image))
-                    .push(pc.gpu(), pc.cmd());
-                pipelines.imageWrite.pushConstants(pc.cmd(), OpPush{kCount, kWidth, 1, 0});
-                pc.dispatch(pipelines.imageWrite, kCount / 64);
-            });
-        struct ReadData {
-            rg::Texture image;
-            rg::Buffer dst;
-        };
-        const ReadData& fromImage = g.addPass<ReadData>(
-            "from-image", rg::Queue::Graphics,
-            [&](rg::Builder& builder, ReadData& d) {
-                d.image = builder.read(toImage.image, rg::Access::StorageRead);
-                d.dst = builder.write(builder.createBuffer("c", words), rg::Access::StorageWrite);
-            },
-            [&pipelines](const ReadData& d, rg::PassContext& pc) {
-                gpu::PushDescriptors(pipelines.imageRead)
-                    .storageImage(0, pc.view(d.image))
-                    .storageBuffer(1, pc.buffer(d.dst))
-                    .push(pc.gpu(), pc.cmd());
-                pipelines.imageRead.pushConstants(pc.cmd(), OpPush{kCount, kWidth, 0, 0});
-                pc.dispatch(pipelines.imageRead, kCount / 64);
-            });
-        const rg::Buffer c = fromImage.dst;
+        const rg::Buffer c = addFromImage(g, pipelines, addToImage(g, pipelines, b));
         // Async compute where the device has it: crosses queues both ways.
         rg::Buffer d = addOp(g, pipelines, "async-add", rg::Queue::AsyncCompute, c, g.createBuffer("d", words), 1, 100);
         // The two result buffers alternate: each was last written by the
@@ -239,25 +249,7 @@ TEST_CASE("skipped passes record nothing, and the barriers they carry still orde
         rg::Buffer a = addOp(g, pipelines, "fill", rg::Queue::Graphics, {}, g.createBuffer("a", words), 1, 5 + frame);
         const rg::Buffer seed = addOp(g, pipelines, "seed", rg::Queue::Graphics, {}, g.createBuffer("seed", words), 0, 7);
         a = addOp(g, pipelines, "overwrite", rg::Queue::Graphics, seed, a, 1, 0, skip);
-        struct ImageData {
-            rg::Buffer src;
-            rg::Texture image;
-        };
-        const ImageData& toImage = g.addPass<ImageData>(
-            "to-image", rg::Queue::Graphics,
-            [&](rg::Builder& b, ImageData& d) {
-                d.src = b.read(a, rg::Access::StorageRead);
-                d.image = b.write(b.createTexture("image", {kWidth, kCount / kWidth, 1, 1, 1, VK_FORMAT_R32_UINT}),
-                                  rg::Access::StorageWrite);
-            },
-            [&pipelines](const ImageData& d, rg::PassContext& pc) {
-                gpu::PushDescriptors(pipelines.imageWrite)
-                    .storageBuffer(0, pc.buffer(d.src))
-                    .storageImage(1, pc.view(d.image))
-                    .push(pc.gpu(), pc.cmd());
-                pipelines.imageWrite.pushConstants(pc.cmd(), OpPush{kCount, kWidth, 1, 0});
-                pc.dispatch(pipelines.imageWrite, kCount / 64);
-            });
+        const rg::Texture image = addToImage(g, pipelines, a);
         struct ProbeData {
             rg::Texture image;
             rg::Buffer copy;
@@ -265,7 +257,7 @@ TEST_CASE("skipped passes record nothing, and the barriers they carry still orde
         g.addPass<ProbeData>(
             "probe", rg::Queue::Graphics,
             [&](rg::Builder& b, ProbeData& d) {
-                d.image = b.read(toImage.image, rg::Access::TransferSrc);
+                d.image = b.read(image, rg::Access::TransferSrc);
                 d.copy = b.write(b.createBuffer("probe.copy", words), rg::Access::TransferDst);
                 b.markSideEffects();
                 if (skip) b.skip();
@@ -278,27 +270,10 @@ TEST_CASE("skipped passes record nothing, and the barriers they carry still orde
                 vkCmdCopyImageToBuffer(pc.cmd(), pc.image(d.image).handle(), pc.layout(d.image),
                                        pc.buffer(d.copy).handle(), 1, &region);
             });
-        struct ReadData {
-            rg::Texture image;
-            rg::Buffer dst;
-        };
-        const ReadData& fromImage = g.addPass<ReadData>(
-            "from-image", rg::Queue::Graphics,
-            [&](rg::Builder& b, ReadData& d) {
-                d.image = b.read(toImage.image, rg::Access::StorageRead);
-                d.dst = b.write(b.createBuffer("c", words), rg::Access::StorageWrite);
-            },
-            [&pipelines](const ReadData& d, rg::PassContext& pc) {
-                gpu::PushDescriptors(pipelines.imageRead)
-                    .storageImage(0, pc.view(d.image))
-                    .storageBuffer(1, pc.buffer(d.dst))
-                    .push(pc.gpu(), pc.cmd());
-                pipelines.imageRead.pushConstants(pc.cmd(), OpPush{kCount, kWidth, 0, 0});
-                pc.dispatch(pipelines.imageRead, kCount / 64);
-            });
+        const rg::Buffer c = addFromImage(g, pipelines, image);
         const rg::Buffer out =
             g.importBuffer("results", {words, rg::BoundaryState::of(rg::Access::StorageWrite), kHostRead});
-        g.markOutput(addOp(g, pipelines, "copy-out", rg::Queue::Graphics, fromImage.dst, out, 1, 0));
+        g.markOutput(addOp(g, pipelines, "copy-out", rg::Queue::Graphics, c, out, 1, 0));
 
         const rg::Plan plan = g.compile(executor.compileOptions());
         REQUIRE(rg::verify(plan).ok());
