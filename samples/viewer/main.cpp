@@ -559,7 +559,10 @@ private:
                     ImGui::TextUnformatted("SSLR tried on hybrid pixels");
                 } else {
                     ImGui::Text("SSLR does not pay: %s; a probe about every %u frames",
-                                screenSpaceIdle_ ? "frame rendered as rt" : "probe frame", sslrProbeSpacing_);
+                                screenSpaceIdle_  ? "frame rendered as rt"
+                                : sslrCountsOnly_ ? "probe frame (SSLR counted, rendered as rt)"
+                                                  : "probe frame",
+                                sslrProbeSpacing_);
                 }
             }
             if (countRays_ && counts_.valid) {
@@ -667,10 +670,13 @@ private:
         settings.resetHistory = resetHistory_;
         settings.countRays = countRays_;
         resetHistory_ = false;
+        // The panel's graph_carry_skipped_barriers.
+        executor_->setCarrySkippedBarriers(options_.carrySkippedBarriers);
         rg::Graph graph(executor_->queueCaps());
         const passes::ReflectionFrame reflections = renderer_->addFrame(graph, camera_, settings);
         screenSpaceIdle_ = reflections.screenSpaceIdle;
         sslrProbeSpacing_ = reflections.sslrProbeSpacing;
+        sslrCountsOnly_ = reflections.sslrCountsOnly;
         rg::FrameResources resources;
         renderer_->bind(resources, reflections);
 
@@ -723,6 +729,7 @@ private:
     const std::vector<viewer::ParameterSlider> sliders_;
     bool screenSpaceIdle_ = false;  // the last hybrid frame was rendered as rt (FeedbackSettings::hostGate)
     uint32_t sslrProbeSpacing_ = 0; // ReflectionFrame::sslrProbeSpacing of the last frame
+    bool sslrCountsOnly_ = false;   // ReflectionFrame::sslrCountsOnly of the last frame (a probe rendered as rt)
     app::ReflectionRunOptions options_;            // what the panel edits
     passes::ReflectionRendererOptions builtWith_;  // what renderer_ was built with
     viewer::Swapchain swapchain_;
