@@ -386,13 +386,16 @@ SubmittedFrame Executor::run(const Plan& declared, const FrameResources& imports
     slot.spanRecorded = false;
     slot.spanMilliseconds.reset();
 
-    // The span's first and last member passes, in submission order.
+    // The span's first and last member passes that run, in submission
+    // order. A skipped member records nothing: a span that began at it
+    // would take in the next pass's barrier call, which a frame without
+    // that member (or with it running) leaves before the span.
     const PlannedPass* spanFirst = nullptr;
     const PlannedPass* spanLast = nullptr;
     if (span_) {
         for (const Batch& batch : plan.batches) {
             for (const PlannedPass& p : plan.passesOf(batch)) {
-                if (!span_->member(plan.passName(p))) continue;
+                if (!span_->member(plan.passName(p)) || plan.declaration->passes[p.pass].skipped) continue;
                 if (spanFirst && p.queue != spanFirst->queue) {
                     throw gpu::GpuError("render graph: timed span '" + span_->name + "' has passes on two queues ('" +
                                         std::string(plan.passName(*spanFirst)) + "' and '" + std::string(plan.passName(p)) + "')");

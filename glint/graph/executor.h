@@ -189,7 +189,9 @@ enum class PassTimer : uint8_t { GpuTimestamps, HostSerial };
 // A chain of passes timed as one: from the start of the first pass (in
 // submission order) whose name `member` accepts to the end of the last one,
 // everything between included (barriers, idle gaps, passes that are not
-// members). All members must run on one queue. With GPU timestamps it is
+// members). Members skipped this frame (Builder::skip) do not count: the
+// span runs from the first member that is recorded to the last; none, no
+// span. All members must run on one queue. With GPU timestamps it is
 // one timestamp pair; host-serial, the host's wall time from the first
 // submission of the span's commands to the queue's idle after its last
 // (the span's passes are then submitted together, per batch, not alone).
