@@ -45,8 +45,6 @@ class Carried {
 public:
     explicit Carried(const Plan& plan) : plan_(plan) {}
 
-    bool empty() const { return carried_.empty(); }
-
     // `own`, one pass's barriers (or a batch's end barriers), with what is
     // carried on their resources merged in: a subresource's two barriers
     // become one, from the carried one's old layout to the pass's new one,
@@ -76,9 +74,10 @@ public:
         return out;
     }
 
-    // Carried barriers on resources `uses` names with no barrier in
-    // `emitted`: a pass that runs relies on them (a read the compiler found
-    // ordered and visible already, through the barrier now carried).
+    // The carried barriers on resources `uses` names (after take(): those
+    // with no barrier of the pass's own) join `emitted`: a pass that runs
+    // relies on them (a read the compiler found ordered and visible
+    // already, through the barrier now carried).
     void takeUsed(std::span<const ir::Use> uses, std::vector<Barrier>& emitted) {
         for (auto it = carried_.begin(); it != carried_.end();) {
             const bool used = std::any_of(uses.begin(), uses.end(),

@@ -215,8 +215,8 @@ void Replay::replayFrame(uint32_t f) {
             const uint32_t planned = batch.firstPass + i;
             const PlannedPass& p = plan_.passes[planned];
             applyBarriers(p.firstBarrier, p.barrierCount, q, f);
-            // A skipped pass records nothing: its barriers (carried ones,
-            // where merging was refused) are all it does.
+            // A skipped pass records nothing: no use of its own (its
+            // barriers, carried on by skipPasses(), have none left here).
             if (p.skipped) continue;
             const ir::Pass& pass = d_.passes[p.pass];
             for (uint32_t u = pass.firstUse; u < pass.firstUse + pass.useCount; ++u) checkOrder(planned, u, f);
