@@ -337,16 +337,10 @@ SubmittedFrame Executor::run(const Plan& declared, const FrameResources& imports
     if (carrySkippedBarriers_ && hasSkippedPasses(declared)) {
         carried = skipPasses(declared);
         if (spdlog::should_log(spdlog::level::debug)) {
-            const auto calls = [](const Plan& p) {
-                size_t n = 0;
-                for (const PlannedPass& pass : p.passes) n += pass.barrierCount > 0;
-                for (const Batch& b : p.batches) n += b.endBarrierCount > 0;
-                return n;
-            };
             const auto skipped = std::count_if(carried->passes.begin(), carried->passes.end(),
                                                [](const PlannedPass& p) { return p.skipped; });
             spdlog::debug("render graph frame {}: {} passes skipped, barrier calls {} -> {}", frame_, skipped,
-                          calls(declared), calls(*carried));
+                          declared.barrierCallCount(), carried->barrierCallCount());
         }
     }
     const Plan& plan = carried ? *carried : declared;

@@ -15,6 +15,13 @@ uint32_t Plan::batchCount(Queue q) const {
     return n;
 }
 
+uint32_t Plan::barrierCallCount() const {
+    uint32_t n = 0;
+    for (const PlannedPass& p : passes) n += p.barrierCount > 0;
+    for (const Batch& b : batches) n += b.endBarrierCount > 0;
+    return n;
+}
+
 uint32_t Plan::family(Queue q) const {
     return q == Queue::AsyncCompute && caps.separateComputeFamily ? caps.computeFamily : caps.graphicsFamily;
 }

@@ -166,6 +166,9 @@ struct Plan {
     Pipeline pipeline(const PlannedPass& p) const { return declaration->passes[p.pass].pipeline; }
 
     uint32_t batchCount(Queue q) const;
+    // vkCmdPipelineBarrier2 calls a frame records: every non-empty group
+    // (before a pass, at a batch's end).
+    uint32_t barrierCallCount() const;
     uint32_t family(Queue q) const;
     uint32_t timestampQueryCount() const { return static_cast<uint32_t>(passes.size()) * 2; }
 

@@ -178,9 +178,11 @@ Reflection integratePixel(uvec2 pixel) {
     if (traced && (pixelClass == kPixelSslr || pixelClass == kPixelHybrid)) {
         const vec4 radiance = texelFetch(sslrRadianceTexture, leader, 0);
         const float c = texelFetch(sslrConfidenceTexture, leader, 0).x;
-        // A probe that renders as rt: SSLR handed every hybrid ray on
-        // (beyond the reach, kPixelSslr, it still stands alone).
-        handedToRt = pixelClass == kPixelHybrid && (C.sslrCountsOnly != 0u || !(c >= C.confidenceThreshold));
+        // A probe that renders as rt: SSLR handed every hybrid ray on, and
+        // its hits are counted, not used (beyond the reach, kPixelSslr, it
+        // still stands alone).
+        const bool countsOnly = C.sslrCountsOnly != 0u && pixelClass == kPixelHybrid;
+        handedToRt = pixelClass == kPixelHybrid && (countsOnly || !(c >= C.confidenceThreshold));
         const vec2 hitUv = texelFetch(sslrHitTexture, leader, 0).xy;
         // A non-finite result is no hit: the pixel falls through to the
         // next source rather than carrying NaN into temporal accumulation.
@@ -198,7 +200,7 @@ Reflection integratePixel(uvec2 pixel) {
         }
 #endif
         // Counted, not used: the ray tracer's result stands (rt's image).
-        if (C.sslrCountsOnly != 0u && pixelClass == kPixelHybrid) {
+        if (countsOnly) {
             confidence = 0.0;
         }
     }

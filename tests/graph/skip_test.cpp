@@ -32,14 +32,6 @@ void expectVerified(const Plan& plan, const std::string& what) {
     }
 }
 
-// Barrier calls the executor records: every non-empty group.
-uint32_t barrierCalls(const Plan& plan) {
-    uint32_t calls = 0;
-    for (const PlannedPass& p : plan.passes) calls += p.barrierCount > 0 ? 1u : 0u;
-    for (const Batch& b : plan.batches) calls += b.endBarrierCount > 0 ? 1u : 0u;
-    return calls;
-}
-
 // a writes t; s1 samples it, s2 writes it again, s3 reads a buffer a wrote
 // (all three skipped when `skip`); z samples t; s4 (a side effect, skipped
 // too) samples it last, so its barrier lands in the batch's end.
@@ -120,7 +112,7 @@ TEST_CASE("a run of skipped passes costs the next pass's one barrier call") {
     CHECK_FALSE(passNamed(frame, "z").skipped);
     CHECK(passNamed(plan, "s1").barrierCount > 0);
     CHECK(passNamed(plan, "s2").barrierCount > 0);
-    CHECK(barrierCalls(frame) < barrierCalls(plan));
+    CHECK(frame.barrierCallCount() < plan.barrierCallCount());
 
     // t's three transitions (a -> s1, s1 -> s2, s2 -> z) are one before z:
     // from a's write to z's read, in z's layout.
@@ -226,7 +218,7 @@ TEST_CASE("random graphs with random skipped passes verify") {
             const std::string what = std::string(two ? "two queues" : "one queue") + ", seed " + std::to_string(seed);
             expectVerified(frame, what);
             INFO(what);
-            CHECK(barrierCalls(frame) <= barrierCalls(plan));
+            CHECK(frame.barrierCallCount() <= plan.barrierCallCount());
             REQUIRE(frame.passes.size() == plan.passes.size());
             for (size_t i = 0; i < plan.passes.size(); ++i) {
                 CHECK(frame.passes[i].pass == plan.passes[i].pass);
