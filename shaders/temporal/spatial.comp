@@ -51,9 +51,25 @@ void main() {
                                         texelFetch(depthTexture, p, 0).x);
     const vec3 normal = normalize(texelFetch(normalTexture, p, 0).xyz);
     const float w = viewDepth(frame.viewProjection, position);
+    // A tap's distance to this pixel's plane without its world position:
+    // with h = M (ndc, depth, 1) (M the inverse view-projection) the tap
+    // lies at h.xyz / h.w, so its signed distance to the plane
+    // (normal, -normal . position) is dot(M^T plane, v) / dot(M's last row,
+    // v) for v = (ndc, depth, 1): two dot products a tap instead of a
+    // matrix product and a division of a vector.
+    const mat4 m = frame.inverseViewProjection;
+    const vec4 planeInClip = vec4(normal, -dot(normal, position)) * m;
+    const vec4 homogeneousW = vec4(m[0][3], m[1][3], m[2][3], m[3][3]);
     // Sigma of half the radius (plus half a pixel) keeps the window's
     // corners near zero weight.
     const float sigma = 0.5 * float(radius) + 0.5;
+    // The weight's four factors are one exp2 of a sum (and the normal's
+    // power one log2): exp(-x) = exp2(-x log2(e)).
+    const float kLog2e = 1.4426950408889634;
+    const float gaussianScale = kLog2e / (2.0 * sigma * sigma);
+    const float planeScale = kLog2e / max(frame.spatialPlaneSigma * w, 1e-6);
+    const float roughnessScale = kLog2e / max(frame.spatialRoughnessSigma, 1e-6);
+    const vec2 ndcPerPixel = 2.0 / size;
     vec3 sum = centre.rgb;
     float weightSum = 1.0;
     for (int dy = -radius; dy <= radius; ++dy) {
@@ -64,14 +80,16 @@ void main() {
             }
             const vec4 tap = texelFetch(accumulatedTexture, q, 0);
             const float depth = texelFetch(depthTexture, q, 0).x;
-            if (!(tap.a > 0.0) || !(depth > 0.0)) continue;
-            const vec3 tapPosition = worldPosition(frame.inverseViewProjection, vec2(q) + 0.5, size, depth);
             const vec3 tapNormal = texelFetch(normalTexture, q, 0).xyz;
             const float tapRoughness = texelFetch(roughnessMetalTexture, q, 0).r;
-            const float plane = abs(dot(tapPosition - position, normal)) / max(frame.spatialPlaneSigma * w, 1e-6);
-            const float weight = exp(-float(dx * dx + dy * dy) / (2.0 * sigma * sigma)) * exp(-plane) *
-                                 pow(max(dot(tapNormal, normal), 0.0), frame.spatialNormalPower) *
-                                 exp(-abs(tapRoughness - roughness) / max(frame.spatialRoughnessSigma, 1e-6));
+            const float facing = dot(tapNormal, normal);
+            if (!(tap.a > 0.0) || !(depth > 0.0) || !(facing > 0.0)) continue;
+            const vec4 v = vec4((vec2(q) + 0.5) * ndcPerPixel - 1.0, depth, 1.0);
+            const float distance = abs(dot(planeInClip, v) / dot(homogeneousW, v));
+            const float exponent = frame.spatialNormalPower * log2(facing) -
+                                   (float(dx * dx + dy * dy) * gaussianScale + distance * planeScale +
+                                    abs(tapRoughness - roughness) * roughnessScale);
+            const float weight = exp2(exponent);
             if (weight > 0.0 && isFinite(tap.rgb)) {
                 sum += weight * tap.rgb;
                 weightSum += weight;
