@@ -63,7 +63,8 @@ ParticlePipelines::ParticlePipelines(gpu::Context& ctx, RtBackend backend)
       // Every read is a texelFetch; the sampler only completes the combined
       // descriptors.
       nearest_(ctx, {VK_FILTER_NEAREST, VK_SAMPLER_MIPMAP_MODE_NEAREST, VK_SAMPLER_ADDRESS_MODE_CLAMP_TO_EDGE, 0.0f,
-                     "particles.nearest"}) {
+                     "particles.nearest"}),
+      clearer_(ctx) {
     if (backend_ == RtBackend::Auto && supported(ctx, RtBackend::Auto)) {
         // Ray query first, as the reflections' own trace (passes/rt_trace.cpp).
         backend_ = ctx.caps().rayQuery ? RtBackend::RayQuery : RtBackend::Pipeline;
@@ -105,7 +106,7 @@ RtBackend ParticlePipelines::prepare(RtBackend requested) {
     }
     if (backend == RtBackend::RayQuery && !query_) {
         query_ = gpu::createComputePipeline(
-            ctx_, {"particles/trace_query.comp", {}, 0, "particles.trace_query"});
+            ctx_, {"particles/trace_query.comp", {}, sizeof(shader::ParticleTracePush), "particles.trace_query"});
     }
     if (backend == RtBackend::Pipeline && !pipeline_) {
         // Hit record kSbtOffsetParticles is the particle group (the particle
@@ -118,7 +119,7 @@ RtBackend ParticlePipelines::prepare(RtBackend requested) {
                    {"particles/trace.rmiss"},
                    {{"", ""}, {"", "particles/trace.rahit"}},
                    {},
-                   0,
+                   sizeof(shader::ParticleTracePush),
                    1,
                    "particles.trace_pipeline"});
         sbt_.emplace(ctx_, *pipeline_, 1, 2);
@@ -138,6 +139,9 @@ ParticleTraceOutputs addParticleTracePass(rg::Graph& graph, ParticlePipelines& p
     if (inputs.rtRadiance.valid() != inputs.rtHitDistance.valid()) {
         throw gpu::GpuError("addParticleTracePass: give the ray tracer's radiance and hit distance together, or neither");
     }
+    if (inputs.rtRayList.valid() != inputs.rtArgs.valid()) {
+        throw gpu::GpuError("addParticleTracePass: give the RT list and its args together, or neither");
+    }
     if (!particlesTraced(inputs.bvh)) {
         throw gpu::GpuError("addParticleTracePass: the BVH update built no particle TLAS this frame (no particles, or "
                             "declared without the camera); check particlesTraced()");
@@ -148,6 +152,8 @@ ParticleTraceOutputs addParticleTracePass(rg::Graph& graph, ParticlePipelines& p
     const RtBackend backend = pipelines.prepare(settings.backend);
     const bool hasSslr = inputs.sslr.has_value();
     const bool hasRt = inputs.rtRadiance.valid();
+    const rg::Buffer rtList = inputs.rtRayList.valid() ? inputs.rtRayList : inputs.rays.rtRays;
+    const rg::Buffer rtArgs = inputs.rtRayList.valid() ? inputs.rtArgs : inputs.rays.rtArgs;
 
     shader::ParticleTraceConstants constants{};
     constants.inverseViewProjection = glm::inverse(inputs.camera.viewProjection());
@@ -169,10 +175,29 @@ ParticleTraceOutputs addParticleTracePass(rg::Graph& graph, ParticlePipelines& p
 
     const rg::Buffer uploaded = rg::addUpload(graph, "particles.constants", constants);
 
+    rg::Texture radiance = graph.createTexture(
+        "particles.radiance", {.width = gbuf.width, .height = gbuf.height, .format = kParticleRadianceFormat});
+    if (settings.clearUntraced) {
+        struct ClearData {
+            rg::Texture radiance;
+        };
+        radiance = graph
+                       .addPass<ClearData>(
+                           "particles.clear", rg::Queue::Graphics,
+                           [&](rg::Builder& b, ClearData& d) { d.radiance = b.write(radiance, rg::Access::StorageWrite); },
+                           [&pipelines](const ClearData& d, rg::PassContext& pc) { pipelines.clearer_.clear(pc, d.radiance); })
+                       .radiance;
+    }
+
+    struct List {
+        rg::Buffer rays, args;
+        uint32_t name = shader::kParticleListSslr;
+    };
     struct TraceData {
         rg::Texture depth, sslrRadiance, sslrConfidence, sslrHit, rtRadiance, rtHitDistance;
-        rg::Buffer rays, classes, particles, constants;
+        rg::Buffer classes, particles, constants;
         rg::AccelStruct tlas;
+        std::vector<List> lists;
         ParticleTraceOutputs out;
     };
     const TraceData& trace = graph.addPass<TraceData>(
@@ -180,11 +205,23 @@ ParticleTraceOutputs addParticleTracePass(rg::Graph& graph, ParticlePipelines& p
         [&](rg::Builder& b, TraceData& d) {
             b.setPipeline(backend == RtBackend::RayQuery ? rg::Pipeline::Compute : rg::Pipeline::RayTracing);
             d.depth = b.read(gbuf.depth, rg::Access::SampledRead);
-            d.rays = b.read(inputs.rays.rays, rg::Access::StorageRead);
             d.classes = b.read(inputs.rays.classes, rg::Access::StorageRead);
             d.tlas = b.read(inputs.bvh.particleTlas, rg::Access::AccelRead);
             d.particles = b.read(inputs.bvh.particles, rg::Access::StorageRead);
             d.constants = b.read(uploaded, rg::Access::StorageRead);
+            // Each list's args: the indirect command, and its length for
+            // the ray query backend's last, partial group.
+            const auto list = [&](rg::Buffer rays, rg::Buffer args, uint32_t name) {
+                List l{b.read(rays, rg::Access::StorageRead), b.read(args, rg::Access::IndirectArgs), name};
+                b.read(args, rg::Access::StorageRead);
+                d.lists.push_back(l);
+            };
+            if (inputs.rays.sslrListed) {
+                list(inputs.rays.sslrRays, inputs.rays.sslrArgs, shader::kParticleListSslr);
+            }
+            if (inputs.rays.rtListed) {
+                list(rtList, rtArgs, shader::kParticleListRt);
+            }
             // Absent traces: the depth, which the pass reads anyway, fills
             // their bindings; the constants say not to read them.
             d.sslrRadiance = d.sslrConfidence = d.sslrHit = d.rtRadiance = d.rtHitDistance = d.depth;
@@ -199,37 +236,40 @@ ParticleTraceOutputs addParticleTracePass(rg::Graph& graph, ParticlePipelines& p
             }
             d.out.width = gbuf.width;
             d.out.height = gbuf.height;
-            d.out.radiance = b.write(b.createTexture("particles.radiance", {.width = gbuf.width,
-                                                                            .height = gbuf.height,
-                                                                            .format = kParticleRadianceFormat}),
-                                     rg::Access::StorageWrite);
+            d.out.radiance = b.write(radiance, rg::Access::StorageWrite);
         },
         [&pipelines, backend](const TraceData& d, rg::PassContext& pc) {
             const gpu::Pipeline& pipeline = backend == RtBackend::RayQuery ? *pipelines.query_ : *pipelines.pipeline_;
             const VkSampler sampler = pipelines.nearest_.handle();
-            const auto sampled = [&](gpu::PushDescriptors& push, std::string_view name, rg::Texture t) {
-                push.sampledImage(name, pc.view(t), sampler, pc.layout(t));
-            };
             pipeline.bind(pc.cmd());
-            gpu::PushDescriptors push(pipeline);
-            push.accelerationStructure("particleTlas", pc.accel(d.tlas).handle())
-                .storageBuffer("Rays", pc.buffer(d.rays))
-                .storageBuffer("Classes", pc.buffer(d.classes))
-                .storageBuffer("Particles", pc.buffer(d.particles))
-                .storageBuffer("Constants", pc.buffer(d.constants))
-                .storageImage("particleImage", pc.view(d.out.radiance));
-            sampled(push, "depthTexture", d.depth);
-            sampled(push, "sslrRadianceTexture", d.sslrRadiance);
-            sampled(push, "sslrConfidenceTexture", d.sslrConfidence);
-            sampled(push, "sslrHitTexture", d.sslrHit);
-            sampled(push, "rtRadianceTexture", d.rtRadiance);
-            sampled(push, "rtHitDistanceTexture", d.rtHitDistance);
-            push.push(pc.gpu(), pc.cmd());
-            if (backend == RtBackend::RayQuery) {
-                const uint32_t group = shader::kParticleTraceGroupSize;
-                pc.dispatch(pipeline, (d.out.width + group - 1) / group, (d.out.height + group - 1) / group);
-            } else {
-                pipelines.sbt_->traceRays(pc.gpu(), pc.cmd(), d.out.width, d.out.height);
+            for (const List& list : d.lists) {
+                gpu::PushDescriptors push(pipeline);
+                push.accelerationStructure("particleTlas", pc.accel(d.tlas).handle())
+                    .storageBuffer("RayList", pc.buffer(list.rays))
+                    .storageBuffer("RayListArgs", pc.buffer(list.args))
+                    .storageBuffer("Classes", pc.buffer(d.classes))
+                    .storageBuffer("Particles", pc.buffer(d.particles))
+                    .storageBuffer("Constants", pc.buffer(d.constants))
+                    .storageImage("particleImage", pc.view(d.out.radiance));
+                for (const auto& [name, texture] : {std::pair{"depthTexture", d.depth},
+                                                    {"sslrRadianceTexture", d.sslrRadiance},
+                                                    {"sslrConfidenceTexture", d.sslrConfidence},
+                                                    {"sslrHitTexture", d.sslrHit},
+                                                    {"rtRadianceTexture", d.rtRadiance},
+                                                    {"rtHitDistanceTexture", d.rtHitDistance}}) {
+                    push.sampledImage(name, pc.view(texture), sampler, pc.layout(texture));
+                }
+                push.push(pc.gpu(), pc.cmd());
+                pipeline.pushConstants(pc.cmd(), shader::ParticleTracePush{list.name});
+                if (backend == RtBackend::RayQuery) {
+                    pc.dispatchIndirect(pipeline, list.args, kRayListDispatchArgsBytes);
+                } else {
+                    // {count, 1, 1}: one launch per entry, read by device address.
+                    const gpu::ShaderBindingTable& sbt = *pipelines.sbt_;
+                    pc.gpu().fn().cmdTraceRaysIndirect(pc.cmd(), &sbt.raygen(), &sbt.miss(), &sbt.hit(),
+                                                       &sbt.callable(),
+                                                       pc.buffer(list.args).address() + kRayListTraceArgsBytes);
+                }
             }
         });
     return trace.out;

@@ -14,9 +14,13 @@
 // chooseReflectionTrace), so it runs before integrate and particles behind
 // the reflected surface are not composited. (Reading integrate's hit
 // distance instead would put the trace after integrate, which composites
-// it.) One dispatch over every pixel rather than over the two ray lists:
-// ray generation's per-pixel rays buffer names every traced ray, SSLR's
-// and RT's alike, and the pass writes every pixel, so it needs no clear.
+// it.) The trace walks ray generation's two lists, one launch each: the
+// SSLR list's leaders, then the RT list's RT pixels (its hybrid entries,
+// SSLR's failures, were in the SSLR list), so it costs what the traced
+// rays cost: a launch over every pixel paid 0.030 ms at 1080p on the H200
+// for the invocations alone, whose pixels trace nothing. It writes the
+// leaders' texels only, as the traces do (integrate reads nothing else);
+// ParticleTraceSettings::clearUntraced zeroes the rest for the debug view.
 // Soft round particles: traversal offers every quad the ray crosses
 // (non-opaque geometry, nothing committed), the nearest
 // kParticleMaxHits that cover the hit point are kept in a sorted list and
@@ -51,7 +55,8 @@
 //     std::optional<passes::ParticleTraceOutputs> traced;
 //     if (passes::particlesTraced(bvh))            // no particles: no pass
 //         traced = passes::addParticleTracePass(graph, particles,
-//             {gbuf, rays, sslr, rt.radiance, rt.hitDistance, bvh, camera}, {.confidenceThreshold = ...});
+//             {gbuf, rays, sslr, rt.radiance, rt.hitDistance, rtList, rtArgs, bvh, camera},
+//             {.confidenceThreshold = ...});
 //     integrateInputs.particles = traced ? traced->radiance : rg::Texture{};
 //     ... integrate ...
 //     const auto lit = passes::addParticleForwardPass(graph, particles, {gbuf, scene.particles, camera});
@@ -63,6 +68,7 @@
 #include "glint/graph/graph.h"
 #include "glint/passes/bvh_update.h"
 #include "glint/passes/gbuffer.h"
+#include "glint/passes/image_clear.h"
 #include "glint/passes/ray_generation.h"
 #include "glint/passes/rt_trace.h"
 #include "glint/passes/sslr.h"
@@ -92,6 +98,12 @@ struct ParticleTraceInputs {
     std::optional<SslrOutputs> sslr;
     rg::Texture rtRadiance;
     rg::Texture rtHitDistance;
+    // The RT list and its args as the ray tracer walked them (after SSLR's
+    // appends: SslrOutputs::rtRayList, rtArgs); absent: rays.rtRays and
+    // rays.rtArgs. The trace walks the lists `rays` says are listed
+    // (RayGenerationOutputs::sslrListed, rtListed).
+    rg::Buffer rtRayList;
+    rg::Buffer rtArgs;
     BvhUpdateOutputs bvh;              // particleTlas (AccelRead), particles (StorageRead)
     scene::Camera camera;              // the G-buffer's; unjittered, as integrate reconstructs
     // A hybrid frame the host renders as rt (ReflectionRenderer's SSLR
@@ -124,11 +136,16 @@ struct ParticleTraceSettings {
     // Integrate's IntegrateSettings::rtMissesTrusted: the same choice of
     // trace, so the same reflection distance.
     bool rtMissesTrusted = true;
+    // Zero the output before the trace, so that texels it does not write
+    // (all but the traced rays' leaders) read as "no particles" (the debug
+    // view; integrate reads the leaders only and needs no clear).
+    bool clearUntraced = false;
 };
 
 struct ParticleTraceOutputs {
     // kParticleRadianceFormat: premultiplied particle radiance, a =
-    // coverage, at the ray leaders of traced pixels; 0 elsewhere.
+    // coverage, at the ray leaders of traced pixels; elsewhere as the
+    // memory held it (zero with clearUntraced).
     rg::Texture radiance;
     uint32_t width = 0;
     uint32_t height = 0;
@@ -179,10 +196,12 @@ private:
     std::optional<gpu::ShaderBindingTable> sbt_;
     gpu::Pipeline forward_;
     gpu::Sampler nearest_;
+    ImageClearer clearer_;
 };
 
 // Declares the particle trace (see the top of this file) on the graphics
-// queue: a small upload of its constants and the trace. Throws
+// queue: a small upload of its constants, the clear with clearUntraced,
+// and the trace. Throws
 // gpu::GpuError when inputs.bvh has no particle TLAS (check
 // particlesTraced) or the inputs' sizes differ.
 ParticleTraceOutputs addParticleTracePass(rg::Graph& graph, ParticlePipelines& pipelines,

@@ -91,6 +91,10 @@ RayGenerationOutputs addRayGenerationPass(rg::Graph& graph, RayGenerationPipelin
     out.height = gbuf.height;
     out.tilesX = (gbuf.width + shader::kTileSize - 1) / shader::kTileSize;
     out.tilesY = (gbuf.height + shader::kTileSize - 1) / shader::kTileSize;
+    // A frame the gate renders as rt classifies as rt (the flags below).
+    const ReflectionMode listedMode = inputs.screenSpaceIdle ? ReflectionMode::Rt : inputs.mode;
+    out.sslrListed = listedMode != ReflectionMode::Rt;
+    out.rtListed = listedMode != ReflectionMode::Ssr;
     const uint64_t pixels = uint64_t(gbuf.width) * gbuf.height;
 
     // The lists count up from zero every frame, and a dispatch's (or a
@@ -130,7 +134,7 @@ RayGenerationOutputs addRayGenerationPass(rg::Graph& graph, RayGenerationPipelin
     constants.rtMaxDistance = settings.rtMaxDistance;
     constants.sslrMinDistance = inputs.sslrMinDistance;
     const bool idle = inputs.screenSpaceIdle;
-    constants.flags = uint32_t(idle ? ReflectionMode::Rt : inputs.mode) | (settings.reuse ? shader::kRayGenReuse : 0u) |
+    constants.flags = uint32_t(listedMode) | (settings.reuse ? shader::kRayGenReuse : 0u) |
                       (inputs.tileModes.valid() && !idle ? shader::kRayGenTileModes : 0u) |
                       (settings.checkerboard ? shader::kRayGenCheckerboard : 0u) |
                       (settings.blueNoise ? shader::kRayGenBlueNoise : 0u) |

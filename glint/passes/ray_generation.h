@@ -138,6 +138,12 @@ struct RayGenerationOutputs {
     rg::Buffer rtRays;        // RT ray list: shader::PackedRay per RT ray leader (capacity: one per pixel)
     rg::Buffer rtArgs;        // shader::kRayListArgsWords: dispatch at kRayListDispatchArgsBytes, trace at kRayListTraceArgsBytes
     rg::Texture classDebug;   // kRayClassDebugFormat: a colour per class (debug view "ray_classes")
+    // Whether each list can hold entries this frame: ssr mode lists nothing
+    // for RT (SSLR's failures take the environment), rt mode and a frame
+    // the gate renders as rt nothing for SSLR. A pass that walks a list
+    // that cannot would pay an empty launch.
+    bool sslrListed = true;
+    bool rtListed = true;
     // Whether the rays were drawn from the blue noise, and its buffer
     // (owned by RayGenerationPipelines, uploaded once when they were
     // created and never written again, so no pass needs to order itself

@@ -275,6 +275,8 @@ ReflectionFrame ReflectionRenderer::addFrame(rg::Graph& graph, const scene::Came
         if (f.rt) {
             particleInputs.rtRadiance = f.rt->radiance;
             particleInputs.rtHitDistance = f.rt->hitDistance;
+            particleInputs.rtRayList = rtList;
+            particleInputs.rtArgs = rtArgs;
         }
         particleInputs.bvh = *f.bvh;
         particleInputs.camera = camera;
@@ -286,6 +288,7 @@ ReflectionFrame ReflectionRenderer::addFrame(rg::Graph& graph, const scene::Came
         particleSettings.maxDistance = settings.reach;
         particleSettings.sslrSeesParticles = settings.sslrParticles && f.sslr.has_value();
         particleSettings.rtMissesTrusted = !sslrFallback;
+        particleSettings.clearUntraced = view == "particles";
         f.particles = addParticleTracePass(graph, particles_, particleInputs, particleSettings);
     }
     // 5. Integrate.

@@ -1,6 +1,6 @@
 #version 460
 // The particle trace (passes/particles.h), ray query backend: one
-// invocation per pixel. The particle quads are not opaque, so every quad on
+// invocation per ray list entry. The particle quads are not opaque, so every quad on
 // the segment comes back as a candidate; none is committed (the nearest
 // hits are kept in the invocation's list instead). Everything else is
 // glint/particles_trace.glsl, shared with the ray tracing pipeline backend.
@@ -9,7 +9,7 @@
 
 #include "glint/particles_trace.glsl"
 
-layout(local_size_x = kParticleTraceGroupSize, local_size_y = kParticleTraceGroupSize) in;
+layout(local_size_x = kRayListGroupSize) in;
 
 ParticleHits particleTraceSegment(vec3 origin, vec3 direction, float tMax, uint cullMask) {
     ParticleHits hits;
@@ -26,5 +26,5 @@ ParticleHits particleTraceSegment(vec3 origin, vec3 direction, float tMax, uint 
 }
 
 void main() {
-    particleTracePixel(gl_GlobalInvocationID.xy);
+    particleTraceSlot(gl_GlobalInvocationID.x);
 }

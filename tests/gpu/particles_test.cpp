@@ -280,10 +280,16 @@ public:
                 in.rtRadiance = rt->radiance;
                 in.rtHitDistance = rt->hitDistance;
             }
+            if (sslr) {
+                in.rtRayList = sslr->rtRayList;
+                in.rtArgs = sslr->rtArgs;
+            }
             in.bvh = bvh;
             in.camera = camera_;
             passes::ParticleTraceSettings settings;
             settings.backend = backend;
+            // The whole image is compared: texels no leader writes read 0.
+            settings.clearUntraced = true;
             settings.sslrSeesParticles = sslrParticles && sslr.has_value();
             particleRadiance = passes::addParticleTracePass(graph, particles_, in, settings).radiance;
             reads.push_back({particleRadiance, &f.particles});

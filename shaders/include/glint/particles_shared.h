@@ -37,7 +37,6 @@ struct ParticleData {
 };
 
 GLINT_CONST uint kParticleBillboardGroupSize = 64u;
-GLINT_CONST uint kParticleTraceGroupSize = 8u;  // 8x8 pixels per workgroup (ray query backend)
 GLINT_CONST uint kParticleQuadVertices = 6u;    // two unindexed triangles per quad
 
 // The quads of a particle in the particle BLASes: one per view-space axis,
@@ -142,12 +141,24 @@ struct ParticleTraceConstants {
     vec4 boundsMax;
 };
 
+// Push constants of the particle trace: which ray list a launch walks
+// (kParticleList*). The trace runs once over each list the frame has
+// (ray query: kRayListGroupSize invocations per group, as the lists'
+// dispatch args count them); the RT list's hybrid entries are SSLR's
+// failures, whose leaders the SSLR list's launch traced already.
+GLINT_CONST uint kParticleListSslr = 0u;
+GLINT_CONST uint kParticleListRt = 1u;
+struct ParticleTracePush {
+    uint list;
+};
+
 GLINT_END
 
 #ifdef __cplusplus
 static_assert(sizeof(glint::shader::ParticleData) == 32);
 static_assert(sizeof(glint::shader::ParticleBillboardParams) == 48);
 static_assert(sizeof(glint::shader::ParticleTraceConstants) == 192);
+static_assert(sizeof(glint::shader::ParticleTracePush) == 4);
 #endif
 
 #endif

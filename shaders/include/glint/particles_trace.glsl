@@ -6,13 +6,17 @@
 // kParticleMaxHits covering ones in a sorted list, and the list is
 // composited front to back here.
 //
-// Per pixel, ray leaders of traced pixels only (a follower's reflection
-// takes its leader's particles in integrate, as it takes its traces): the
-// ray leaves the G-buffer surface along ray generation's direction and
-// ends where the pixel's reflection ends: the hit distance of the trace
-// integrate takes (glint/integrate_shared.h's chooseReflectionTrace over
-// the same SSLR and RT outputs), so particles behind the reflected surface
-// are not composited. Misses end at maxDistance.
+// One invocation per entry of ray generation's lists, i.e. per ray leader
+// of a traced pixel (a follower's reflection takes its leader's particles
+// in integrate, as it takes its traces): the SSLR list's leaders, then the
+// RT list's RT pixels (its hybrid entries are SSLR's failures, traced with
+// the SSLR list). The ray leaves the G-buffer surface along ray
+// generation's direction and ends where the pixel's reflection ends: the
+// hit distance of the trace integrate takes
+// (glint/integrate_shared.h's chooseReflectionTrace over the same SSLR and
+// RT outputs), so particles behind the reflected surface are not
+// composited. Misses end at maxDistance. Only the leaders' texels are
+// written.
 #ifndef GLINT_PARTICLES_TRACE_GLSL
 #define GLINT_PARTICLES_TRACE_GLSL
 
@@ -25,7 +29,7 @@
 // Bindings (passes/particles.cpp pushes the same).
 layout(set = 0, binding = 0) uniform accelerationStructureEXT particleTlas;
 layout(set = 0, binding = 1) uniform sampler2D depthTexture;
-layout(set = 0, binding = 2, scalar) readonly buffer Rays { PackedRay rays[]; };
+layout(set = 0, binding = 2, scalar) readonly buffer RayList { PackedRay rayList[]; };
 layout(set = 0, binding = 3, scalar) readonly buffer Classes { uint classes[]; };
 layout(set = 0, binding = 4, scalar) readonly buffer Particles { ParticleData particles[]; };
 layout(set = 0, binding = 5, scalar) readonly buffer Constants { ParticleTraceConstants C; };
@@ -35,6 +39,9 @@ layout(set = 0, binding = 8) uniform sampler2D sslrHitTexture;
 layout(set = 0, binding = 9) uniform sampler2D rtRadianceTexture;
 layout(set = 0, binding = 10) uniform sampler2D rtHitDistanceTexture;
 layout(set = 0, binding = 11, rgba16f) uniform writeonly image2D particleImage;
+// The walked list's args (glint/ray_generation_shared.h): its length.
+layout(set = 0, binding = 12, scalar) readonly buffer RayListArgs { uint rayListArgs[]; };
+layout(push_constant, scalar) uniform Push { ParticleTracePush pushed; };
 
 // The nearest covering particle hits of one ray, sorted by (t, particle).
 struct ParticleHits {
@@ -196,38 +203,40 @@ vec4 particleComposite(ParticleHits h, vec3 origin, vec3 direction) {
     return sum;
 }
 
-// Traces pixel `pixel` (when it is a traced ray's leader) and writes its
-// particles; every pixel of the image is written (0 where nothing traced).
-void particleTracePixel(uvec2 pixel) {
+// Traces the ray of list slot `slot` (a traced pixel's leader) and writes
+// its pixel's particles (0 where it finds none).
+void particleTraceSlot(uint slot) {
+    if (slot >= rayListArgs[kRayListCountOffset]) {
+        return;  // the ray query backend's last group
+    }
+    const PackedRay ray = rayList[slot];
+    const uvec2 pixel = unpackRayPixel(ray.pixelFlags);
     if (pixel.x >= C.size.x || pixel.y >= C.size.y) {
         return;
     }
     const ivec2 p = ivec2(pixel);
-    const uint index = pixel.y * C.size.x + pixel.x;
-    const uint pixelClass = classes[index];
-    const PackedRay ray = rays[index];
+    const uint pixelClass = classes[pixel.y * C.size.x + pixel.x];
+    if (pushed.list == kParticleListRt && pixelClass == kPixelHybrid) {
+        return;  // SSLR's failure, traced from the SSLR list
+    }
     vec4 result = vec4(0.0);
-    const bool traced = pixelClass == kPixelSslr || pixelClass == kPixelHybrid || pixelClass == kPixelRt;
-    if (traced && ray.pixelFlags != kNoRay && (ray.pixelFlags & kRayReused) == 0u) {
-        const float depth = texelFetch(depthTexture, p, 0).x;
-        if (depth > 0.0) {
-            const vec3 position = particleWorldPosition(vec2(pixel) + 0.5, depth);
-            const vec3 direction = unpackRayDirection(ray.direction);
-            // A ray whose longest segment misses the particles' box has
-            // nothing to find: it skips the reads that find where its
-            // reflection ends (on the H200 at 1080p they were most of
-            // this pass's time on the plaza, the trace itself a tenth).
-            if (particleFinite(position) && particleSegmentMeetsBounds(position, direction, C.maxDistance)) {
-                uint trace;
-                const float tMax = min(particleReflectionDistance(p, pixelClass, position, trace), C.maxDistance);
-                // What SSLR resolved already shows the particles it saw in
-                // the lit colour: each particle reaches a pixel by one road.
-                const bool seenBySslr = C.sslrSeesParticles != 0u && trace == kTraceSslr;
-                if (!seenBySslr && tMax > 0.0 && particleSegmentMeetsBounds(position, direction, tMax)) {
-                    const ParticleHits hits =
-                        particleTraceSegment(position, direction, tMax, particleCullMask(direction));
-                    result = particleComposite(hits, position, direction);
-                }
+    const float depth = texelFetch(depthTexture, p, 0).x;
+    if (depth > 0.0) {
+        const vec3 position = particleWorldPosition(vec2(pixel) + 0.5, depth);
+        const vec3 direction = unpackRayDirection(ray.direction);
+        // A ray whose longest segment misses the particles' box has
+        // nothing to find: it skips the reads that find where its
+        // reflection ends (on the H200 at 1080p they were most of this
+        // pass's time on the plaza, the trace itself a tenth).
+        if (particleFinite(position) && particleSegmentMeetsBounds(position, direction, C.maxDistance)) {
+            uint trace;
+            const float tMax = min(particleReflectionDistance(p, pixelClass, position, trace), C.maxDistance);
+            // What SSLR resolved already shows the particles it saw in
+            // the lit colour: each particle reaches a pixel by one road.
+            const bool seenBySslr = C.sslrSeesParticles != 0u && trace == kTraceSslr;
+            if (!seenBySslr && tMax > 0.0 && particleSegmentMeetsBounds(position, direction, tMax)) {
+                const ParticleHits hits = particleTraceSegment(position, direction, tMax, particleCullMask(direction));
+                result = particleComposite(hits, position, direction);
             }
         }
     }
