@@ -174,7 +174,7 @@ TemporalOutputs addTemporalPass(rg::Graph& graph, TemporalPipelines& pipelines, 
 
     struct SpatialData {
         rg::Buffer frame;
-        rg::Texture depth, normal, roughnessMetal, accumulated;
+        rg::Texture depth, surface, accumulated;
         rg::Texture resolved;
     };
     const SpatialData& spatial = graph.addPass<SpatialData>(
@@ -182,8 +182,7 @@ TemporalOutputs addTemporalPass(rg::Graph& graph, TemporalPipelines& pipelines, 
         [&](rg::Builder& b, SpatialData& d) {
             d.frame = b.read(accumulate.frame, rg::Access::SampledRead);
             d.depth = b.read(gbuf.depth, rg::Access::SampledRead);
-            d.normal = b.read(gbuf.normal, rg::Access::SampledRead);
-            d.roughnessMetal = b.read(gbuf.roughnessMetal, rg::Access::SampledRead);
+            d.surface = b.read(accumulate.surfaceOut, rg::Access::SampledRead);
             d.accumulated = b.read(accumulate.radianceOut, rg::Access::SampledRead);
             d.resolved = b.write(b.createTexture("temporal.resolved", desc(kTemporalResolvedFormat)),
                                  rg::Access::StorageWrite);
@@ -195,8 +194,7 @@ TemporalOutputs addTemporalPass(rg::Graph& graph, TemporalPipelines& pipelines, 
             gpu::PushDescriptors(pipeline)
                 .uniformBuffer("Frame", pc.buffer(d.frame))
                 .sampledImage("depthTexture", pc.view(d.depth), sampler, pc.layout(d.depth))
-                .sampledImage("normalTexture", pc.view(d.normal), sampler, pc.layout(d.normal))
-                .sampledImage("roughnessMetalTexture", pc.view(d.roughnessMetal), sampler, pc.layout(d.roughnessMetal))
+                .sampledImage("surfaceTexture", pc.view(d.surface), sampler, pc.layout(d.surface))
                 .sampledImage("accumulatedTexture", pc.view(d.accumulated), sampler, pc.layout(d.accumulated))
                 .storageImage("resolvedImage", pc.view(d.resolved))
                 .push(pipelines.ctx_, pc.cmd());

@@ -11,21 +11,31 @@
 #extension GL_GOOGLE_include_directive : require
 #extension GL_EXT_scalar_block_layout : require
 
+#include "glint/packing.h"
 #include "glint/temporal_shared.h"
 #include "temporal_common.glsl"
 
 layout(local_size_x = 8, local_size_y = 8) in;
 
 layout(set = 0, binding = 1) uniform sampler2D depthTexture;
-layout(set = 0, binding = 2) uniform sampler2D normalTexture;
-layout(set = 0, binding = 3) uniform sampler2D roughnessMetalTexture;
-layout(set = 0, binding = 4) uniform sampler2D accumulatedTexture;
-layout(set = 0, binding = 5, rgba16f) uniform writeonly image2D resolvedImage;
+// This frame's surface as the accumulation wrote it (temporal.surface:
+// view depth, roughness, octahedral normal): one read a tap instead of
+// the G-buffer's three.
+layout(set = 0, binding = 2) uniform sampler2D surfaceTexture;
+layout(set = 0, binding = 3) uniform sampler2D accumulatedTexture;
+layout(set = 0, binding = 4, rgba16f) uniform writeonly image2D resolvedImage;
 
 float ramp(float x, float start, float end) {
     if (x <= start) return 0.0;
     if (x >= end) return 1.0;
     return smoothstep(start, end, x);
+}
+
+// E at a pixel position: the world step along its view ray per unit of
+// view depth (from the point at any depth on it).
+vec3 stepPerViewDepth(vec2 pixelPosition, float depth) {
+    const vec3 point = worldPosition(frame.inverseViewProjection, pixelPosition, vec2(frame.size), depth);
+    return (point - frame.cameraPosition.xyz) / viewDepth(frame.viewProjection, point);
 }
 
 void main() {
@@ -39,7 +49,8 @@ void main() {
         imageStore(resolvedImage, p, vec4(0.0));
         return;
     }
-    const float roughness = texelFetch(roughnessMetalTexture, p, 0).r;
+    const vec4 surface = texelFetch(surfaceTexture, p, 0);
+    const float roughness = surface.y;
     const float strength = ramp(roughness, frame.spatialRoughnessStart, frame.spatialRoughnessEnd);
     const int radius = int(min(frame.spatialRadius, kTemporalMaxSpatialRadius));
     if (radius == 0 || strength <= 0.0 || roughness > frame.spatialRoughnessMax) {
@@ -47,19 +58,20 @@ void main() {
         return;
     }
     const vec2 size = vec2(frame.size);
-    const vec3 position = worldPosition(frame.inverseViewProjection, vec2(p) + 0.5, size,
-                                        texelFetch(depthTexture, p, 0).x);
-    const vec3 normal = normalize(texelFetch(normalTexture, p, 0).xyz);
+    const vec3 normal = octDecode(clamp(surface.zw, vec2(-1.0), vec2(1.0)));
+    // A tap's distance to this pixel's plane from its view depth alone:
+    // the point at view depth w on pixel q's ray is camera + w E(q), where
+    // E(q), the step along the ray per unit of view depth, is affine in q
+    // (a pinhole camera, jittered or not). So with e(q) = E(q) . normal,
+    // affine too, the distance is |w_q e(q) - w e(p)|: a few FMAs a tap
+    // instead of a position reconstructed from depth.
+    const float depth = texelFetch(depthTexture, p, 0).x;
+    const vec3 position = worldPosition(frame.inverseViewProjection, vec2(p) + 0.5, size, depth);
     const float w = viewDepth(frame.viewProjection, position);
-    // A tap's distance to this pixel's plane without its world position:
-    // with h = M (ndc, depth, 1) (M the inverse view-projection) the tap
-    // lies at h.xyz / h.w, so its signed distance to the plane
-    // (normal, -normal . position) is dot(M^T plane, v) / dot(M's last row,
-    // v) for v = (ndc, depth, 1): two dot products a tap instead of a
-    // matrix product and a division of a vector.
-    const mat4 m = frame.inverseViewProjection;
-    const vec4 planeInClip = vec4(normal, -dot(normal, position)) * m;
-    const vec4 homogeneousW = vec4(m[0][3], m[1][3], m[2][3], m[3][3]);
+    const float e = dot(stepPerViewDepth(vec2(p) + 0.5, depth), normal);
+    const float eX = dot(stepPerViewDepth(vec2(p) + vec2(1.5, 0.5), depth), normal) - e;
+    const float eY = dot(stepPerViewDepth(vec2(p) + vec2(0.5, 1.5), depth), normal) - e;
+    const float we = w * e;
     // Sigma of half the radius (plus half a pixel) keeps the window's
     // corners near zero weight.
     const float sigma = 0.5 * float(radius) + 0.5;
@@ -69,7 +81,6 @@ void main() {
     const float gaussianScale = kLog2e / (2.0 * sigma * sigma);
     const float planeScale = kLog2e / max(frame.spatialPlaneSigma * w, 1e-6);
     const float roughnessScale = kLog2e / max(frame.spatialRoughnessSigma, 1e-6);
-    const vec2 ndcPerPixel = 2.0 / size;
     vec3 sum = centre.rgb;
     float weightSum = 1.0;
     for (int dy = -radius; dy <= radius; ++dy) {
@@ -79,16 +90,14 @@ void main() {
                 continue;
             }
             const vec4 tap = texelFetch(accumulatedTexture, q, 0);
-            const float depth = texelFetch(depthTexture, q, 0).x;
-            const vec3 tapNormal = texelFetch(normalTexture, q, 0).xyz;
-            const float tapRoughness = texelFetch(roughnessMetalTexture, q, 0).r;
-            const float facing = dot(tapNormal, normal);
-            if (!(tap.a > 0.0) || !(depth > 0.0) || !(facing > 0.0)) continue;
-            const vec4 v = vec4((vec2(q) + 0.5) * ndcPerPixel - 1.0, depth, 1.0);
-            const float distance = abs(dot(planeInClip, v) / dot(homogeneousW, v));
+            const vec4 tapSurface = texelFetch(surfaceTexture, q, 0);
+            if (!(tap.a > 0.0) || !(tapSurface.x > 0.0)) continue;
+            const float facing = dot(octDecode(clamp(tapSurface.zw, vec2(-1.0), vec2(1.0))), normal);
+            if (!(facing > 0.0)) continue;
+            const float distance = abs(tapSurface.x * (e + float(dx) * eX + float(dy) * eY) - we);
             const float exponent = frame.spatialNormalPower * log2(facing) -
                                    (float(dx * dx + dy * dy) * gaussianScale + distance * planeScale +
-                                    abs(tapRoughness - roughness) * roughnessScale);
+                                    abs(tapSurface.y - roughness) * roughnessScale);
             const float weight = exp2(exponent);
             if (weight > 0.0 && isFinite(tap.rgb)) {
                 sum += weight * tap.rgb;

@@ -207,7 +207,9 @@ TEST_CASE("the spatial filter blurs along a slanted wall and not across a depth 
                                      {material(0.5f, 1.0f)});
     const std::vector<FrameOutput> blurred = runTemporal(slanted, noisy);
     MESSAGE("rms: input " << single << ", slanted " << rmsError(blurred[0].resolved));
-    CHECK(rmsError(blurred[0].resolved) < 0.4f * single);
+    // As the facing wall (0.23 of the input's): a plane distance off by a
+    // pixel's depth step weighs the taps across the slope down (0.36).
+    CHECK(rmsError(blurred[0].resolved) < 0.3f * single);
 
     // Left of the image's centre column the wall at kWallDistance, right of
     // it one a unit behind; each reflects a flat radiance of its own.
