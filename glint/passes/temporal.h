@@ -13,7 +13,9 @@
 //                        to the 3x3 neighbourhood's variance in YCoCg, and
 //                        accumulate with weight 1 / history length;
 //   temporal.spatial     an edge-aware blur of the accumulation for rough
-//                        surfaces, into the resolved image only.
+//                        surfaces, into the resolved image only; its taps
+//                        read the surface the accumulation wrote this frame
+//                        (view depth, roughness, normal in one texel).
 // History lives in two graph history textures (glint/temporal_shared.h);
 // the executor ping-pongs them, so two frames in flight are safe. The first
 // frame finds them cleared (length 0: no history); resetHistory discards

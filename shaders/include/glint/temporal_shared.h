@@ -12,7 +12,9 @@
 //   temporal.surface   RGBA16F; x: view depth (clip w) of the pixel's surface,
 //                      y: perceptual roughness, zw: octahedral world normal
 //                      (glint/packing.h's octEncode, unquantised); x = 0
-//                      where nothing reflects
+//                      where nothing reflects. The accumulation writes it
+//                      for the next frame's rejection tests; the spatial
+//                      filter reads this frame's for its taps.
 #ifndef GLINT_TEMPORAL_SHARED_H
 #define GLINT_TEMPORAL_SHARED_H
 
