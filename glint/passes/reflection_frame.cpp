@@ -327,6 +327,7 @@ ReflectionFrame ReflectionRenderer::addFrame(rg::Graph& graph, const scene::Came
     temporalInputs.sharedRayRoughness = settings.rays.checkerboard ? 0.0f
                                         : settings.rays.reuse      ? settings.rays.reuseRoughness
                                                                    : 2.0f;
+    temporalInputs.environmentRoughness = settings.rays.roughnessCutoff;
     temporalInputs.camera = camera;
     temporalInputs.frameIndex = frameIndex;
     temporalInputs.resetHistory = settings.resetHistory;

@@ -65,6 +65,7 @@ shader::TemporalFrame frameConstants(const TemporalInputs& in, const TemporalSet
     f.hitMotionBound = in.hitMotion.valid() ? 1u : 0u;
     f.clampRadius = s.clampRadius;
     f.sharedRayRoughness = in.sharedRayRoughness;
+    f.environmentRoughness = in.environmentRoughness;
     return f;
 }
 

@@ -71,6 +71,17 @@ struct TemporalInputs {
     // 0 with its checkerboard; above 1: nowhere): there the clip box spans
     // TemporalSettings::clampRadius.
     float sharedRayRoughness = 2.0f;
+    // Perceptual roughness above which a pixel reflects the environment
+    // map alone (ray generation's RayGenerationSettings::roughnessCutoff;
+    // above 1: nowhere). Such a pixel traces no ray: its radiance has no
+    // noise and follows its normal smoothly. Its history is taken wherever
+    // last frame's holds a finite one, without the surface tests (which
+    // rejected it at every edge the jitter moves across, leaving those
+    // pixels unaccumulated, i.e. aliased: on the plaza at 1080p FLIP 0.0617
+    // -> 0.0603 in hybrid, in motion 0.2900 -> 0.2868, docs/results.md),
+    // and its clip box is 3x3 (it shares no rays), which is what bounds a
+    // disocclusion's ghost there.
+    float environmentRoughness = 2.0f;
 };
 
 struct TemporalSettings {
@@ -99,7 +110,8 @@ struct TemporalSettings {
     // History rejection: a history texel counts only if last frame's
     // surface there lies within planeTolerance x view depth of this pixel's
     // tangent plane, its normal within acos(normalTolerance) and its
-    // roughness within roughnessTolerance. Glint's starting values: 2%
+    // roughness within roughnessTolerance (at pixels that trace rays:
+    // TemporalInputs::environmentRoughness). Glint's starting values: 2%
     // passes 16-bit depth and motion rounding at every distance and rejects
     // any object a visible distance in front.
     float planeTolerance = 0.02f;

@@ -14,7 +14,9 @@
 //      motions blend by roughness;
 //   3. history at each candidate, bilinear over four taps, each tap kept
 //      only if last frame's surface there lies on this pixel's plane with a
-//      similar normal and roughness (disocclusion and history rejection);
+//      similar normal and roughness (disocclusion and history rejection;
+//      not where the pixel reflects the environment alone, whose radiance
+//      has no noise and follows the normal: the clip box bounds its ghost);
 //   4. variance clipping of the history in YCoCg over the (2 r + 1)^2
 //      neighbourhood (r = clampRadius where quads share rays, else 1: 3x3)
 //      (Salvi, "An Excursion in Temporal Supersampling", GDC 2016; YCoCg,
@@ -96,12 +98,14 @@ struct Pixel {
     vec3 normal;
     float roughness;
     float w;
+    bool environment;  // rougher than frame.environmentRoughness: the environment map alone
 };
 
 // One history texel, or false where last frame saw another surface there:
 // off the plane (by more than planeTolerance of the view depth: a
 // disocclusion, or an object that moved across depth), turned away, of
-// another roughness, or holding nothing usable.
+// another roughness, or holding nothing usable. An environment pixel skips
+// the surface tests (passes/temporal.h, TemporalInputs::environmentRoughness).
 bool historyTap(ivec2 texel, Pixel px, out vec4 radiance) {
     radiance = vec4(0.0);
     if (any(lessThan(texel, ivec2(0))) || any(greaterThanEqual(texel, ivec2(frame.size)))) {
@@ -111,6 +115,9 @@ bool historyTap(ivec2 texel, Pixel px, out vec4 radiance) {
     radiance = texelFetch(previousRadianceTexture, texel, 0);
     if (!(surface.x > 0.0) || !(radiance.a >= 1.0) || !isFinite(radiance.rgb) || !isFinite(surface.yzw)) {
         return false;
+    }
+    if (px.environment) {
+        return true;
     }
     const vec3 q = previousPosition(texel, surface.x);
     if (!(abs(dot(q - px.position, px.normal)) <= frame.planeTolerance * px.w)) {
@@ -227,6 +234,7 @@ void main() {
     px.normal = normalize(normalSample.xyz);
     px.roughness = roughness;
     px.w = viewDepth(frame.viewProjection, px.position);
+    px.environment = px.roughness > frame.environmentRoughness;
 
     // 1. This frame's radiance and its neighbourhood's statistics.
     vec3 current;
@@ -235,8 +243,9 @@ void main() {
     vec3 sumSquares = vec3(0.0);
     float count = 0.0;
     // The wide box only where neighbouring pixels share rays; 3x3 where
-    // each has its own.
-    const uint radius = px.roughness >= frame.sharedRayRoughness ? frame.clampRadius : min(frame.clampRadius, 1u);
+    // each has its own, and where none is traced (the environment).
+    const bool sharedRays = px.roughness >= frame.sharedRayRoughness && !px.environment;
+    const uint radius = sharedRays ? frame.clampRadius : min(frame.clampRadius, 1u);
     const int r = int(min(radius, kTemporalMaxClampRadius));
     const ivec2 local = ivec2(gl_LocalInvocationID.xy) + int(kTemporalMaxClampRadius);
     for (int dy = -r; dy <= r; ++dy) {

@@ -47,6 +47,9 @@ struct FrameInput {
     bool reset = false;
     // TemporalInputs::sharedRayRoughness (above 1: no pixel shares rays).
     float sharedRayRoughness = 2.0f;
+    // TemporalInputs::environmentRoughness (above 1: no pixel takes the
+    // environment alone).
+    float environmentRoughness = 2.0f;
     // Called before the frame's G-buffer is declared (moves objects).
     std::function<void(scene::Scene&)> update;
 };
@@ -81,6 +84,7 @@ std::vector<FrameOutput> runTemporal(scene::Scene& scene, const std::vector<Fram
             uploadTexture(graph, resources, staging, "test.hit", VK_FORMAT_R32_SFLOAT, in.hitDistance.data());
         passes::TemporalInputs inputs{gbuf, radiance, hit, in.camera, uint64_t(f), in.reset};
         inputs.sharedRayRoughness = in.sharedRayRoughness;
+        inputs.environmentRoughness = in.environmentRoughness;
         const passes::TemporalOutputs out = passes::addTemporalPass(graph, pipelines, inputs, settings);
         REQUIRE(out.width == kSize);
         readbacks.push_back({&readTexture(graph, resources, staging, out.resolved, passes::kTemporalResolvedFormat,
@@ -455,14 +459,18 @@ TEST_CASE("a reset discards the history; without it the history lingers") {
     }
 }
 
-TEST_CASE("the clip box spans 5x5 where rays are shared, 3x3 where each pixel has its own") {
+TEST_CASE("the clip box spans 5x5 where rays are shared, 3x3 where each pixel has its own or none") {
     // A history of 0.5; then a frame of 0.1 in the 3x3 around the centre
     // and 0.9 beyond. The 3x3 box holds only 0.1: the history is clipped to
     // it. The 5x5 box also holds sixteen 0.9s, wide enough for 0.5 to
-    // stand: the new frame takes half (two frames of history).
+    // stand: the new frame takes half (two frames of history). A pixel
+    // that takes the environment alone shares no rays, whatever its
+    // roughness: 3x3.
     constexpr uint32_t kCentre = 32;
     for (const bool shared : {false, true}) {
+      for (const bool environment : {false, true}) {
         CAPTURE(shared);
+        CAPTURE(environment);
         scene::Scene scene = wallScene(material(0.05f, 1.0f));
         std::vector<FrameInput> frames(2);
         std::fill(frames[0].radiance.begin(), frames[0].radiance.end(), glm::vec4(0.5f, 0.5f, 0.5f, 1.0f));
@@ -473,16 +481,53 @@ TEST_CASE("the clip box spans 5x5 where rays are shared, 3x3 where each pixel ha
                 frames[1].radiance[at(x, y)] = glm::vec4(v, v, v, 1.0f);
             }
         }
-        for (FrameInput& f : frames) f.sharedRayRoughness = shared ? 0.0f : 2.0f;
+        for (FrameInput& f : frames) {
+            f.sharedRayRoughness = shared ? 0.0f : 2.0f;
+            f.environmentRoughness = environment ? 0.01f : 2.0f;
+        }
         passes::TemporalSettings settings;
         settings.clampRadius = 2;
         const std::vector<FrameOutput> out = runTemporal(scene, frames, settings);
         const float v = out.back().resolved[at(kCentre, kCentre)].g;
         CHECK(out.back().length[at(kCentre, kCentre)] == 2.0f);
-        if (shared) {
+        if (shared && !environment) {
             CHECK(v == doctest::Approx(0.3f).epsilon(0.01));
         } else {
             CHECK(v == doctest::Approx(0.1f).epsilon(0.01));
+        }
+      }
+    }
+}
+
+TEST_CASE("a pixel that takes the environment alone keeps its history where the surface tests reject it") {
+    // A rough wall that steps a unit back after two frames: every pixel
+    // fails the plane test (1 unit against 2% of 5). Where the wall traces
+    // rays its history starts over; where it takes the environment alone
+    // (noise-free, following its normal) the history stays, and the frame,
+    // the same radiance, changes nothing.
+    const glm::vec4 radiance(0.2f, 0.4f, 0.6f, 1.0f);
+    for (const bool environment : {false, true}) {
+        CAPTURE(environment);
+        scene::Scene scene = wallScene(material(0.5f, 1.0f));
+        std::vector<FrameInput> frames(3);
+        for (FrameInput& f : frames) {
+            std::fill(f.radiance.begin(), f.radiance.end(), radiance);
+            f.environmentRoughness = environment ? 0.4f : 2.0f;
+        }
+        const glm::mat4 back = glm::translate(glm::mat4(1.0f), glm::vec3(0.0f, 0.0f, -1.0f));
+        frames[2].update = [back](scene::Scene& s) {
+            s.instances[0].previousTransform = s.instances[0].transform;
+            s.instances[0].transform = back;
+        };
+        const std::vector<FrameOutput> out = runTemporal(scene, frames);
+        // (Near the image's edge last frame saw these points off screen.)
+        for (const uint32_t y : {12u, 32u, 52u}) {
+            for (const uint32_t x : {12u, 32u, 52u}) {
+                INFO("pixel " << x << ", " << y);
+                CHECK(out[1].length[at(x, y)] == 2.0f);
+                CHECK(out[2].length[at(x, y)] == (environment ? 3.0f : 1.0f));
+                CHECK(glm::length(glm::vec3(out[2].resolved[at(x, y)] - radiance)) < 2e-3f);
+            }
         }
     }
 }

@@ -60,7 +60,7 @@ struct TemporalFrame {
     uint hitMotionBound;                 // 1: the reflected points' own motion is bound
     uint clampRadius;                    // the clip box's neighbourhood where rays are shared: (2 r + 1)^2 pixels
     float sharedRayRoughness;            // from this roughness on, quads share rays (above 1: nowhere)
-    uint pad1;
+    float environmentRoughness;          // above this roughness the environment alone (above 1: nowhere)
     uint pad2;
 };
 
