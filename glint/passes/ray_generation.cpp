@@ -9,6 +9,7 @@
 #include "glint/sslr_shared.h"
 #include "glint/sampling/blue_noise.h"
 
+#include <algorithm>
 #include <array>
 #include <cstring>
 
@@ -116,8 +117,9 @@ RayGenerationOutputs addRayGenerationPass(rg::Graph& graph, RayGenerationPipelin
             // SSLR's pyramid passes: their groups, closed (z = 0) until a
             // ray that cone-traces is listed.
             const glm::uvec2 base = shader::sslrPyramidGroups(size, 0), down = shader::sslrPyramidGroups(size, 1);
-            const std::array<uint32_t, shader::kSslrArgsWords> sslr = {0, 1, 1, 0, 1, 1, base.x, base.y, 0,
-                                                                       down.x, down.y, 0};
+            std::array<uint32_t, shader::kSslrArgsWords> sslr{0, 1, 1, 0, 1, 1};
+            const std::array<uint32_t, 6> pyramid = {base.x, base.y, 0, down.x, down.y, 0};
+            std::copy(pyramid.begin(), pyramid.end(), sslr.begin() + shader::kSslrArgsPyramidOffset);
             vkCmdUpdateBuffer(pc.cmd(), pc.buffer(d.sslrArgs).handle(), 0, sizeof(sslr), sslr.data());
             vkCmdUpdateBuffer(pc.cmd(), pc.buffer(d.rtArgs).handle(), 0, sizeof(initial), initial.data());
         });
