@@ -181,17 +181,16 @@ ParticleTraceOutputs addParticleTracePass(rg::Graph& graph, ParticlePipelines& p
         struct ClearData {
             rg::Texture radiance;
         };
-        radiance = graph
-                       .addPass<ClearData>(
-                           "particles.clear", rg::Queue::Graphics,
-                           [&](rg::Builder& b, ClearData& d) { d.radiance = b.write(radiance, rg::Access::StorageWrite); },
-                           [&pipelines](const ClearData& d, rg::PassContext& pc) { pipelines.clearer_.clear(pc, d.radiance); })
-                       .radiance;
+        const ClearData& clear = graph.addPass<ClearData>(
+            "particles.clear", rg::Queue::Graphics,
+            [&](rg::Builder& b, ClearData& d) { d.radiance = b.write(radiance, rg::Access::StorageWrite); },
+            [&pipelines](const ClearData& d, rg::PassContext& pc) { pipelines.clearer_.clear(pc, d.radiance); });
+        radiance = clear.radiance;
     }
 
     struct List {
         rg::Buffer rays, args;
-        uint32_t name = shader::kParticleListSslr;
+        uint32_t which = shader::kParticleListSslr;  // ParticleTracePush::list
     };
     struct TraceData {
         rg::Texture depth, sslrRadiance, sslrConfidence, sslrHit, rtRadiance, rtHitDistance;
@@ -211,10 +210,9 @@ ParticleTraceOutputs addParticleTracePass(rg::Graph& graph, ParticlePipelines& p
             d.constants = b.read(uploaded, rg::Access::StorageRead);
             // Each list's args: the indirect command, and its length for
             // the ray query backend's last, partial group.
-            const auto list = [&](rg::Buffer rays, rg::Buffer args, uint32_t name) {
-                List l{b.read(rays, rg::Access::StorageRead), b.read(args, rg::Access::IndirectArgs), name};
+            const auto list = [&](rg::Buffer rays, rg::Buffer args, uint32_t which) {
+                d.lists.push_back({b.read(rays, rg::Access::StorageRead), b.read(args, rg::Access::IndirectArgs), which});
                 b.read(args, rg::Access::StorageRead);
-                d.lists.push_back(l);
             };
             if (inputs.rays.sslrListed) {
                 list(inputs.rays.sslrRays, inputs.rays.sslrArgs, shader::kParticleListSslr);
@@ -260,7 +258,7 @@ ParticleTraceOutputs addParticleTracePass(rg::Graph& graph, ParticlePipelines& p
                     push.sampledImage(name, pc.view(texture), sampler, pc.layout(texture));
                 }
                 push.push(pc.gpu(), pc.cmd());
-                pipeline.pushConstants(pc.cmd(), shader::ParticleTracePush{list.name});
+                pipeline.pushConstants(pc.cmd(), shader::ParticleTracePush{list.which});
                 if (backend == RtBackend::RayQuery) {
                     pc.dispatchIndirect(pipeline, list.args, kRayListDispatchArgsBytes);
                 } else {

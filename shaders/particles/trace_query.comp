@@ -1,8 +1,8 @@
 #version 460
 // The particle trace (passes/particles.h), ray query backend: one
-// invocation per ray list entry. The particle quads are not opaque, so every quad on
-// the segment comes back as a candidate; none is committed (the nearest
-// hits are kept in the invocation's list instead). Everything else is
+// invocation per ray list entry. The particle quads are not opaque, so
+// every quad on the segment comes back as a candidate; none is committed
+// (the nearest hits are kept in the invocation's list instead). Everything else is
 // glint/particles_trace.glsl, shared with the ray tracing pipeline backend.
 #extension GL_EXT_ray_query : require
 #extension GL_GOOGLE_include_directive : require

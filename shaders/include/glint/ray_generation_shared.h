@@ -84,10 +84,10 @@ GLINT_CONST uint kRayListArgsWords = 6u;
 // The SSLR list's args go on with the indirect dispatches of SSLR's two
 // colour-pyramid passes (glint/sslr_shared.h): words 32-34 and 35-37, each
 // {groups x, groups y, z}, z = 0 unless a listed ray cone-traces (then 1).
-// They start 128 bytes in, on a cache line of their own: on the list's
-// line, every tile's look at them queued behind the count's atomics (the
-// cone's block cost ray generation 0.013 ms of its 0.065 in the city on
-// an H100; without it, the pass took rt's 0.053).
+// They start 128 bytes in, on a cache line of their own, so that the tiles
+// that look at them do not queue behind the count's atomics on the list's
+// line (docs/results.md, "the passes every mode runs": that look cost ray
+// generation 0.013 ms of its 0.065 in the city on an H100).
 GLINT_CONST uint kSslrArgsPyramidOffset = 32u;
 GLINT_CONST uint kSslrArgsWords = 38u;
 
