@@ -328,6 +328,8 @@ ReflectionFrame ReflectionRenderer::addFrame(rg::Graph& graph, const scene::Came
                                         : settings.rays.reuse      ? settings.rays.reuseRoughness
                                                                    : 2.0f;
     temporalInputs.environmentRoughness = settings.rays.roughnessCutoff;
+    temporalInputs.debugOutputs =
+        settings.temporalDebugOutputs || view == "reflection_motion" || view == "history_length";
     temporalInputs.camera = camera;
     temporalInputs.frameIndex = frameIndex;
     temporalInputs.resetHistory = settings.resetHistory;

@@ -119,6 +119,10 @@ struct ReflectionFrameSettings {
     // Declares a small pass counting pixel classes and traced rays into
     // ReflectionFrame::counts (for stats).
     bool countRays = false;
+    // Writes the temporal pass's reflection motion and history length
+    // (ReflectionFrame::temporal; TemporalInputs::debugOutputs) for a caller
+    // that reads them; their debug views turn them on of themselves.
+    bool temporalDebugOutputs = false;
 };
 
 // Everything a frame declared, for debug views, readbacks and stats.

@@ -66,6 +66,7 @@ shader::TemporalFrame frameConstants(const TemporalInputs& in, const TemporalSet
     f.clampRadius = s.clampRadius;
     f.sharedRayRoughness = in.sharedRayRoughness;
     f.environmentRoughness = in.environmentRoughness;
+    f.debugOutputs = in.debugOutputs ? 1u : 0u;
     return f;
 }
 
@@ -203,8 +204,10 @@ TemporalOutputs addTemporalPass(rg::Graph& graph, TemporalPipelines& pipelines, 
         });
 
     out.resolved = spatial.resolved;
-    out.reflectionMotion = accumulate.motionOut;
-    out.historyLength = accumulate.lengthOut;
+    if (inputs.debugOutputs) {
+        out.reflectionMotion = accumulate.motionOut;
+        out.historyLength = accumulate.lengthOut;
+    }
     return out;
 }
 

@@ -82,6 +82,11 @@ struct TemporalInputs {
     // and its clip box is 3x3 (it shares no rays), which is what bounds a
     // disocclusion's ghost there.
     float environmentRoughness = 2.0f;
+    // Write TemporalOutputs::reflectionMotion and historyLength (their
+    // debug views, tests). Off, nothing writes them and the outputs are
+    // invalid handles: 6 bytes a pixel the frame does not store (the
+    // reflection frame turns them on for their debug views only).
+    bool debugOutputs = true;
 };
 
 struct TemporalSettings {
@@ -151,6 +156,7 @@ struct TemporalSettings {
 
 struct TemporalOutputs {
     rg::Texture resolved;          // kTemporalResolvedFormat: reflections after both passes, a = 1 where they exist
+    // With TemporalInputs::debugOutputs (else invalid):
     rg::Texture reflectionMotion;  // kTemporalMotionFormat: pixels to last frame (debug view "reflection_motion")
     rg::Texture historyLength;     // kTemporalHistoryLengthFormat: frames, 0 = none (debug view "history_length")
     uint32_t width = 0;

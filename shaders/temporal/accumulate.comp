@@ -174,11 +174,19 @@ float ramp(float x, float start, float end) {
     return smoothstep(start, end, x);
 }
 
+// The reflection motion and history length images, for their debug views
+// (passes/temporal.h, TemporalInputs::debugOutputs).
+void writeDebugOutputs(ivec2 p, vec2 motion, float historyLength) {
+    if (frame.debugOutputs != 0u) {
+        imageStore(motionImage, p, vec4(motion, 0.0, 0.0));
+        imageStore(lengthImage, p, vec4(historyLength));
+    }
+}
+
 void writeNothing(ivec2 p, vec2 motion) {
     imageStore(radianceHistory, p, vec4(0.0));
     imageStore(surfaceHistory, p, vec4(0.0));
-    imageStore(motionImage, p, vec4(motion, 0.0, 0.0));
-    imageStore(lengthImage, p, vec4(0.0));
+    writeDebugOutputs(p, motion, 0.0);
 }
 
 // The workgroup's pixels and a border of kTemporalMaxClampRadius around
@@ -359,6 +367,5 @@ void main() {
 
     imageStore(radianceHistory, p, vec4(result, newLength));
     imageStore(surfaceHistory, p, vec4(px.w, px.roughness, octEncode(px.normal)));
-    imageStore(motionImage, p, vec4(reflectionMotion, 0.0, 0.0));
-    imageStore(lengthImage, p, vec4(newLength));
+    writeDebugOutputs(p, reflectionMotion, newLength);
 }

@@ -73,6 +73,7 @@ MotionFrame renderMoving(passes::ReflectionMode mode, bool reflectedMotion,
         passes::ReflectionFrameSettings settings;
         settings.mode = mode;
         settings.reflectedMotion = reflectedMotion;
+        settings.temporalDebugOutputs = true;  // the reflection motion is read back
         settings.resetHistory = i == 0;
         const passes::ReflectionFrame f = renderer.addFrame(graph, camera, settings);
         rg::FrameResources resources;

@@ -50,6 +50,8 @@ struct FrameInput {
     // TemporalInputs::environmentRoughness (above 1: no pixel takes the
     // environment alone).
     float environmentRoughness = 2.0f;
+    // TemporalInputs::debugOutputs: off, the motion and length are not read back.
+    bool debugOutputs = true;
     // Called before the frame's G-buffer is declared (moves objects).
     std::function<void(scene::Scene&)> update;
 };
@@ -85,14 +87,19 @@ std::vector<FrameOutput> runTemporal(scene::Scene& scene, const std::vector<Fram
         passes::TemporalInputs inputs{gbuf, radiance, hit, in.camera, uint64_t(f), in.reset};
         inputs.sharedRayRoughness = in.sharedRayRoughness;
         inputs.environmentRoughness = in.environmentRoughness;
+        inputs.debugOutputs = in.debugOutputs;
         const passes::TemporalOutputs out = passes::addTemporalPass(graph, pipelines, inputs, settings);
         REQUIRE(out.width == kSize);
-        readbacks.push_back({&readTexture(graph, resources, staging, out.resolved, passes::kTemporalResolvedFormat,
-                                          "resolved"),
-                             &readTexture(graph, resources, staging, out.reflectionMotion,
-                                          passes::kTemporalMotionFormat, "motion"),
-                             &readTexture(graph, resources, staging, out.historyLength,
-                                          passes::kTemporalHistoryLengthFormat, "length")});
+        REQUIRE(out.reflectionMotion.valid() == in.debugOutputs);
+        REQUIRE(out.historyLength.valid() == in.debugOutputs);
+        readbacks.push_back(
+            {&readTexture(graph, resources, staging, out.resolved, passes::kTemporalResolvedFormat, "resolved"),
+             in.debugOutputs ? &readTexture(graph, resources, staging, out.reflectionMotion,
+                                            passes::kTemporalMotionFormat, "motion")
+                             : nullptr,
+             in.debugOutputs ? &readTexture(graph, resources, staging, out.historyLength,
+                                            passes::kTemporalHistoryLengthFormat, "length")
+                             : nullptr});
         const rg::Plan plan = graph.compile(executor.compileOptions());
         const auto report = rg::verify(plan);
         REQUIRE_MESSAGE(report.ok(), report.text());
@@ -103,8 +110,10 @@ std::vector<FrameOutput> runTemporal(scene::Scene& scene, const std::vector<Fram
     for (const auto& r : readbacks) {
         FrameOutput o;
         o.resolved = halves(*r[0], 4);
-        for (const glm::vec4& m : halves(*r[1], 2)) o.motion.emplace_back(m.x, m.y);
-        for (const glm::vec4& l : halves(*r[2], 1)) o.length.push_back(l.x);
+        if (r[1]) {
+            for (const glm::vec4& m : halves(*r[1], 2)) o.motion.emplace_back(m.x, m.y);
+            for (const glm::vec4& l : halves(*r[2], 1)) o.length.push_back(l.x);
+        }
         outputs.push_back(std::move(o));
     }
     return outputs;
@@ -496,6 +505,18 @@ TEST_CASE("the clip box spans 5x5 where rays are shared, 3x3 where each pixel ha
             CHECK(v == doctest::Approx(0.1f).epsilon(0.01));
         }
       }
+    }
+}
+
+TEST_CASE("without its debug outputs the pass resolves the same image and hands out no motion or length") {
+    scene::Scene scene = wallScene(material(0.3f, 1.0f));
+    std::vector<FrameInput> frames = noisyFrames(3, 0.3f);
+    const std::vector<FrameOutput> with = runTemporal(scene, frames);
+    for (FrameInput& f : frames) f.debugOutputs = false;
+    const std::vector<FrameOutput> without = runTemporal(scene, frames);
+    for (size_t f = 0; f < frames.size(); ++f) {
+        CHECK(without[f].motion.empty());
+        CHECK(with[f].resolved == without[f].resolved);
     }
 }
 

@@ -61,7 +61,7 @@ struct TemporalFrame {
     uint clampRadius;                    // the clip box's neighbourhood where rays are shared: (2 r + 1)^2 pixels
     float sharedRayRoughness;            // from this roughness on, quads share rays (above 1: nowhere)
     float environmentRoughness;          // above this roughness the environment alone (above 1: nowhere)
-    uint pad2;
+    uint debugOutputs;                   // 1: write the motion and history length images
 };
 
 GLINT_END
