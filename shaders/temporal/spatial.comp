@@ -68,10 +68,10 @@ void main() {
     const float depth = texelFetch(depthTexture, p, 0).x;
     const vec3 position = worldPosition(frame.inverseViewProjection, vec2(p) + 0.5, size, depth);
     const float w = viewDepth(frame.viewProjection, position);
-    const float e = dot(stepPerViewDepth(vec2(p) + 0.5, depth), normal);
+    const float we = dot(position - frame.cameraPosition.xyz, normal);
+    const float e = we / w;
     const float eX = dot(stepPerViewDepth(vec2(p) + vec2(1.5, 0.5), depth), normal) - e;
     const float eY = dot(stepPerViewDepth(vec2(p) + vec2(0.5, 1.5), depth), normal) - e;
-    const float we = w * e;
     // Sigma of half the radius (plus half a pixel) keeps the window's
     // corners near zero weight.
     const float sigma = 0.5 * float(radius) + 0.5;
