@@ -80,25 +80,33 @@ bool currentRadiance(ivec2 texel, out vec3 radiance) {
     return true;
 }
 
-// Where the previous camera's ray through the centre of `texel` meets view
-// depth `w`.
-vec3 previousPosition(ivec2 texel, float w) {
-    const vec2 ndc = (vec2(texel) + 0.5) / vec2(frame.size) * 2.0 - 1.0;
+// E_prev at a pixel position: the world step along the previous camera's
+// ray through it per unit of last frame's view depth. The point at view
+// depth w on that ray is previousCameraPosition + w E_prev, and E_prev is
+// affine in the pixel position (a pinhole camera, jittered or not).
+vec3 previousStepPerViewDepth(vec2 pixelPosition) {
+    const vec2 ndc = pixelPosition / vec2(frame.size) * 2.0 - 1.0;
     const vec4 near = frame.previousInverseViewProjection * vec4(ndc, 1.0, 1.0);
-    const vec3 camera = frame.previousCameraPosition.xyz;
-    const vec3 dir = near.xyz / near.w - camera;
+    const vec3 dir = near.xyz / near.w - frame.previousCameraPosition.xyz;
     const mat4 m = frame.previousViewProjection;
     // w is linear along a ray from the camera (where it is 0).
-    const float wPerUnit = dot(vec3(m[0][3], m[1][3], m[2][3]), dir);
-    return camera + dir * (w / wPerUnit);
+    return dir / dot(vec3(m[0][3], m[1][3], m[2][3]), dir);
 }
 
 struct Pixel {
+    ivec2 texel;
     vec3 position;
     vec3 normal;
     float roughness;
     float w;
     bool environment;  // rougher than frame.environmentRoughness: the environment map alone
+    // The plane test's terms (not for environment pixels): a history texel
+    // t at last frame's view depth w_t lies (previousCameraPosition +
+    // w_t E_prev(t) - position) . normal off this pixel's plane, which is
+    // planeOffset + w_t (planeStep.x + dx planeStep.y + dy planeStep.z)
+    // with (dx, dy) = t - texel.
+    float planeOffset;
+    vec3 planeStep;
 };
 
 // One history texel, or false where last frame saw another surface there:
@@ -111,16 +119,20 @@ bool historyTap(ivec2 texel, Pixel px, out vec4 radiance) {
     if (any(lessThan(texel, ivec2(0))) || any(greaterThanEqual(texel, ivec2(frame.size)))) {
         return false;
     }
+    if (px.environment) {
+        // A history length says a surface was there (writeNothing stores
+        // none): its radiance alone is read.
+        radiance = texelFetch(previousRadianceTexture, texel, 0);
+        return radiance.a >= 1.0 && isFinite(radiance.rgb);
+    }
     const vec4 surface = texelFetch(previousSurfaceTexture, texel, 0);
     radiance = texelFetch(previousRadianceTexture, texel, 0);
     if (!(surface.x > 0.0) || !(radiance.a >= 1.0) || !isFinite(radiance.rgb) || !isFinite(surface.yzw)) {
         return false;
     }
-    if (px.environment) {
-        return true;
-    }
-    const vec3 q = previousPosition(texel, surface.x);
-    if (!(abs(dot(q - px.position, px.normal)) <= frame.planeTolerance * px.w)) {
+    const vec2 d = vec2(texel - px.texel);
+    const float offPlane = px.planeOffset + surface.x * (px.planeStep.x + d.x * px.planeStep.y + d.y * px.planeStep.z);
+    if (!(abs(offPlane) <= frame.planeTolerance * px.w)) {
         return false;
     }
     const vec3 n = octDecode(clamp(surface.zw, vec2(-1.0), vec2(1.0)));
@@ -243,6 +255,15 @@ void main() {
     px.roughness = roughness;
     px.w = viewDepth(frame.viewProjection, px.position);
     px.environment = px.roughness > frame.environmentRoughness;
+    px.texel = p;
+    px.planeOffset = 0.0;
+    px.planeStep = vec3(0.0);
+    if (!px.environment) {
+        const vec3 e = previousStepPerViewDepth(centre);
+        px.planeOffset = dot(frame.previousCameraPosition.xyz - px.position, px.normal);
+        px.planeStep = vec3(dot(e, px.normal), dot(previousStepPerViewDepth(centre + vec2(1.0, 0.0)) - e, px.normal),
+                            dot(previousStepPerViewDepth(centre + vec2(0.0, 1.0)) - e, px.normal));
+    }
 
     // 1. This frame's radiance and its neighbourhood's statistics.
     vec3 current;

@@ -441,6 +441,49 @@ TEST_CASE("a jittered camera keeps the history of a grazing floor") {
     }
 }
 
+TEST_CASE("a camera moving down a street keeps the history of the floor and the wall beside it") {
+    // Each frame the camera moves half a unit forward between a floor (1
+    // below it) and a wall (2 to its left): their points move up to ~10
+    // pixels a frame, down the floor and left along the wall. A history
+    // texel far from the pixel must still be found on the pixel's plane
+    // (the plane test's gradient across the image, in y on the floor and in
+    // x on the wall).
+    constexpr uint32_t kFrames = 8;
+    scene::Scene scene = makeScene({square({0, -1, -500}, {1, 0, 0}, {0, 0, -1}, 500.0f, 0),
+                                    square({-2, 0, -500}, {0, 0, -1}, {0, 1, 0}, 500.0f, 0)},
+                                   {material(0.5f, 1.0f)});
+    std::vector<FrameInput> frames(kFrames);
+    scene::Camera camera = testCamera();
+    for (uint32_t f = 0; f < kFrames; ++f) {
+        const glm::vec3 position(0.0f, 0.0f, -0.5f * float(f));
+        const scene::CameraPose pose{position, position + glm::vec3(0, 0, -1), {0, 1, 0}};
+        if (f == 0) {
+            camera.reset(pose, 0);
+        } else {
+            camera.advance(pose, f);
+        }
+        frames[f].camera = camera;
+        std::fill(frames[f].radiance.begin(), frames[f].radiance.end(), glm::vec4(0.5f, 0.6f, 0.7f, 1.0f));
+    }
+    const std::vector<FrameOutput> out = runTemporal(scene, frames);
+    // Every surface point seen now was on screen last frame (moving
+    // forward, points move away from the image's centre).
+    uint32_t floorPixels = 0, wallPixels = 0;
+    for (uint32_t y = 0; y < kSize; ++y) {
+        for (uint32_t x = 0; x < kSize; ++x) {
+            if (!(out.back().length[at(x, y)] > 0.0f)) continue;
+            INFO("pixel " << x << ", " << y);
+            REQUIRE(out.back().length[at(x, y)] == float(kFrames));
+            REQUIRE(glm::length(glm::vec3(out.back().resolved[at(x, y)]) - glm::vec3(0.5f, 0.6f, 0.7f)) < 2e-3f);
+            floorPixels += y >= kSize * 3 / 4 ? 1 : 0;              // the floor alone
+            wallPixels += x < kSize / 8 && y < kSize / 2 ? 1 : 0;  // the wall alone
+        }
+    }
+    // Both surfaces are in view there.
+    CHECK(floorPixels == kSize * kSize / 4);
+    CHECK(wallPixels == kSize * kSize / 16);
+}
+
 TEST_CASE("a reset discards the history; without it the history lingers") {
     constexpr uint32_t kFrames = 6;
     const glm::vec4 before(1.0f, 0.0f, 0.0f, 1.0f);
