@@ -67,6 +67,7 @@ shader::TemporalFrame frameConstants(const TemporalInputs& in, const TemporalSet
     f.sharedRayRoughness = in.sharedRayRoughness;
     f.environmentRoughness = in.environmentRoughness;
     f.debugOutputs = in.debugOutputs ? 1u : 0u;
+    f.frame = uint32_t(in.frameIndex);
     return f;
 }
 

@@ -42,11 +42,16 @@ namespace glint::passes {
 inline constexpr VkFormat kTemporalResolvedFormat = VK_FORMAT_R16G16B16A16_SFLOAT;
 inline constexpr VkFormat kTemporalMotionFormat = VK_FORMAT_R16G16_SFLOAT;
 inline constexpr VkFormat kTemporalHistoryLengthFormat = VK_FORMAT_R16_SFLOAT;
-// Float: at a weight of 1/32 per frame a half float's step (2^-11 relative)
-// would stall the average up to 16 steps from the mean (32 where stores
-// round towards zero, as Vulkan allows for 16-bit floats): a bias of
-// 1-3%, visible as darkening.
-inline constexpr VkFormat kTemporalRadianceHistoryFormat = VK_FORMAT_R32G32B32A32_SFLOAT;
+// Half floats, rounded stochastically by the accumulation: at a weight of
+// 1/64 per frame, rounding to nearest would stall the average up to 32 of
+// a half float's steps (2^-11 to 2^-10 relative) from the mean (64 where
+// stores round towards zero, as Vulkan allows for 16-bit floats), a bias of
+// 2-6%, visible as darkening. The shader stores one of the two half floats
+// around each value, the upper with probability proportional to the
+// distance from the lower, so the stored value's mean is the value itself
+// and no rounding mode applies (shaders/temporal/accumulate.comp). Half the
+// bytes of RGBA32F for every history tap and spatial filter tap.
+inline constexpr VkFormat kTemporalRadianceHistoryFormat = VK_FORMAT_R16G16B16A16_SFLOAT;
 inline constexpr VkFormat kTemporalSurfaceHistoryFormat = VK_FORMAT_R16G16B16A16_SFLOAT;
 
 struct TemporalInputs {
@@ -56,8 +61,8 @@ struct TemporalInputs {
     // This and last frame's unjittered matrices and positions (the
     // G-buffer's camera).
     scene::Camera camera;
-    // The frame's index (the pass draws no noise of its own; kept so the
-    // inputs name the frame like every pass's).
+    // The frame's index: the history's stochastic rounding draws its noise
+    // from it (glint/sampling.glsl's kNoiseHistoryRounding).
     uint64_t frameIndex = 0;
     // Discard the history (a camera cut, a teleport, a new scene).
     bool resetHistory = false;
@@ -130,8 +135,8 @@ struct TemporalSettings {
     float surfaceMotionRoughnessStart = 0.1f;
     float surfaceMotionRoughnessEnd = 0.3f;
     // Radiance is clamped to [0, maxRadiance] before it is accumulated: the
-    // largest half float, so the RGBA16F resolved image never overflows to
-    // Inf.
+    // largest half float, so neither the RGBA16F history nor the resolved
+    // image overflows to Inf.
     float maxRadiance = 65504.0f;
     // The spatial filter: a (2 radius + 1)^2 edge-aware Gaussian, off below
     // spatialRoughnessStart (mirrors need none), full from

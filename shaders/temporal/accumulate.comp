@@ -23,12 +23,14 @@
 //      clipping towards the mean and the luma-compressed space as Karis,
 //      "High Quality Temporal Supersampling", SIGGRAPH 2014);
 //   5. an exponential moving average with weight 1 / history length, the
-//      length capped at maxHistoryFrames.
+//      length capped at maxHistoryFrames, stored in half floats rounded
+//      stochastically (passes/temporal.h's kTemporalRadianceHistoryFormat).
 #extension GL_GOOGLE_include_directive : require
 #extension GL_EXT_scalar_block_layout : require
 
 #include "glint/packing.h"
 #include "glint/ray_generation_shared.h"
+#include "glint/sampling.glsl"
 #include "glint/temporal_shared.h"
 #include "temporal_common.glsl"
 
@@ -42,7 +44,7 @@ layout(set = 0, binding = 5) uniform sampler2D radianceTexture;
 layout(set = 0, binding = 6) uniform sampler2D hitDistanceTexture;
 layout(set = 0, binding = 7) uniform sampler2D previousRadianceTexture;
 layout(set = 0, binding = 8) uniform sampler2D previousSurfaceTexture;
-layout(set = 0, binding = 9, rgba32f) uniform writeonly image2D radianceHistory;
+layout(set = 0, binding = 9, rgba16f) uniform writeonly image2D radianceHistory;
 layout(set = 0, binding = 10, rgba16f) uniform writeonly image2D surfaceHistory;
 // RG16F and R16F are not among the formats every device can store with a
 // format qualifier; the context enables shaderStorageImageWriteWithoutFormat.
@@ -176,6 +178,24 @@ bool sampleHistory(vec2 position, Pixel px, out vec3 radiance, out float history
     radiance /= weightSum;
     historyLength /= weightSum;
     return true;
+}
+
+// One of the two half floats around x (finite, in [0, 65504]): the upper
+// with probability (x - lower) / (upper - lower) for u uniform in [0, 1),
+// so the mean is x, where rounding to nearest (or towards zero) would stall
+// an average whose steps are below half a half float's step. The result is
+// a half float, which the RGBA16F store keeps exactly whatever its
+// rounding. From the bits (a float32 whose 13 low mantissa bits are zero is
+// a half float in the half's normal range; the next one up is 2^13 bits
+// on), not through packHalf2x16 and back: on lavapipe that round trip came
+// back as x itself (the history was bit-identical to a plain store's), as
+// if folded away. Below the half's normal range (2^-14) the store rounds as
+// it will: an error under 2^-24.
+float roundToHalf(float x, float u) {
+    const uint lowerBits = floatBitsToUint(x) & ~0x1FFFu;
+    const float lower = uintBitsToFloat(lowerBits);
+    const float upper = min(uintBitsToFloat(lowerBits + 0x2000u), 65504.0);
+    return upper > lower && u * (upper - lower) < x - lower ? upper : lower;
 }
 
 // 0 below `start`, 1 from `end`, smooth between (smoothstep is undefined
@@ -385,6 +405,10 @@ void main() {
         result = mix(history, current, 1.0 / max(newLength, 1.0));
     }
     result = clamp(result, vec3(0.0), vec3(frame.maxRadiance));
+    // One draw for the three channels: each rounds without bias whatever
+    // the others do.
+    const float u = scalarNoise(uvec2(p), frame.frame, kNoiseHistoryRounding);
+    result = vec3(roundToHalf(result.r, u), roundToHalf(result.g, u), roundToHalf(result.b, u));
 
     imageStore(radianceHistory, p, vec4(result, newLength));
     imageStore(surfaceHistory, p, vec4(px.w, px.roughness, octEncode(px.normal)));

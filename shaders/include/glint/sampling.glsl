@@ -64,6 +64,7 @@ GLINT_FUNC float unitFromBits(uint bits) {
 // draw GGX samples from one band of u.x.
 GLINT_CONST uint kNoiseSslrOffset = 0u;
 GLINT_CONST uint kNoiseRtToHybrid = 1u;
+GLINT_CONST uint kNoiseHistoryRounding = 2u;
 
 // Roberts' R2 sequence ("The Unreasonable Effectiveness of Quasirandom
 // Sequences", 2018): x_n = frac(n / g, n / g^2), g = 1.3247179572 (the
@@ -82,14 +83,17 @@ GLINT_FUNC vec2 ggxNoise(uvec2 pixel, uint frame) {
 // One more dimension, kNoise*: a Weyl sequence frac(seed + n alpha) per
 // pixel, its seed hashed from the pixel and the dimension, its step an
 // irrational of its own: 2^32 / golden ratio for the SSLR offset, 2^32
-// (sqrt 2 - 1) for the hybrid share. 1, 1/g, 1/g^2, 1/phi and sqrt 2 are
-// linearly independent over the rationals (the fields Q(g) and
-// Q(sqrt 5, sqrt 2) meet only in Q), so over frames each pixel's GGX
-// sample and these dimensions are jointly equidistributed (Weyl), and
+// (sqrt 2 - 1) for the hybrid share, 2^32 (sqrt 3 - 1) for the history's
+// rounding. 1, 1/g, 1/g^2, 1/phi, sqrt 2 and sqrt 3 are linearly
+// independent over the rationals (the fields Q(g) and
+// Q(sqrt 5, sqrt 2, sqrt 3) meet only in Q), so over frames each pixel's
+// GGX sample and these dimensions are jointly equidistributed (Weyl), and
 // across pixels their seeds are independent hashes.
 GLINT_FUNC float scalarNoise(uvec2 pixel, uint frame, uint dimension) {
     const uint seed = pcgHash(pixel.x + pcgHash(pixel.y + pcgHash(dimension + 0x51ED27u)));
-    const uint step = dimension == kNoiseSslrOffset ? 2654435769u : 1779033703u;
+    const uint step = dimension == kNoiseSslrOffset   ? 2654435769u
+                      : dimension == kNoiseRtToHybrid ? 1779033703u
+                                                      : 3144134277u;
     return unitFromBits(seed + frame * step);
 }
 

@@ -6,9 +6,10 @@
 //
 // History textures (ping-ponged by the graph across frames; their names
 // end in the image size, ".<width>x<height>"):
-//   temporal.radiance  RGBA32F; rgb: accumulated reflection radiance before
-//                      the spatial filter; a: history length in frames
-//                      (0: none)
+//   temporal.radiance  RGBA16F; rgb: accumulated reflection radiance before
+//                      the spatial filter, rounded stochastically to half
+//                      floats (passes/temporal.h); a: history length in
+//                      frames (0: none)
 //   temporal.surface   RGBA16F; x: view depth (clip w) of the pixel's surface,
 //                      y: perceptual roughness, zw: octahedral world normal
 //                      (glint/packing.h's octEncode, unquantised); x = 0
@@ -62,12 +63,13 @@ struct TemporalFrame {
     float sharedRayRoughness;            // from this roughness on, quads share rays (above 1: nowhere)
     float environmentRoughness;          // above this roughness the environment alone (above 1: nowhere)
     uint debugOutputs;                   // 1: write the motion and history length images
+    uint frame;                          // the frame's index (the history's rounding noise)
 };
 
 GLINT_END
 
 #ifdef __cplusplus
-static_assert(sizeof(glint::shader::TemporalFrame) == 4 * 64 + 2 * 16 + 96);
+static_assert(sizeof(glint::shader::TemporalFrame) == 4 * 64 + 2 * 16 + 100);
 #endif
 
 #endif
