@@ -189,8 +189,8 @@ bool sampleHistory(vec2 position, Pixel px, out vec3 radiance, out float history
 // a half float in the half's normal range; the next one up is 2^13 bits
 // on), not through packHalf2x16 and back: on lavapipe that round trip came
 // back as x itself (the history was bit-identical to a plain store's), as
-// if folded away. Below the half's normal range (2^-14) the store rounds as
-// it will: an error under 2^-24.
+// if folded away. Below the half's normal range (2^-14) the store rounds
+// the result as it will: an error below 2^-23.
 float roundToHalf(float x, float u) {
     const uint lowerBits = floatBitsToUint(x) & ~0x1FFFu;
     const float lower = uintBitsToFloat(lowerBits);
