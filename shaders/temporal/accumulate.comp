@@ -82,19 +82,6 @@ bool currentRadiance(ivec2 texel, out vec3 radiance) {
     return true;
 }
 
-// E_prev at a pixel position: the world step along the previous camera's
-// ray through it per unit of last frame's view depth. The point at view
-// depth w on that ray is previousCameraPosition + w E_prev, and E_prev is
-// affine in the pixel position (a pinhole camera, jittered or not).
-vec3 previousStepPerViewDepth(vec2 pixelPosition) {
-    const vec2 ndc = pixelPosition / vec2(frame.size) * 2.0 - 1.0;
-    const vec4 near = frame.previousInverseViewProjection * vec4(ndc, 1.0, 1.0);
-    const vec3 dir = near.xyz / near.w - frame.previousCameraPosition.xyz;
-    const mat4 m = frame.previousViewProjection;
-    // w is linear along a ray from the camera (where it is 0).
-    return dir / dot(vec3(m[0][3], m[1][3], m[2][3]), dir);
-}
-
 struct Pixel {
     ivec2 texel;
     vec3 position;
@@ -102,11 +89,11 @@ struct Pixel {
     float roughness;
     float w;
     bool environment;  // rougher than frame.environmentRoughness: the environment map alone
-    // The plane test's terms (not for environment pixels): a history texel
-    // t at last frame's view depth w_t lies (previousCameraPosition +
-    // w_t E_prev(t) - position) . normal off this pixel's plane, which is
+    // The plane test's terms (not for environment pixels;
+    // temporal_common.glsl's planeDistanceSteps, last frame's camera): a
+    // history texel t at last frame's view depth w_t lies
     // planeOffset + w_t (planeStep.x + dx planeStep.y + dy planeStep.z)
-    // with (dx, dy) = t - texel.
+    // off this pixel's plane, with (dx, dy) = t - texel.
     float planeOffset;
     vec3 planeStep;
 };
@@ -279,10 +266,9 @@ void main() {
     px.planeOffset = 0.0;
     px.planeStep = vec3(0.0);
     if (!px.environment) {
-        const vec3 e = previousStepPerViewDepth(centre);
         px.planeOffset = dot(frame.previousCameraPosition.xyz - px.position, px.normal);
-        px.planeStep = vec3(dot(e, px.normal), dot(previousStepPerViewDepth(centre + vec2(1.0, 0.0)) - e, px.normal),
-                            dot(previousStepPerViewDepth(centre + vec2(0.0, 1.0)) - e, px.normal));
+        px.planeStep = planeDistanceSteps(frame.previousInverseViewProjection, frame.previousViewProjection,
+                                          frame.previousCameraPosition.xyz, centre, px.normal);
     }
 
     // 1. This frame's radiance and its neighbourhood's statistics.

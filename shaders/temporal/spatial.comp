@@ -31,13 +31,6 @@ float ramp(float x, float start, float end) {
     return smoothstep(start, end, x);
 }
 
-// E at a pixel position: the world step along its view ray per unit of
-// view depth (from the point at any depth on it).
-vec3 stepPerViewDepth(vec2 pixelPosition, float depth) {
-    const vec3 point = worldPosition(frame.inverseViewProjection, pixelPosition, vec2(frame.size), depth);
-    return (point - frame.cameraPosition.xyz) / viewDepth(frame.viewProjection, point);
-}
-
 void main() {
     const ivec2 p = ivec2(gl_GlobalInvocationID.xy);
     if (p.x >= int(frame.size.x) || p.y >= int(frame.size.y)) {
@@ -59,19 +52,15 @@ void main() {
     }
     const vec2 size = vec2(frame.size);
     const vec3 normal = octDecode(clamp(surface.zw, vec2(-1.0), vec2(1.0)));
-    // A tap's distance to this pixel's plane from its view depth alone:
-    // the point at view depth w on pixel q's ray is camera + w E(q), where
-    // E(q), the step along the ray per unit of view depth, is affine in q
-    // (a pinhole camera, jittered or not). So with e(q) = E(q) . normal,
-    // affine too, the distance is |w_q e(q) - w e(p)|: a few FMAs a tap
+    // A tap's distance to this pixel's plane from its view depth alone
+    // (temporal_common.glsl's planeDistanceSteps): a few FMAs a tap
     // instead of a position reconstructed from depth.
     const float depth = texelFetch(depthTexture, p, 0).x;
     const vec3 position = worldPosition(frame.inverseViewProjection, vec2(p) + 0.5, size, depth);
     const float w = viewDepth(frame.viewProjection, position);
-    const float we = dot(position - frame.cameraPosition.xyz, normal);
-    const float e = we / w;
-    const float eX = dot(stepPerViewDepth(vec2(p) + vec2(1.5, 0.5), depth), normal) - e;
-    const float eY = dot(stepPerViewDepth(vec2(p) + vec2(0.5, 1.5), depth), normal) - e;
+    const float planeOffset = dot(frame.cameraPosition.xyz - position, normal);
+    const vec3 steps = planeDistanceSteps(frame.inverseViewProjection, frame.viewProjection, frame.cameraPosition.xyz,
+                                          vec2(p) + 0.5, normal);
     // Sigma of half the radius (plus half a pixel) keeps the window's
     // corners near zero weight.
     const float sigma = 0.5 * float(radius) + 0.5;
@@ -94,7 +83,8 @@ void main() {
             if (!(tap.a > 0.0) || !(tapSurface.x > 0.0)) continue;
             const float facing = dot(octDecode(clamp(tapSurface.zw, vec2(-1.0), vec2(1.0))), normal);
             if (!(facing > 0.0)) continue;
-            const float distance = abs(tapSurface.x * (e + float(dx) * eX + float(dy) * eY) - we);
+            const float distance =
+                abs(planeOffset + tapSurface.x * (steps.x + float(dx) * steps.y + float(dy) * steps.z));
             const float exponent = frame.spatialNormalPower * log2(facing) -
                                    (float(dx * dx + dy * dy) * gaussianScale + distance * planeScale +
                                     abs(tapSurface.y - roughness) * roughnessScale);
