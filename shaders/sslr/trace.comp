@@ -65,18 +65,24 @@ struct March {
     float dk;
 };
 
-// How far the ray at screen parameter t lies behind the depth buffer, in
-// view units (positive: behind), whether the texel is sky, and the depth
-// buffer's distance there (view units).
-float behind(March m, float t, out ivec2 texel, out bool sky, out float surface) {
-    const vec2 pos = m.start + t * m.delta;
-    texel = clamp(ivec2(floor(pos)), ivec2(0), ivec2(pc.size) - 1);
-    const float depth = texelFetch(depthTexture, texel, 0).x;
-    sky = depth <= 0.0;
-    const float rayDistance = 1.0 / (m.k0 + t * m.dk);
-    surface = -viewZ(depth);
-    return sky ? -1.0 : rayDistance - surface;
+// The depth buffer's depth under the ray at screen parameter t, and its
+// texel.
+float depthUnder(March m, float t, out ivec2 texel) {
+    texel = clamp(ivec2(floor(m.start + t * m.delta)), ivec2(0), ivec2(pc.size) - 1);
+    return texelFetch(depthTexture, texel, 0).x;
 }
+
+// Whether the ray at screen parameter t lies in front of a surface of the
+// depth buffer at `depth`, or over the sky (depth 0), decided in depth
+// without a division: the ray's reversed-Z depth, P32 / w - P22, is affine
+// in 1 / w and so in t, and lies above the buffer's where the ray is
+// nearer than the surface. Most steps end here.
+bool inFront(March m, float t, float depth) {
+    return depth <= 0.0 || pc.projection.w * (m.k0 + t * m.dk) - pc.projection.z > depth;
+}
+
+// The ray's view distance (view units, along -z) at screen parameter t.
+float rayDistance(March m, float t) { return 1.0 / (m.k0 + t * m.dk); }
 
 void writeResult(ivec2 pixel, vec3 radiance, float confidence, vec2 hitUv, bool hit) {
     imageStore(radianceImage, pixel, vec4(radiance, hit ? 1.0 : 0.0));
@@ -162,6 +168,7 @@ void main() {
     float tFront = 0.0;
     float tHit = -1.0;
     ivec2 hitTexel = ivec2(0);
+    float hitDepth = 0.0;
     float gap = 0.0;
     // A ray passing behind a thick occluder lies behind the depth buffer at
     // every step, and a search between two such steps finds that occluder
@@ -184,14 +191,14 @@ void main() {
             continue;
         }
         ivec2 texel;
-        bool sky;
-        float surface;
-        const float d = behind(m, t, texel, sky, surface);
-        if (sky || d < 0.0) {
+        const float depth = depthUnder(m, t, texel);
+        if (inFront(m, t, depth)) {
             tFront = t;
             wasBehind = false;
             continue;
         }
+        const float surface = -viewZ(depth);
+        const float d = rayDistance(m, t) - surface;
         const bool sameOccluder = surface <= lastSurface * (1.0 + pc.thickness);
         lastSurface = surface;
         if (wasBehind && d > pc.thickness * surface && sameOccluder) {
@@ -202,28 +209,27 @@ void main() {
         // A crossing: refine between the last point in front and this one.
         float lo = tFront, hi = t;
         ivec2 hiTexel = texel;
-        float hiGap = d;
-        float hiSurface = surface;
+        float hiDepth = depth;
         for (uint j = 0u; j < pc.refineSteps; ++j) {
             const float mid = 0.5 * (lo + hi);
             ivec2 midTexel;
-            bool midSky;
-            float midSurface;
-            const float md = behind(m, mid, midTexel, midSky, midSurface);
-            if (midSky || md < 0.0) {
+            const float midDepth = depthUnder(m, mid, midTexel);
+            if (inFront(m, mid, midDepth)) {
                 lo = mid;
             } else {
                 hi = mid;
                 hiTexel = midTexel;
-                hiGap = md;
-                hiSurface = midSurface;
+                hiDepth = midDepth;
             }
         }
+        const float hiSurface = -viewZ(hiDepth);
+        const float hiGap = rayDistance(m, hi) - hiSurface;
         // Thickness test: the depth buffer holds only front surfaces, so a
         // ray found far behind one passed behind it; keep marching.
         if (hiGap <= pc.thickness * hiSurface) {
             tHit = hi;
             hitTexel = hiTexel;
+            hitDepth = hiDepth;
             gap = hiGap / (pc.thickness * hiSurface);
             break;
         }
@@ -244,7 +250,6 @@ void main() {
             // depth's pixels, is the footprint; the pyramid level whose
             // texels span it holds the lobe's mean colour.
             const float alpha = roughness * roughness;
-            const float hitDepth = texelFetch(depthTexture, hitTexel, 0).x;
             const vec3 hitPosition = viewPosition(vec2(hitTexel) + 0.5, hitDepth);
             const float distance = length(hitPosition - origin);
             const float pixelsPerUnit = 0.5 * abs(pc.projection.y) * float(pc.size.y) / max(-hitPosition.z, 1e-6);
