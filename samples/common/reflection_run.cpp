@@ -61,7 +61,7 @@ constexpr std::array<bool, 3> kEveryMode{true, true, true};
 
 // The one table of parameters: name, field, the viewer's range, the
 // bench's sweep, and where the value lives.
-const std::array<ParameterSlot, 29> kParameters = {{
+const std::array<ParameterSlot, 30> kParameters = {{
     // A confidence; the talk's 0.9 (default) bracketed from "trust SSLR
     // often" to "almost never".
     {{"sslr_threshold", "ReflectionFrameSettings::confidenceThreshold", 0.0f, 1.0f, false, {0.5, 0.7, 0.8, 0.95, 0.99},
@@ -161,6 +161,10 @@ const std::array<ParameterSlot, 29> kParameters = {{
     // cut-outs): what the test costs.
     {{"alpha_test", "RtTraceSettings::alphaTest (0 or 1)", 0.0f, 1.0f, true, {0}, {0}, kTraced}, nullptr, nullptr,
      [](ReflectionRunOptions& o) { return &o.frame.rt.alphaTest; }},
+    // Hits lit unshadowed (default: a shadow ray to the sun from each hit
+    // that faces it): what the shadow rays cost.
+    {{"rt_shadows", "RtTraceSettings::shadows (0 or 1)", 0.0f, 1.0f, true, {0}, {}, kTraced}, nullptr, nullptr,
+     [](ReflectionRunOptions& o) { return &o.frame.rt.shadows; }},
     // BLASes from full detail instead of the reflection LODs (default on):
     // what the LODs cost in error.
     {{"reflection_lods", "BvhSettings::reflectionLods (0: BLASes from full detail)", 0.0f, 1.0f, true, {0}, {0},
