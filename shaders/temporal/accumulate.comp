@@ -213,24 +213,31 @@ void writeNothing(ivec2 p, vec2 motion) {
     writeDebugOutputs(p, motion, 0.0);
 }
 
-// The workgroup's pixels and a border of kTemporalMaxClampRadius around
-// them, as the clip box's statistics want them: YCoCg of the compressed
-// radiance, w = 1 where this frame's radiance there is valid. Loaded once
-// per workgroup: a 5x5 box would otherwise fetch and convert every texel 25
-// times.
+// The workgroup's pixels and a border of the clip box's radius around them
+// (frame.clampRadius, at most kTemporalMaxClampRadius), as the clip box's
+// statistics want them: YCoCg of the compressed radiance, w = 1 where this
+// frame's radiance there is valid. Loaded once per workgroup: a 5x5 box
+// would otherwise fetch and convert every texel 25 times. The array holds
+// the largest border; only the frame's is loaded (144 texels instead of
+// 196 at the default radius 2: three rounds of the workgroup instead of
+// four), and no pixel reads beyond it.
 const int kTile = int(kTemporalGroupSize) + 2 * int(kTemporalMaxClampRadius);
 shared vec4 tile[kTile * kTile];
 
 void loadTile() {
-    const ivec2 origin = ivec2(gl_WorkGroupID.xy) * int(kTemporalGroupSize) - int(kTemporalMaxClampRadius);
-    for (uint i = gl_LocalInvocationIndex; i < uint(kTile * kTile); i += kTemporalGroupSize * kTemporalGroupSize) {
-        const ivec2 q = origin + ivec2(int(i) % kTile, int(i) / kTile);
+    const int border = int(min(frame.clampRadius, kTemporalMaxClampRadius));
+    const int side = int(kTemporalGroupSize) + 2 * border;
+    const int skip = int(kTemporalMaxClampRadius) - border;  // the array's unused rows and columns
+    const ivec2 origin = ivec2(gl_WorkGroupID.xy) * int(kTemporalGroupSize) - border;
+    for (int i = int(gl_LocalInvocationIndex); i < side * side; i += int(kTemporalGroupSize * kTemporalGroupSize)) {
+        const ivec2 offset = ivec2(i % side, i / side);
+        const ivec2 q = origin + offset;
         vec4 entry = vec4(0.0);
         vec3 c;
         if (all(greaterThanEqual(q, ivec2(0))) && all(lessThan(q, ivec2(frame.size))) && currentRadiance(q, c)) {
             entry = vec4(rgbToYCoCg(compress(c)), 1.0);
         }
-        tile[i] = entry;
+        tile[(offset.y + skip) * kTile + offset.x + skip] = entry;
     }
     barrier();
 }
