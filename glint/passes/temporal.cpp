@@ -114,7 +114,10 @@ TemporalOutputs addTemporalPass(rg::Graph& graph, TemporalPipelines& pipelines, 
     // a new resolution start from a new, cleared pair instead of reusing
     // images of the old size.
     const std::string suffix = "." + std::to_string(gbuf.width) + "x" + std::to_string(gbuf.height);
-    const rg::HistoryTexture history = graph.createHistoryTexture("temporal.history" + suffix, desc(kTemporalHistoryFormat));
+    const rg::HistoryTexture radianceHistory =
+        graph.createHistoryTexture("temporal.radiance" + suffix, desc(kTemporalRadianceHistoryFormat));
+    const rg::HistoryTexture surfaceHistory =
+        graph.createHistoryTexture("temporal.surface" + suffix, desc(kTemporalSurfaceHistoryFormat));
 
     // The constants (four matrices: more than push constants guarantee)
     // reach the shaders through a uniform buffer the graph owns, filled on
@@ -123,9 +126,9 @@ TemporalOutputs addTemporalPass(rg::Graph& graph, TemporalPipelines& pipelines, 
 
     struct AccumulateData {
         rg::Buffer frame;
-        rg::Texture depth, normal, roughnessMetal, motion, radiance, hitDistance, previousHistory;
+        rg::Texture depth, normal, roughnessMetal, motion, radiance, hitDistance, previousRadiance, previousSurface;
         rg::Texture hitMotion;  // the reflected points' motion, or the hit distance as a stand-in (never read)
-        rg::Texture historyOut, motionOut, lengthOut;
+        rg::Texture radianceOut, surfaceOut, motionOut, lengthOut;
     };
     const AccumulateData& accumulate = graph.addPass<AccumulateData>(
         "temporal.accumulate", rg::Queue::Graphics,
@@ -138,8 +141,10 @@ TemporalOutputs addTemporalPass(rg::Graph& graph, TemporalPipelines& pipelines, 
             d.radiance = b.read(inputs.radiance, rg::Access::SampledRead);
             d.hitDistance = b.read(inputs.hitDistance, rg::Access::SampledRead);
             d.hitMotion = inputs.hitMotion.valid() ? b.read(inputs.hitMotion, rg::Access::SampledRead) : d.hitDistance;
-            d.previousHistory = b.read(history.previous, rg::Access::SampledRead);
-            d.historyOut = b.write(history.current, rg::Access::StorageWrite);
+            d.previousRadiance = b.read(radianceHistory.previous, rg::Access::SampledRead);
+            d.previousSurface = b.read(surfaceHistory.previous, rg::Access::SampledRead);
+            d.radianceOut = b.write(radianceHistory.current, rg::Access::StorageWrite);
+            d.surfaceOut = b.write(surfaceHistory.current, rg::Access::StorageWrite);
             d.motionOut = b.write(b.createTexture("temporal.reflection_motion", desc(kTemporalMotionFormat)),
                                   rg::Access::StorageWrite);
             d.lengthOut = b.write(b.createTexture("temporal.history_length", desc(kTemporalHistoryLengthFormat)),
@@ -158,9 +163,12 @@ TemporalOutputs addTemporalPass(rg::Graph& graph, TemporalPipelines& pipelines, 
                 .sampledImage("radianceTexture", pc.view(d.radiance), sampler, pc.layout(d.radiance))
                 .sampledImage("hitDistanceTexture", pc.view(d.hitDistance), sampler, pc.layout(d.hitDistance))
                 .sampledImage("hitMotionTexture", pc.view(d.hitMotion), sampler, pc.layout(d.hitMotion))
-                .sampledImage("previousHistoryTexture", pc.view(d.previousHistory), sampler,
-                              pc.layout(d.previousHistory))
-                .storageImage("historyImage", pc.view(d.historyOut))
+                .sampledImage("previousRadianceTexture", pc.view(d.previousRadiance), sampler,
+                              pc.layout(d.previousRadiance))
+                .sampledImage("previousSurfaceTexture", pc.view(d.previousSurface), sampler,
+                              pc.layout(d.previousSurface))
+                .storageImage("radianceHistory", pc.view(d.radianceOut))
+                .storageImage("surfaceHistory", pc.view(d.surfaceOut))
                 .storageImage("motionImage", pc.view(d.motionOut))
                 .storageImage("lengthImage", pc.view(d.lengthOut))
                 .push(pipelines.ctx_, pc.cmd());
@@ -169,7 +177,7 @@ TemporalOutputs addTemporalPass(rg::Graph& graph, TemporalPipelines& pipelines, 
 
     struct SpatialData {
         rg::Buffer frame;
-        rg::Texture depth, history;
+        rg::Texture depth, surface, accumulated;
         rg::Texture resolved;
     };
     const SpatialData& spatial = graph.addPass<SpatialData>(
@@ -177,7 +185,8 @@ TemporalOutputs addTemporalPass(rg::Graph& graph, TemporalPipelines& pipelines, 
         [&](rg::Builder& b, SpatialData& d) {
             d.frame = b.read(accumulate.frame, rg::Access::SampledRead);
             d.depth = b.read(gbuf.depth, rg::Access::SampledRead);
-            d.history = b.read(accumulate.historyOut, rg::Access::SampledRead);
+            d.surface = b.read(accumulate.surfaceOut, rg::Access::SampledRead);
+            d.accumulated = b.read(accumulate.radianceOut, rg::Access::SampledRead);
             d.resolved = b.write(b.createTexture("temporal.resolved", desc(kTemporalResolvedFormat)),
                                  rg::Access::StorageWrite);
         },
@@ -188,7 +197,8 @@ TemporalOutputs addTemporalPass(rg::Graph& graph, TemporalPipelines& pipelines, 
             gpu::PushDescriptors(pipeline)
                 .uniformBuffer("Frame", pc.buffer(d.frame))
                 .sampledImage("depthTexture", pc.view(d.depth), sampler, pc.layout(d.depth))
-                .sampledImage("historyTexture", pc.view(d.history), sampler, pc.layout(d.history))
+                .sampledImage("surfaceTexture", pc.view(d.surface), sampler, pc.layout(d.surface))
+                .sampledImage("accumulatedTexture", pc.view(d.accumulated), sampler, pc.layout(d.accumulated))
                 .storageImage("resolvedImage", pc.view(d.resolved))
                 .push(pipelines.ctx_, pc.cmd());
             pc.dispatch(pipeline, groups(width), groups(height));

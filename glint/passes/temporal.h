@@ -16,7 +16,7 @@
 //                        surfaces, into the resolved image only; its taps
 //                        read the surface the accumulation wrote this frame
 //                        (view depth, roughness, normal in one texel).
-// History lives in a graph history texture (glint/temporal_shared.h);
+// History lives in two graph history textures (glint/temporal_shared.h);
 // the executor ping-pongs them, so two frames in flight are safe. The first
 // frame finds them cleared (length 0: no history); resetHistory discards
 // them on a camera cut. The pairs are named by the image size, so a graph
@@ -42,20 +42,17 @@ namespace glint::passes {
 inline constexpr VkFormat kTemporalResolvedFormat = VK_FORMAT_R16G16B16A16_SFLOAT;
 inline constexpr VkFormat kTemporalMotionFormat = VK_FORMAT_R16G16_SFLOAT;
 inline constexpr VkFormat kTemporalHistoryLengthFormat = VK_FORMAT_R16_SFLOAT;
-// The history (glint/temporal_shared.h's temporal.history): eight half
-// floats a texel, radiance with its length and the surface the rejection
-// tests and the spatial filter's weights read, so that each of their taps
-// is one 16-byte fetch instead of two 8-byte ones.
-// The radiance is rounded to half floats stochastically by the
-// accumulation: at a weight of 1/64 per frame, rounding to nearest would
-// stall the average up to 32 of a half float's steps (2^-11 to 2^-10
-// relative) from the mean (64 where conversions round towards zero, as
-// Vulkan allows for 16-bit floats), a bias of 2-6%, visible as darkening.
-// The shader stores one of the two half floats around each value, the upper
-// with probability proportional to the distance from the lower, so the
-// stored value's mean is the value itself and no rounding mode applies
-// (shaders/temporal/accumulate.comp). Half the bytes of RGBA32F radiance.
-inline constexpr VkFormat kTemporalHistoryFormat = VK_FORMAT_R32G32B32A32_UINT;
+// Half floats, rounded stochastically by the accumulation: at a weight of
+// 1/64 per frame, rounding to nearest would stall the average up to 32 of
+// a half float's steps (2^-11 to 2^-10 relative) from the mean (64 where
+// stores round towards zero, as Vulkan allows for 16-bit floats), a bias of
+// 2-6%, visible as darkening. The shader stores one of the two half floats
+// around each value, the upper with probability proportional to the
+// distance from the lower, so the stored value's mean is the value itself
+// and no rounding mode applies (shaders/temporal/accumulate.comp). Half the
+// bytes of RGBA32F for every history tap and spatial filter tap.
+inline constexpr VkFormat kTemporalRadianceHistoryFormat = VK_FORMAT_R16G16B16A16_SFLOAT;
+inline constexpr VkFormat kTemporalSurfaceHistoryFormat = VK_FORMAT_R16G16B16A16_SFLOAT;
 
 struct TemporalInputs {
     GBufferOutputs gbuffer;   // depth, normal, roughnessMetal, motion

@@ -78,13 +78,13 @@ vec3 worldPosition(vec2 pixelPosition, float depth) {
     return world.xyz / world.w;
 }
 
-// Where the surface seen at `texel` (this frame; at world `position`) was
-// last frame: the G-buffer's motion there (`motion`, read by the caller)
-// gives last frame's pixel, and the point is taken at the view depth last
-// frame's camera has for `position` (exact for motion across the view; the
-// G-buffer keeps no depth motion). Returns last frame's position minus
-// this one's.
-vec3 surfaceMotion(ivec2 texel, vec2 motion, vec3 position) {
+// Where the surface seen at pixel position `pixelPosition` (pixels, this
+// frame) was last frame: the G-buffer's motion there gives last frame's
+// pixel, and the point is taken at the view depth last frame's camera has
+// for `position` (exact for motion across the view; the G-buffer keeps no
+// depth motion). Returns last frame's position minus this one's.
+vec3 surfaceMotion(ivec2 texel, vec3 position) {
+    const vec2 motion = texelFetch(motionTexture, texel, 0).xy;
     if (!isFinite(motion)) {
         return vec3(0.0);
     }
@@ -241,13 +241,11 @@ Reflection integratePixel(uvec2 pixel) {
         // The reflected point is the surface the depth buffer holds at the
         // hit texel, measured from this pixel's own surface.
         const ivec2 hitTexel = clamp(ivec2(floor(sslrHitUv * vec2(C.size))), ivec2(0), ivec2(C.size) - 1);
-        // The hit's depth and motion, read together.
         const float hitDepth = texelFetch(depthTexture, hitTexel, 0).x;
-        const vec2 hitSurfaceMotion = texelFetch(motionTexture, hitTexel, 0).xy;
         if (hitDepth > 0.0) {
             const vec3 hitPosition = worldPosition(vec2(hitTexel) + 0.5, hitDepth);
             r.hitDistance = min(length(hitPosition - position), kMissHitDistance);
-            r.hitMotion = surfaceMotion(hitTexel, hitSurfaceMotion, hitPosition);
+            r.hitMotion = surfaceMotion(hitTexel, hitPosition);
         }
     }
     // Particles between the surface and what it reflects (the leader's

@@ -24,7 +24,7 @@
 //      "High Quality Temporal Supersampling", SIGGRAPH 2014);
 //   5. an exponential moving average with weight 1 / history length, the
 //      length capped at maxHistoryFrames, stored in half floats rounded
-//      stochastically (passes/temporal.h's kTemporalHistoryFormat).
+//      stochastically (passes/temporal.h's kTemporalRadianceHistoryFormat).
 #extension GL_GOOGLE_include_directive : require
 #extension GL_EXT_scalar_block_layout : require
 
@@ -42,17 +42,17 @@ layout(set = 0, binding = 3) uniform sampler2D roughnessMetalTexture;
 layout(set = 0, binding = 4) uniform sampler2D motionTexture;
 layout(set = 0, binding = 5) uniform sampler2D radianceTexture;
 layout(set = 0, binding = 6) uniform sampler2D hitDistanceTexture;
-// Last frame's history and this frame's (glint/temporal_shared.h's
-// temporal.history: radiance, length and surface in one texel).
-layout(set = 0, binding = 7) uniform usampler2D previousHistoryTexture;
-layout(set = 0, binding = 8, rgba32ui) uniform writeonly uimage2D historyImage;
+layout(set = 0, binding = 7) uniform sampler2D previousRadianceTexture;
+layout(set = 0, binding = 8) uniform sampler2D previousSurfaceTexture;
+layout(set = 0, binding = 9, rgba16f) uniform writeonly image2D radianceHistory;
+layout(set = 0, binding = 10, rgba16f) uniform writeonly image2D surfaceHistory;
 // RG16F and R16F are not among the formats every device can store with a
 // format qualifier; the context enables shaderStorageImageWriteWithoutFormat.
-layout(set = 0, binding = 9) uniform writeonly image2D motionImage;
-layout(set = 0, binding = 10) uniform writeonly image2D lengthImage;
+layout(set = 0, binding = 11) uniform writeonly image2D motionImage;
+layout(set = 0, binding = 12) uniform writeonly image2D lengthImage;
 // xyz: where the reflected point was last frame minus where it is (world;
 // passes/integrate.h's hitMotion). Read where frame.hitMotionBound says so.
-layout(set = 0, binding = 11) uniform sampler2D hitMotionTexture;
+layout(set = 0, binding = 13) uniform sampler2D hitMotionTexture;
 
 vec3 rgbToYCoCg(vec3 c) {
     return vec3(0.25 * c.r + 0.5 * c.g + 0.25 * c.b, 0.5 * c.r - 0.5 * c.b, -0.25 * c.r + 0.5 * c.g - 0.25 * c.b);
@@ -98,21 +98,25 @@ struct Pixel {
     vec3 planeStep;
 };
 
-// Whether a history texel (its radiance and surface as fetched) holds
-// last frame's view of this pixel's surface: false off the plane (by more
-// than planeTolerance of the view depth: a disocclusion, or an object that
-// moved across depth), turned away, of another roughness, or holding
-// nothing usable. An environment pixel skips the surface tests
-// (passes/temporal.h, TemporalInputs::environmentRoughness): a history
-// length says a surface was there (writeNothing stores none).
-bool historyTapValid(ivec2 texel, Pixel px, vec4 radiance, vec4 surface) {
-    if (!(radiance.a >= 1.0) || !isFinite(radiance.rgb)) {
+// One history texel, or false where last frame saw another surface there:
+// off the plane (by more than planeTolerance of the view depth: a
+// disocclusion, or an object that moved across depth), turned away, of
+// another roughness, or holding nothing usable. An environment pixel skips
+// the surface tests (passes/temporal.h, TemporalInputs::environmentRoughness).
+bool historyTap(ivec2 texel, Pixel px, out vec4 radiance) {
+    radiance = vec4(0.0);
+    if (any(lessThan(texel, ivec2(0))) || any(greaterThanEqual(texel, ivec2(frame.size)))) {
         return false;
     }
     if (px.environment) {
-        return true;
+        // A history length says a surface was there (writeNothing stores
+        // none): its radiance alone is read.
+        radiance = texelFetch(previousRadianceTexture, texel, 0);
+        return radiance.a >= 1.0 && isFinite(radiance.rgb);
     }
-    if (!(surface.x > 0.0) || !isFinite(surface.yzw)) {
+    const vec4 surface = texelFetch(previousSurfaceTexture, texel, 0);
+    radiance = texelFetch(previousRadianceTexture, texel, 0);
+    if (!(surface.x > 0.0) || !(radiance.a >= 1.0) || !isFinite(radiance.rgb) || !isFinite(surface.yzw)) {
         return false;
     }
     const vec2 d = vec2(texel - px.texel);
@@ -144,25 +148,14 @@ bool sampleHistory(vec2 position, Pixel px, out vec3 radiance, out float history
     }
     const vec2 base = floor(position - 0.5);
     const vec2 f = position - 0.5 - base;
-    // The four taps' texels are all fetched (at clamped coordinates) before
-    // any is tested: their latencies overlap instead of adding up, as they
-    // did with each fetch behind the previous tap's tests.
-    ivec2 texels[4];
-    vec4 radiances[4];
-    vec4 surfaces[4];
-    for (int i = 0; i < 4; ++i) {
-        texels[i] = ivec2(base) + ivec2(i & 1, i >> 1);
-        unpackHistory(texelFetch(previousHistoryTexture, clamp(texels[i], ivec2(0), ivec2(frame.size) - 1), 0),
-                      radiances[i], surfaces[i]);
-    }
     float weightSum = 0.0;
     for (int i = 0; i < 4; ++i) {
         const ivec2 offset = ivec2(i & 1, i >> 1);
         const float weight = (offset.x == 1 ? f.x : 1.0 - f.x) * (offset.y == 1 ? f.y : 1.0 - f.y);
-        const bool inside = all(greaterThanEqual(texels[i], ivec2(0))) && all(lessThan(texels[i], ivec2(frame.size)));
-        if (weight > 0.0 && inside && historyTapValid(texels[i], px, radiances[i], surfaces[i])) {
-            radiance += weight * radiances[i].rgb;
-            historyLength += weight * radiances[i].a;
+        vec4 tap;
+        if (weight > 0.0 && historyTap(ivec2(base) + offset, px, tap)) {
+            radiance += weight * tap.rgb;
+            historyLength += weight * tap.a;
             weightSum += weight;
         }
     }
@@ -178,7 +171,8 @@ bool sampleHistory(vec2 position, Pixel px, out vec3 radiance, out float history
 // with probability (x - lower) / (upper - lower) for u uniform in [0, 1),
 // so the mean is x, where rounding to nearest (or towards zero) would stall
 // an average whose steps are below half a half float's step. The result is
-// a half float, which packHalf2x16 keeps exactly whatever its rounding. From the bits (a float32 whose 13 low mantissa bits are zero is
+// a half float, which the RGBA16F store keeps exactly whatever its
+// rounding. From the bits (a float32 whose 13 low mantissa bits are zero is
 // a half float in the half's normal range; the next one up is 2^13 bits
 // on), not through packHalf2x16 and back: on lavapipe that round trip came
 // back as x itself (the history was bit-identical to a plain store's), as
@@ -209,7 +203,8 @@ void writeDebugOutputs(ivec2 p, vec2 motion, float historyLength) {
 }
 
 void writeNothing(ivec2 p, vec2 motion) {
-    imageStore(historyImage, p, uvec4(0u));
+    imageStore(radianceHistory, p, vec4(0.0));
+    imageStore(surfaceHistory, p, vec4(0.0));
     writeDebugOutputs(p, motion, 0.0);
 }
 
@@ -408,6 +403,7 @@ void main() {
     const float u = scalarNoise(uvec2(p), frame.frame, kNoiseHistoryRounding);
     result = vec3(roundToHalf(result.r, u), roundToHalf(result.g, u), roundToHalf(result.b, u));
 
-    imageStore(historyImage, p, packHistory(vec4(result, newLength), vec4(px.w, px.roughness, octEncode(px.normal))));
+    imageStore(radianceHistory, p, vec4(result, newLength));
+    imageStore(surfaceHistory, p, vec4(px.w, px.roughness, octEncode(px.normal)));
     writeDebugOutputs(p, reflectionMotion, newLength);
 }

@@ -18,12 +18,12 @@
 layout(local_size_x = 8, local_size_y = 8) in;
 
 layout(set = 0, binding = 1) uniform sampler2D depthTexture;
-// This frame's history as the accumulation wrote it (temporal.history):
-// the accumulated radiance and the surface (view depth, roughness,
-// octahedral normal) in one read a tap, instead of the G-buffer's three
-// and the radiance.
-layout(set = 0, binding = 2) uniform usampler2D historyTexture;
-layout(set = 0, binding = 3, rgba16f) uniform writeonly image2D resolvedImage;
+// This frame's surface as the accumulation wrote it (temporal.surface:
+// view depth, roughness, octahedral normal): one read a tap instead of
+// the G-buffer's three.
+layout(set = 0, binding = 2) uniform sampler2D surfaceTexture;
+layout(set = 0, binding = 3) uniform sampler2D accumulatedTexture;
+layout(set = 0, binding = 4, rgba16f) uniform writeonly image2D resolvedImage;
 
 float ramp(float x, float start, float end) {
     if (x <= start) return 0.0;
@@ -36,13 +36,13 @@ void main() {
     if (p.x >= int(frame.size.x) || p.y >= int(frame.size.y)) {
         return;
     }
-    vec4 centre, surface;
-    unpackHistory(texelFetch(historyTexture, p, 0), centre, surface);
+    const vec4 centre = texelFetch(accumulatedTexture, p, 0);
     // No history length: nothing reflects here (or nothing finite yet).
     if (!(centre.a > 0.0)) {
         imageStore(resolvedImage, p, vec4(0.0));
         return;
     }
+    const vec4 surface = texelFetch(surfaceTexture, p, 0);
     const float roughness = surface.y;
     const float strength = ramp(roughness, frame.spatialRoughnessStart, frame.spatialRoughnessEnd);
     const int radius = int(min(frame.spatialRadius, kTemporalMaxSpatialRadius));
@@ -78,8 +78,8 @@ void main() {
             if ((dx == 0 && dy == 0) || any(lessThan(q, ivec2(0))) || any(greaterThanEqual(q, ivec2(frame.size)))) {
                 continue;
             }
-            vec4 tap, tapSurface;
-            unpackHistory(texelFetch(historyTexture, q, 0), tap, tapSurface);
+            const vec4 tap = texelFetch(accumulatedTexture, q, 0);
+            const vec4 tapSurface = texelFetch(surfaceTexture, q, 0);
             if (!(tap.a > 0.0) || !(tapSurface.x > 0.0)) continue;
             const float facing = dot(octDecode(clamp(tapSurface.zw, vec2(-1.0), vec2(1.0))), normal);
             if (!(facing > 0.0)) continue;

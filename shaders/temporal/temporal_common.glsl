@@ -50,17 +50,4 @@ vec3 planeDistanceSteps(mat4 inverseViewProjection, mat4 viewProjection, vec3 ca
     return vec3(e0, dot(e[1], normal) - e0, dot(e[2], normal) - e0);
 }
 
-// One texel of the history (glint/temporal_shared.h's temporal.history):
-// radiance (rgb) with its length in frames (a), and the surface (view
-// depth, roughness, octahedral normal), as eight half floats.
-void unpackHistory(uvec4 texel, out vec4 radiance, out vec4 surface) {
-    radiance = vec4(unpackHalf2x16(texel.x), unpackHalf2x16(texel.y));
-    surface = vec4(unpackHalf2x16(texel.z), unpackHalf2x16(texel.w));
-}
-
-uvec4 packHistory(vec4 radiance, vec4 surface) {
-    return uvec4(packHalf2x16(radiance.xy), packHalf2x16(radiance.zw), packHalf2x16(surface.xy),
-                 packHalf2x16(surface.zw));
-}
-
 #endif

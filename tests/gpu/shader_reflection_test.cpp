@@ -28,14 +28,14 @@ const gpu::ReflectedBinding& find(const gpu::ShaderInterface& s, uint32_t bindin
 TEST_CASE("a shader's bindings, names and push-constant size come from its SPIR-V") {
     const gpu::ShaderInterface spatial =
         gpu::reflectShader(gpu::loadSpirv("temporal/spatial.comp"), VK_SHADER_STAGE_COMPUTE_BIT, "spatial");
-    REQUIRE(spatial.bindings.size() == 4);
+    REQUIRE(spatial.bindings.size() == 5);
     CHECK(find(spatial, 0).type == VK_DESCRIPTOR_TYPE_UNIFORM_BUFFER);
     CHECK(find(spatial, 0).name == "Frame");  // a block: its block name
     CHECK(find(spatial, 1).type == VK_DESCRIPTOR_TYPE_COMBINED_IMAGE_SAMPLER);
     CHECK(find(spatial, 1).name == "depthTexture");
-    CHECK(find(spatial, 3).type == VK_DESCRIPTOR_TYPE_STORAGE_IMAGE);
-    CHECK(find(spatial, 3).name == "resolvedImage");
-    CHECK(find(spatial, 3).stages == VK_SHADER_STAGE_COMPUTE_BIT);
+    CHECK(find(spatial, 4).type == VK_DESCRIPTOR_TYPE_STORAGE_IMAGE);
+    CHECK(find(spatial, 4).name == "resolvedImage");
+    CHECK(find(spatial, 4).stages == VK_SHADER_STAGE_COMPUTE_BIT);
     CHECK(spatial.pushConstantBytes == 0);
 
     const gpu::ShaderInterface clear =
@@ -65,8 +65,8 @@ TEST_CASE("a pipeline takes its layout from the shader, checks a stated table, a
     test::GpuTest gpu;
     auto& ctx = gpu.ctx();
     const gpu::Pipeline reflected = gpu::createComputePipeline(ctx, {"temporal/spatial.comp", {}, 0, "spatial"});
-    REQUIRE(reflected.layout().bindings().size() == 4);
-    CHECK(reflected.layout().binding("historyTexture").binding == 2);
+    REQUIRE(reflected.layout().bindings().size() == 5);
+    CHECK(reflected.layout().binding("accumulatedTexture").binding == 3);
     CHECK_THROWS_WITH_AS(reflected.layout().binding("noSuchTexture"),
                          doctest::Contains("pipeline 'spatial' has no binding named 'noSuchTexture'"), gpu::GpuError);
     gpu::PushDescriptors push(reflected);

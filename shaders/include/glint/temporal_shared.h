@@ -4,21 +4,18 @@
 // holds four matrices, more than the 128 bytes of push constants every
 // device guarantees.
 //
-// The history texture (ping-ponged by the graph across frames; its name
-// ends in the image size, ".<width>x<height>"):
-//   temporal.history  RGBA32UI, eight half floats (temporal_common.glsl's
-//                     packHistory and unpackHistory):
-//                     radiance rgb: accumulated reflection radiance before
-//                       the spatial filter, rounded stochastically to half
-//                       floats (passes/temporal.h); a: history length in
-//                       frames (0: none);
-//                     surface x: view depth (clip w) of the pixel's surface,
-//                       y: perceptual roughness, zw: octahedral world normal
-//                       (glint/packing.h's octEncode, unquantised); x = 0
-//                       where nothing reflects.
-//                     The accumulation writes it; the next frame's
-//                     accumulation reads it for its history and rejection
-//                     tests, this frame's spatial filter for its taps.
+// History textures (ping-ponged by the graph across frames; their names
+// end in the image size, ".<width>x<height>"):
+//   temporal.radiance  RGBA16F; rgb: accumulated reflection radiance before
+//                      the spatial filter, rounded stochastically to half
+//                      floats (passes/temporal.h); a: history length in
+//                      frames (0: none)
+//   temporal.surface   RGBA16F; x: view depth (clip w) of the pixel's surface,
+//                      y: perceptual roughness, zw: octahedral world normal
+//                      (glint/packing.h's octEncode, unquantised); x = 0
+//                      where nothing reflects. The accumulation writes it
+//                      for the next frame's rejection tests; the spatial
+//                      filter reads this frame's for its taps.
 #ifndef GLINT_TEMPORAL_SHARED_H
 #define GLINT_TEMPORAL_SHARED_H
 
