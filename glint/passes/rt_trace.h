@@ -23,9 +23,8 @@
 // Two backends with bit-identical results (one shared GLSL file,
 // glint/rt_trace.glsl): ray query in a compute shader (its candidate loop
 // runs the alpha test), or a ray tracing pipeline with one hit group (a
-// closest-hit shader, and an any-hit shader for the alpha test) and a
-// miss shader that clears the payload's hit flag, so that shadow rays skip
-// the closest-hit shader (NVIDIA has no ray query). Layouts:
+// closest-hit shader, and an any-hit shader for the alpha test) and an
+// empty miss shader (NVIDIA has no ray query). Layouts:
 // glint/rt_trace_shared.h.
 //
 //   passes::RtTracePipelines rtPipelines(ctx);          // once

@@ -1,15 +1,7 @@
 #version 460
-// The miss shader of the ray-traced reflections (passes/rt_trace.h): the
-// payload says "no hit". A reflection ray's payload starts so already; a
-// shadow ray's starts as occluded (trace.rgen's rtTraceOccluded), and this
-// is what clears it.
+// Empty on purpose (passes/rt_trace.h): the ray generation shader starts
+// every payload as a miss, so a miss has nothing to add.
 #extension GL_EXT_ray_tracing : require
-#extension GL_GOOGLE_include_directive : require
-
-#include "glint/rt_hit.glsl"
-
-layout(location = 0) rayPayloadInEXT RtHit payload;
 
 void main() {
-    payload.hit = 0u;
 }
