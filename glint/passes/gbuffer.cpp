@@ -616,6 +616,7 @@ GBufferOutputs addGBufferPass(rg::Graph& graph, GBufferRenderer& renderer, const
                 o.width = width;
                 o.height = height;
                 o.shadowResolution = shadowSize;
+                o.shadow = work->frame.shadow;
             },
             [&renderer, work, phase, environment = inputs.environment](const SurfaceData& d, rg::PassContext& pc) {
                 renderer.record(*work, pc, d.out, environment, phase, d.args);

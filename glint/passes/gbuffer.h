@@ -169,6 +169,9 @@ struct GBufferOutputs {
     uint32_t width = 0;
     uint32_t height = 0;
     uint32_t shadowResolution = 0;
+    // This frame's shadow map fit (enabled = 0 with shadows off): what a
+    // later pass that reads shadowMap needs to look it up.
+    shader::GBufferShadow shadow{};
     // With occlusion culling, the frame's counts (shader::kOcclusionStat*,
     // u32 words, glint/occlusion_shared.h), final after "gbuffer.cull_late";
     // else invalid.

@@ -192,6 +192,11 @@ RtTraceOutputs addRtTracePass(rg::Graph& graph, RtTracePipelines& pipelines, con
     constants.shadows = settings.shadows ? 1u : 0u;
     constants.instanceMask = settings.instanceMask & 0xFFu;
     constants.alphaTest = settings.alphaTest ? 1u : 0u;
+    // The map is read only where the G-buffer rendered one this frame.
+    const bool shadowMap = settings.shadows && settings.shadowMapAtHits && gbuf.shadowMap.valid() &&
+                           gbuf.shadow.enabled != 0u;
+    constants.shadowMapAtHits = shadowMap ? 1u : 0u;
+    constants.shadow = gbuf.shadow;
 
     // This frame's constants, which are larger than push constants
     // guarantee. The outputs are written at the listed rays' pixels only,
@@ -227,6 +232,7 @@ RtTraceOutputs addRtTracePass(rg::Graph& graph, RtTracePipelines& pipelines, con
     struct TraceData {
         rg::Texture depth, normal, roughnessMetal;
         rg::Texture environment;  // the prefiltered image, or the normal as a stand-in (never read)
+        rg::Texture shadowMap;    // the G-buffer's shadow map, or the depth as a stand-in (never read)
         rg::Texture alphaMasks;
         rg::Buffer rayList, rayListArgs, pool, offsets, materials, alphaTriangles, deformMotion, constants;
         rg::AccelStruct tlas;
@@ -241,6 +247,7 @@ RtTraceOutputs addRtTracePass(rg::Graph& graph, RtTracePipelines& pipelines, con
             d.roughnessMetal = b.read(gbuf.roughnessMetal, rg::Access::SampledRead);
             // The procedural sky reads no texture: the normal fills the binding.
             d.environment = inputs.environment.valid() ? b.read(inputs.environment, rg::Access::SampledRead) : d.normal;
+            d.shadowMap = shadowMap ? b.read(gbuf.shadowMap, rg::Access::SampledRead) : d.depth;
             d.rayList = b.read(inputs.rayList, rg::Access::StorageRead);
             // The indirect command, and the list's length for the ray query
             // backend's last, partial group.
@@ -271,6 +278,7 @@ RtTraceOutputs addRtTracePass(rg::Graph& graph, RtTracePipelines& pipelines, con
                 .sampledImage("environmentTexture", pc.view(d.environment), environmentSampler,
                               pc.layout(d.environment))
                 .sampledImage("depthTexture", pc.view(d.depth), sampler, pc.layout(d.depth))
+                .sampledImage("shadowMapTexture", pc.view(d.shadowMap), sampler, pc.layout(d.shadowMap))
                 .sampledImage("normalTexture", pc.view(d.normal), sampler, pc.layout(d.normal))
                 .sampledImage("roughnessMetalTexture", pc.view(d.roughnessMetal), sampler, pc.layout(d.roughnessMetal))
                 .storageBuffer("RayList", pc.buffer(d.rayList))

@@ -104,6 +104,15 @@ struct RtTraceSettings {
     // Sun visibility at hits from a shadow ray; off, hits are lit unshadowed
     // (as the G-buffer's lit colour is).
     bool shadows = true;
+    // With shadows: a hit the G-buffer's shadow map covers (inside its fit,
+    // nearer the camera than its fade) takes the sun's visibility from the
+    // map, filtered as the G-buffer filters it (the shadows SSLR's hits
+    // show), instead of tracing a shadow ray; the rest trace theirs. The
+    // shadow rays are a quarter of the trace's time on an H100 at 1080p
+    // (docs/results.md, fifth session). Off by default until measured
+    // against the reference: the map's shadows are the G-buffer's, not the
+    // exact ones the reference traces.
+    bool shadowMapAtHits = false;
     // Multiplies the robust origin offset (glint/rt_trace_shared.h); 0 turns
     // it off, which tests and the bench use to show what it prevents.
     float originOffsetScale = 1.0f;

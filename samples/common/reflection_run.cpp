@@ -61,7 +61,7 @@ constexpr std::array<bool, 3> kEveryMode{true, true, true};
 
 // The one table of parameters: name, field, the viewer's range, the
 // bench's sweep, and where the value lives.
-const std::array<ParameterSlot, 30> kParameters = {{
+const std::array<ParameterSlot, 31> kParameters = {{
     // A confidence; the talk's 0.9 (default) bracketed from "trust SSLR
     // often" to "almost never".
     {{"sslr_threshold", "ReflectionFrameSettings::confidenceThreshold", 0.0f, 1.0f, false, {0.5, 0.7, 0.8, 0.95, 0.99},
@@ -165,6 +165,10 @@ const std::array<ParameterSlot, 30> kParameters = {{
     // that faces it): what the shadow rays cost.
     {{"rt_shadows", "RtTraceSettings::shadows (0 or 1)", 0.0f, 1.0f, true, {0}, {}, kTraced}, nullptr, nullptr,
      [](ReflectionRunOptions& o) { return &o.frame.rt.shadows; }},
+    // Hits the shadow map covers take its visibility instead of a shadow
+    // ray (default off): faster, the G-buffer's shadows instead of exact.
+    {{"rt_shadow_map", "RtTraceSettings::shadowMapAtHits (0 or 1)", 0.0f, 1.0f, true, {1}, {1}, kTraced}, nullptr,
+     nullptr, [](ReflectionRunOptions& o) { return &o.frame.rt.shadowMapAtHits; }},
     // BLASes from full detail instead of the reflection LODs (default on):
     // what the LODs cost in error.
     {{"reflection_lods", "BvhSettings::reflectionLods (0: BLASes from full detail)", 0.0f, 1.0f, true, {0}, {0},

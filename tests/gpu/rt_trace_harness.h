@@ -299,7 +299,8 @@ public:
     }
 
     RtFrame trace(passes::RtTracePipelines& pipelines, const RayList& list, const shader::SceneLighting& lighting,
-                  const passes::RtTraceSettings& settings, float maxDistance = scene::kDefaultBvhRadius) {
+                  const passes::RtTraceSettings& settings, float maxDistance = scene::kDefaultBvhRadius,
+                  float shadowDistance = 2.0f * scene::kDefaultBvhRadius) {
         REQUIRE(list.entries.size() <= size_t(kSize) * kSize);
         REQUIRE(list.count <= list.entries.size());
         std::memcpy(rays_.mapped(), list.entries.data(), list.entries.size() * sizeof(shader::PackedRay));
@@ -331,6 +332,7 @@ public:
         resources.bind(args, args_);
         passes::RtTraceInputs inputs{gbuf, rays, args, bvh, lighting, camera_, frame_};
         inputs.maxDistance = maxDistance;
+        inputs.shadowDistance = shadowDistance;
         const passes::RtTraceOutputs out = passes::addRtTracePass(graph, pipelines, inputs, settings);
         REQUIRE(out.width == kSize);
         REQUIRE(out.height == kSize);

@@ -266,6 +266,82 @@ TEST_CASE("RT hits interpolate the packed triangle and light it as the CPU does;
     }
 }
 
+TEST_CASE("hits the G-buffer's shadow map covers take the sun's visibility from it") {
+    test::GpuTest gpu;
+    const auto backends = availableBackends(gpu.ctx());
+    REQUIRE_FALSE(backends.empty());
+    // The scene's sun is the test lighting's, so that the G-buffer's map
+    // holds the roof's shadow where the shadow rays find it.
+    scene::Scene s = hitScene();
+    s.sun.directionToLight = kSun;
+    Rig rig(gpu.ctx(), std::move(s), test::testCamera());
+    const CpuScene cpu(rig.scene());
+    const std::vector<ListedRay> rays = hitTestRays(rig, 3);
+    const RayList list = toList(rays);
+    const shader::SceneLighting lit = sunAndSky();
+    // Shadow rays a hundredth of a unit long reach no roof: only the map
+    // can shadow a hit.
+    const float shortShadows = 0.01f;
+    for (const passes::RtBackend backend : backends) {
+        CAPTURE(passes::rtBackendName(backend));
+        passes::RtTracePipelines pipelines(gpu.ctx(), backend);
+        passes::RtTraceSettings settings = settingsFor(backend);
+        const RtFrame rayFrame = rig.trace(pipelines, list, lit, settings, scene::kDefaultBvhRadius, shortShadows);
+        settings.shadowMapAtHits = true;
+        const RtFrame mapFrame = rig.trace(pipelines, list, lit, settings, scene::kDefaultBvhRadius, shortShadows);
+        uint32_t shadowed = 0, sunlit = 0;
+        float worst = 0.0f;
+        for (const ListedRay& r : rays) {
+            if (!r.aimedAtTarget) continue;
+            CAPTURE(r.pixel.x);
+            CAPTURE(r.pixel.y);
+            const size_t i = pixelIndex(r.pixel);
+            const glm::dvec3 origin = rig.rayOrigin(mapFrame, r.pixel, {0, 1, 0});
+            const CpuHit h = cpu.trace(origin, glm::dvec3(r.direction), 0.0, floorRayLength(settings));
+            REQUIRE(h.hit);
+            const glm::vec3 position = glm::vec3(origin + h.t * glm::dvec3(r.direction));
+            const CpuSurface packed = hitSurface(h, position, r.direction, true);
+            if (!(glm::dot(packed.normal, kSun) > 0.0f)) continue;  // turned from the sun: no shadow to find
+            // The roof's shadow, analytically; the map's filter and biases
+            // blur its edge over a few of its texels: hits within a hand's
+            // width of the edge are left out.
+            const glm::dvec3* v = h.triangle->v;
+            const glm::dvec3 e1 = glm::normalize(v[1] - v[0]), e2 = glm::normalize(v[2] - v[0]);
+            const glm::dvec3 face = glm::normalize(glm::cross(e1, e2));
+            const glm::dvec3 lift = face * (glm::dot(face, glm::dvec3(kSun)) > 0.0 ? 1e-4 : -1e-4);
+            bool anyOccluded = false, allOccluded = true;
+            for (const glm::dvec3 offset : {glm::dvec3(0), 0.1 * e1, -0.1 * e1, 0.1 * e2, -0.1 * e2}) {
+                const bool occluded =
+                    cpu.trace(glm::dvec3(position) + offset + lift, glm::dvec3(kSun), 0.0, 200.0, false).hit;
+                anyOccluded = anyOccluded || occluded;
+                allOccluded = allOccluded && occluded;
+            }
+            if (anyOccluded != allOccluded) continue;
+            (allOccluded ? shadowed : sunlit)++;
+            const glm::vec3 litColour = shadeSurface(lit, packed, -r.direction, 1.0f);
+            // The short shadow rays find nothing: every hit sunlit.
+            CHECK_MESSAGE(near(glm::vec3(rayFrame.radiance[i]), litColour, 3e-3f, 3e-4f),
+                          text(glm::vec3(rayFrame.radiance[i])) << " vs " << text(litColour));
+            // The map shadows those under the roof. Its visibility is the
+            // G-buffer's, filtered over a few texels and biased against acne
+            // along the hit's shading normal (the G-buffer's is the geometric
+            // one), so it is read back from the radiance (linear in it) and
+            // compared with a tolerance.
+            const glm::vec3 dark = shadeSurface(lit, packed, -r.direction, 0.0f);
+            const float sunTerm = glm::dot(litColour - dark, glm::vec3(1.0f));
+            REQUIRE(sunTerm > 1e-3f);
+            const float visibility = glm::dot(glm::vec3(mapFrame.radiance[i]) - dark, glm::vec3(1.0f)) / sunTerm;
+            worst = std::max(worst, std::abs(visibility - (allOccluded ? 0.0f : 1.0f)));
+            CHECK_MESSAGE(std::abs(visibility - (allOccluded ? 0.0f : 1.0f)) < 0.15f,
+                          "visibility " << visibility << " where the roof " << (allOccluded ? "shadows" : "does not"));
+        }
+        MESSAGE(sunlit << " sunlit and " << shadowed << " shadowed hits; the map's visibility at most " << worst
+                       << " from the analytic one");
+        CHECK(sunlit > 10);
+        CHECK(shadowed > 10);
+    }
+}
+
 TEST_CASE("without shadows the roof's shadow is gone; rougher surfaces trace shorter rays") {
     test::GpuTest gpu;
     Rig rig(gpu.ctx(), hitScene(), test::testCamera());

@@ -10,7 +10,9 @@
 // ray's length shrinks with the surface's roughness; a hit's packed
 // primitive (glint/packing.h) is interpolated at the hit's barycentrics and
 // lit with the G-buffer's own lighting (glint/brdf.glsl's shadeSurface),
-// the sun's visibility from a shadow ray, plus its geometry's emission (one
+// the sun's visibility from a shadow ray (or, with shadowMapAtHits, from
+// the G-buffer's shadow map where it covers the hit), plus its geometry's
+// emission (one
 // colour per geometry: the material's mean, scaled as the G-buffer scales
 // emission); a miss takes the environment. Both rays pass through the
 // cut-outs of alpha-tested geometry (glint/rt_geometry.glsl).
@@ -51,6 +53,10 @@ layout(set = 0, binding = 15) uniform writeonly image2D hitMotionImage;
 layout(set = 0, binding = 16, scalar) readonly buffer DeformMotions { DeformMotion deformMotions[]; };
 // Bindings 12-14: the material rows and the alpha test.
 #include "glint/rt_geometry.glsl"
+// The G-buffer's shadow map (read where rt.shadowMapAtHits is 1; otherwise
+// a stand-in texture).
+layout(set = 0, binding = 17) uniform sampler2D shadowMapTexture;
+#include "glint/sun_shadow.glsl"
 
 // The backend's traversals, both with rt.instanceMask and rtRayFlags():
 // alpha-tested geometry is not opaque in its BLAS, and a candidate counts
@@ -197,10 +203,25 @@ void rtTraceListEntry(uint index) {
     const vec3 toSun = rt.lighting.sunDirection.xyz;
     float sunVisibility = 1.0;
     // Facing away from the sun, the sun adds nothing whatever its visibility.
-    if (rt.shadows != 0u && dot(s.normal, toSun) > 0.0) {
-        // The hit point's error grows with the origin's magnitude and t.
-        const vec3 shadowOrigin = rtOffsetOrigin(s.position, s.normal, ray.origin, hit.t, 0.0);
-        sunVisibility = rtTraceOccluded(shadowOrigin, toSun, rt.shadowDistance) ? 0.0 : 1.0;
+    const float NoL = dot(s.normal, toSun);
+    if (rt.shadows != 0u && NoL > 0.0) {
+        // The shadow map where it covers the hit (inside it; a map fitted
+        // to the view fades out from fadeStart, and from there the ray
+        // answers; a map of the whole scene does not fade), else a shadow
+        // ray.
+        float mapVisibility = -1.0;
+        const bool faded = rt.shadow.fadeEnd > rt.shadow.fadeStart &&
+                           !(distance(s.position, rt.cameraPosition.xyz) < rt.shadow.fadeStart);
+        if (rt.shadowMapAtHits != 0u && !faded) {
+            mapVisibility = sunShadowMapVisibility(shadowMapTexture, rt.shadow, NoL, s.position, s.normal);
+        }
+        if (mapVisibility >= 0.0) {
+            sunVisibility = mapVisibility;
+        } else {
+            // The hit point's error grows with the origin's magnitude and t.
+            const vec3 shadowOrigin = rtOffsetOrigin(s.position, s.normal, ray.origin, hit.t, 0.0);
+            sunVisibility = rtTraceOccluded(shadowOrigin, toSun, rt.shadowDistance) ? 0.0 : 1.0;
+        }
     }
     // Emission, unlit and unshadowed as in the G-buffer's lit colour.
     const vec3 emission = rtGeometryMaterial(hit.customIndex, hit.geometry).emission * rt.lighting.sunDirection.w;

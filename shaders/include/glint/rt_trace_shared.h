@@ -79,12 +79,18 @@ struct RtTraceConstants {
     uint shadows;                // 1: trace a shadow ray towards the sun
     uint instanceMask;           // cull mask of every ray (glint/packing.h kInstanceMask*)
     uint alphaTest;              // 1: rays pass through alpha-tested cut-outs; 0: every triangle opaque
+    // 1: a hit the shadow map covers (inside it, nearer the camera than
+    // shadow.fadeStart) takes the sun's visibility from the map, filtered
+    // as the G-buffer's (glint/sun_shadow.glsl); other hits trace their
+    // shadow ray. 0: every hit traces one.
+    uint shadowMapAtHits;
+    GBufferShadow shadow;        // the G-buffer's shadow map fit this frame
 };
 
 GLINT_END
 
 #ifdef __cplusplus
-static_assert(sizeof(glint::shader::RtTraceConstants) == 364);
+static_assert(sizeof(glint::shader::RtTraceConstants) == 364 + 4 + 112);
 #endif
 
 #endif
