@@ -107,12 +107,14 @@ struct RtTraceSettings {
     // With shadows: a hit the G-buffer's shadow map covers (inside its fit,
     // nearer the camera than its fade) takes the sun's visibility from the
     // map, filtered as the G-buffer filters it (the shadows SSLR's hits
-    // show), instead of tracing a shadow ray; the rest trace theirs. The
-    // shadow rays are a quarter of the trace's time on an H100 at 1080p
-    // (docs/results.md, fifth session). Off by default until measured
-    // against the reference: the map's shadows are the G-buffer's, not the
-    // exact ones the reference traces.
-    bool shadowMapAtHits = false;
+    // and the direct view show), instead of tracing a shadow ray; the rest
+    // trace theirs. The shadow rays were a quarter of the trace's time: on
+    // an H100 at 1080p the plaza's reflections 0.667 -> 0.619 ms (hybrid)
+    // and 0.593 -> 0.527 (rt) at FLIP 0.06028 -> 0.06026 and 0.06108 ->
+    // 0.06105 against the exact reference; the city of 1,024 buildings
+    // 0.661 -> 0.631 and 0.902 -> 0.783 at the same FLIP (docs/results.md,
+    // fifth session). Off: a shadow ray from every hit (the reference's).
+    bool shadowMapAtHits = true;
     // Multiplies the robust origin offset (glint/rt_trace_shared.h); 0 turns
     // it off, which tests and the bench use to show what it prevents.
     float originOffsetScale = 1.0f;

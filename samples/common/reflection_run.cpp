@@ -165,9 +165,9 @@ const std::array<ParameterSlot, 31> kParameters = {{
     // that faces it): what the shadow rays cost.
     {{"rt_shadows", "RtTraceSettings::shadows (0 or 1)", 0.0f, 1.0f, true, {0}, {}, kTraced}, nullptr, nullptr,
      [](ReflectionRunOptions& o) { return &o.frame.rt.shadows; }},
-    // Hits the shadow map covers take its visibility instead of a shadow
-    // ray (default off): faster, the G-buffer's shadows instead of exact.
-    {{"rt_shadow_map", "RtTraceSettings::shadowMapAtHits (0 or 1)", 0.0f, 1.0f, true, {1}, {1}, kTraced}, nullptr,
+    // Hits the shadow map covers take its visibility (default on) against
+    // a shadow ray from every hit: the G-buffer's shadows or exact ones.
+    {{"rt_shadow_map", "RtTraceSettings::shadowMapAtHits (0 or 1)", 0.0f, 1.0f, true, {0}, {}, kTraced}, nullptr,
      nullptr, [](ReflectionRunOptions& o) { return &o.frame.rt.shadowMapAtHits; }},
     // BLASes from full detail instead of the reflection LODs (default on):
     // what the LODs cost in error.
@@ -306,6 +306,8 @@ ReflectionRunOptions referenceSettings(const ReflectionRunOptions& in) {
     // Every object in the BVH, rays without end (the long-range group
     // reaches at least as far).
     o.frame.reach = 1e30f;
+    // Exact shadows: a shadow ray from every hit, not the shadow map.
+    o.frame.rt.shadowMapAtHits = false;
     // Full detail: the reference is the scene itself, not its reflection LODs.
     o.renderer.bvh.reflectionLods = false;
     // Every BLAS on the first frame: the reference accumulates from there.
