@@ -15,7 +15,9 @@
 //   - a hit reads its triangle from the packed primitive pool through the
 //     primitive offset buffer, interpolates it at the barycentrics and
 //     lights it as the G-buffer lights its surfaces (glint/brdf.glsl's
-//     shadeSurface), the sun's visibility from a shadow ray, plus its
+//     shadeSurface), the sun's visibility from the G-buffer's shadow map
+//     where it covers the hit, else from a shadow ray
+//     (RtTraceSettings::shadowMapAtHits), plus its
 //     geometry's emission (the BVH's material rows);
 //   - both rays pass through the cut-outs of alpha-tested geometry
 //     (glint/rt_geometry.glsl, passes/bvh_hit_materials.h);

@@ -1,6 +1,7 @@
 // G-buffer surface: writes the attributes and lights the surface with the
 // unified lighting (glint/brdf.glsl), the sun shadowed by the shadow map
-// (shadow.glsl) as the ray-traced hits are by their shadow rays. Compiled
+// (shadow.glsl) as the ray-traced hits are (by the same map where it
+// covers them, else by shadow rays). Compiled
 // three times: gbuffer.frag (opaque materials) and gbuffer_masked.frag
 // (alpha-tested ones, GLINT_ALPHA_TEST 1), so that only the draws that
 // discard lose early depth testing, and transparent.frag (blended ones,

@@ -14,7 +14,8 @@
 //                  the sky's radiance with a = 0 where nothing was drawn.
 //                  The sun term is shadowed by the shadow map below; the
 //                  ambient term never is (the ray-traced hits light the same
-//                  way, their sun visibility from a shadow ray).
+//                  way, their sun visibility from this map where it covers
+//                  them, else from a shadow ray).
 //   shadowMap      the sun's shadow map (its own pass before the G-buffer):
 //                  D32_SFLOAT, square, an orthographic view along the sun's
 //                  rays. Reversed like the camera's depth: 1 at the side

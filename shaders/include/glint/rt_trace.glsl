@@ -12,9 +12,8 @@
 // lit with the G-buffer's own lighting (glint/brdf.glsl's shadeSurface),
 // the sun's visibility from a shadow ray (or, with shadowMapAtHits, from
 // the G-buffer's shadow map where it covers the hit), plus its geometry's
-// emission (one
-// colour per geometry: the material's mean, scaled as the G-buffer scales
-// emission); a miss takes the environment. Both rays pass through the
+// emission (one colour per geometry: the material's mean, scaled as the
+// G-buffer scales emission); a miss takes the environment. Both rays pass through the
 // cut-outs of alpha-tested geometry (glint/rt_geometry.glsl).
 #ifndef GLINT_RT_TRACE_GLSL
 #define GLINT_RT_TRACE_GLSL
