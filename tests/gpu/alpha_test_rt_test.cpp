@@ -242,7 +242,9 @@ TEST_CASE("shadow rays pass through alpha-tested cut-outs: a floor under a strip
     test::GpuTest gpu;
     const scene::Scene s = canopyScene();
     std::vector<Run> runs = {{passes::ReflectionMode::Rt, passes::RtBackend::Pipeline, true, false}};
-    if (gpu.ctx().caps().rayQuery) runs.push_back({passes::ReflectionMode::Rt, passes::RtBackend::RayQuery, true, false});
+    if (gpu.ctx().caps().rayQuery) {
+        runs.push_back({passes::ReflectionMode::Rt, passes::RtBackend::RayQuery, true, false});
+    }
     runs.push_back({passes::ReflectionMode::Rt, passes::RtBackend::Auto, false, false});
     // The shadow map holds the canopy's cut-outs too (the G-buffer's masked
     // shadow pipeline): with the map at the hits the stripes are there
@@ -251,6 +253,7 @@ TEST_CASE("shadow rays pass through alpha-tested cut-outs: a floor under a strip
     for (const Run& run : runs) {
         CAPTURE(std::string(passes::backendName(run.backend)));
         CAPTURE(run.alphaTest);
+        CAPTURE(run.shadowMapAtHits);
         const std::vector<uint8_t> image = render(gpu.ctx(), s, run);
         // The floor fills the mirror's lower half: count its sunlit and
         // shadowed pixels below the horizon's haze.
