@@ -21,8 +21,8 @@
 // procedural sky, with glint/brdf.glsl as the ray-traced hits light (their
 // sun visibility comes from this shadow map where it covers them, else
 // from a shadow ray, so a surface seen directly, in SSLR and in an RT
-// reflection is shadowed alike). GBufferOutputs::shadow is the map's fit. The shadow map is a
-// pass of its own ("shadow_map", graphics queue, before "gbuffer"): an
+// reflection is shadowed alike; GBufferOutputs::shadow is the map's fit).
+// The shadow map is a pass of its own ("shadow_map", graphics queue, before "gbuffer"): an
 // orthographic depth-only raster along the sun's rays of every instance's
 // LOD 0 that meets the map's box (blended geometry casts no shadow), the G-buffer's own vertex buffer and skinning, fitted to the
 // camera's view up to a distance or to the whole scene where that is

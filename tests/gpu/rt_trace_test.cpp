@@ -161,6 +161,27 @@ float floorRayLength(const passes::RtTraceSettings& s, float maxDistance = scene
     return maxDistance * glm::mix(1.0f, s.shortRangeFraction, k);
 }
 
+// Whether the roof shadows a hit, analytically: the sun's ray from the hit
+// and from four points `margin` away along the triangle's edges, each
+// lifted off the face towards the sun. Edge: they disagree (the hit lies
+// within `margin` of the shadow's edge, which the tests leave out).
+enum class SunShadow { Lit, Shadowed, Edge };
+
+SunShadow analyticSunShadow(const CpuScene& cpu, const CpuHit& h, glm::vec3 position, double margin) {
+    const glm::dvec3* v = h.triangle->v;
+    const glm::dvec3 e1 = glm::normalize(v[1] - v[0]), e2 = glm::normalize(v[2] - v[0]);
+    const glm::dvec3 face = glm::normalize(glm::cross(e1, e2));
+    const glm::dvec3 lift = face * (glm::dot(face, glm::dvec3(kSun)) > 0.0 ? 1e-4 : -1e-4);
+    bool anyOccluded = false, allOccluded = true;
+    for (const glm::dvec3 offset : {glm::dvec3(0), margin * e1, -margin * e1, margin * e2, -margin * e2}) {
+        const bool occluded = cpu.trace(glm::dvec3(position) + offset + lift, glm::dvec3(kSun), 0.0, 200.0, false).hit;
+        anyOccluded = anyOccluded || occluded;
+        allOccluded = allOccluded && occluded;
+    }
+    if (anyOccluded != allOccluded) return SunShadow::Edge;
+    return allOccluded ? SunShadow::Shadowed : SunShadow::Lit;
+}
+
 } // namespace
 
 TEST_CASE("RT hits interpolate the packed triangle and light it as the CPU does; misses give the environment") {
@@ -239,17 +260,9 @@ TEST_CASE("RT hits interpolate the packed triangle and light it as the CPU does;
 
             // Sun and sky, with an analytic shadow test. Hits within a
             // hand's width of the roof's shadow edge are left out.
-            const glm::dvec3* v = h.triangle->v;
-            const glm::dvec3 e1 = glm::normalize(v[1] - v[0]), e2 = glm::normalize(v[2] - v[0]);
-            const glm::dvec3 face = glm::normalize(glm::cross(e1, e2));
-            const glm::dvec3 lift = face * (glm::dot(face, glm::dvec3(kSun)) > 0.0 ? 1e-4 : -1e-4);
-            bool anyOccluded = false, allOccluded = true;
-            for (const glm::dvec3 offset : {glm::dvec3(0), 0.05 * e1, -0.05 * e1, 0.05 * e2, -0.05 * e2}) {
-                const bool occluded = cpu.trace(glm::dvec3(position) + offset + lift, glm::dvec3(kSun), 0.0, 200.0, false).hit;
-                anyOccluded = anyOccluded || occluded;
-                allOccluded = allOccluded && occluded;
-            }
-            if (anyOccluded != allOccluded) continue;
+            const SunShadow shadow = analyticSunShadow(cpu, h, position, 0.05);
+            if (shadow == SunShadow::Edge) continue;
+            const bool allOccluded = shadow == SunShadow::Shadowed;
             const float visibility = allOccluded ? 0.0f : 1.0f;
             (allOccluded ? shadowed : sunlit)++;
             const glm::vec3 expected = shadeSurface(lit, packed, -r.direction, visibility);
@@ -305,18 +318,9 @@ TEST_CASE("hits the G-buffer's shadow map covers take the sun's visibility from 
             // The roof's shadow, analytically; the map's filter and biases
             // blur its edge over a few of its texels: hits within a hand's
             // width of the edge are left out.
-            const glm::dvec3* v = h.triangle->v;
-            const glm::dvec3 e1 = glm::normalize(v[1] - v[0]), e2 = glm::normalize(v[2] - v[0]);
-            const glm::dvec3 face = glm::normalize(glm::cross(e1, e2));
-            const glm::dvec3 lift = face * (glm::dot(face, glm::dvec3(kSun)) > 0.0 ? 1e-4 : -1e-4);
-            bool anyOccluded = false, allOccluded = true;
-            for (const glm::dvec3 offset : {glm::dvec3(0), 0.1 * e1, -0.1 * e1, 0.1 * e2, -0.1 * e2}) {
-                const bool occluded =
-                    cpu.trace(glm::dvec3(position) + offset + lift, glm::dvec3(kSun), 0.0, 200.0, false).hit;
-                anyOccluded = anyOccluded || occluded;
-                allOccluded = allOccluded && occluded;
-            }
-            if (anyOccluded != allOccluded) continue;
+            const SunShadow shadow = analyticSunShadow(cpu, h, position, 0.1);
+            if (shadow == SunShadow::Edge) continue;
+            const bool allOccluded = shadow == SunShadow::Shadowed;
             (allOccluded ? shadowed : sunlit)++;
             const glm::vec3 litColour = shadeSurface(lit, packed, -r.direction, 1.0f);
             // The short shadow rays find nothing: every hit sunlit.
