@@ -506,6 +506,73 @@ TEST_CASE("only listed rays are traced; entries past the count, without a surfac
     }
 }
 
+TEST_CASE("a ray marked with SSLR's clear stretch starts where it ends; unmarked, off or unbound, at the surface") {
+    test::GpuTest gpu;
+    const auto backends = availableBackends(gpu.ctx());
+    REQUIRE_FALSE(backends.empty());
+    Rig rig(gpu.ctx(), hitScene(), test::testCamera());
+    const std::vector<ListedRay> rays = hitTestRays(rig, 3);
+    REQUIRE(rays.size() > 40);
+    const RayList plain = toList(rays);
+    const auto sameResult = [](const RtFrame& a, const RtFrame& b, size_t i) {
+        return a.radianceBits[i] == b.radianceBits[i] && a.hitDistance[i] == b.hitDistance[i];
+    };
+    for (const passes::RtBackend backend : backends) {
+        const std::string name = passes::rtBackendName(backend);
+        CAPTURE(name);
+        passes::RtTracePipelines pipelines(gpu.ctx(), backend);
+        passes::RtTraceSettings settings = settingsFor(backend);
+        const RtFrame base = rig.trace(pipelines, plain, whiteSky(), settings);
+        // Every entry marked: a ray aimed at the target that hits it is clear
+        // to half its hit (every other one) or to just past it; the rest
+        // (the rays into the sky, every fourth) are clear for 0 units,
+        // which starts them at their surface.
+        RayList marked = plain;
+        std::vector<float> clear(size_t(kSize) * kSize, 0.0f);
+        std::vector<int> kind(rays.size(), 0);  // 0: from the surface, 1: clear to half the hit, 2: past it
+        for (size_t k = 0; k < rays.size(); ++k) {
+            marked.entries[k].pixelFlags |= shader::kRayClearStart;
+            const size_t i = pixelIndex(rays[k].pixel);
+            const float t = base.hitDistance[i];
+            if (!rays[k].aimedAtTarget || !(t < shader::kMissHitDistance)) continue;
+            kind[k] = k % 2 == 0 ? 1 : 2;
+            clear[i] = kind[k] == 1 ? 0.5f * t : t + 0.25f;
+        }
+        const RtFrame resumed =
+            rig.trace(pipelines, marked, whiteSky(), settings, scene::kDefaultBvhRadius, 2.0f * scene::kDefaultBvhRadius, &clear);
+        std::array<uint32_t, 3> counts{};
+        for (size_t k = 0; k < rays.size(); ++k) {
+            const size_t i = pixelIndex(rays[k].pixel);
+            CAPTURE(k);
+            CAPTURE(kind[k]);
+            ++counts[size_t(kind[k])];
+            if (kind[k] == 2) {
+                // The target lies before the start: the ray passes it (the
+                // sky, or something beyond), its t still from the surface.
+                CHECK(resumed.hitDistance[i] > clear[i]);
+                CHECK(resumed.radiance[i].a == 1.0f);
+            } else {
+                // The same hit, measured from the same origin.
+                CHECK(sameResult(resumed, base, i));
+            }
+        }
+        CHECK(counts[1] > 10);
+        CHECK(counts[2] > 10);
+        // The marks are read only where the pass is told to use them, and
+        // with a texture to read.
+        passes::RtTraceSettings off = settings;
+        off.clearStart = false;
+        const RtFrame ignored =
+            rig.trace(pipelines, marked, whiteSky(), off, scene::kDefaultBvhRadius, 2.0f * scene::kDefaultBvhRadius, &clear);
+        const RtFrame unbound = rig.trace(pipelines, marked, whiteSky(), settings);
+        for (const ListedRay& r : rays) {
+            const size_t i = pixelIndex(r.pixel);
+            CHECK(sameResult(ignored, base, i));
+            CHECK(sameResult(unbound, base, i));
+        }
+    }
+}
+
 TEST_CASE("an unsupported backend is refused with a clear error") {
     gpu::ContextOptions options;
     options.disableRayQuery = true;
