@@ -261,10 +261,6 @@ ReflectionFrame ReflectionRenderer::addFrame(rg::Graph& graph, const scene::Came
         rtInputs.frameIndex = frameIndex;
         rtInputs.maxDistance = settings.reach;
         rtInputs.shadowDistance = 2.0f * settings.reach;
-        if (f.sslr) {
-            rtInputs.clearDistance = f.sslr->clearDistance;
-            rtInputs.ignoreClearDistance = f.screenSpaceIdle || f.sslrCountsOnly;
-        }
         RtTraceSettings rtSettings = settings.rt;
         rtSettings.clearUntraced = rtSettings.clearUntraced || viewsRt;
         f.rt = addRtTracePass(graph, *rt_, rtInputs, rtSettings);

@@ -197,8 +197,6 @@ RtTraceOutputs addRtTracePass(rg::Graph& graph, RtTracePipelines& pipelines, con
                            gbuf.shadow.enabled != 0u;
     constants.shadowMapAtHits = shadowMap ? 1u : 0u;
     constants.shadow = gbuf.shadow;
-    const bool clearStart = settings.clearStart && inputs.clearDistance.valid() && !inputs.ignoreClearDistance;
-    constants.clearStartBound = clearStart ? 1u : 0u;
 
     // This frame's constants, which are larger than push constants
     // guarantee. The outputs are written at the listed rays' pixels only,
@@ -235,8 +233,6 @@ RtTraceOutputs addRtTracePass(rg::Graph& graph, RtTracePipelines& pipelines, con
         rg::Texture depth, normal, roughnessMetal;
         rg::Texture environment;  // the prefiltered image, or the normal as a stand-in (never read)
         rg::Texture shadowMap;    // the G-buffer's shadow map, or the depth as a stand-in (never read)
-        rg::Texture clearDistance;  // SSLR's, declared wherever given
-        bool clearStart = false;    // bound (else the depth stands in, never read)
         rg::Texture alphaMasks;
         rg::Buffer rayList, rayListArgs, pool, offsets, materials, alphaTriangles, deformMotion, constants;
         rg::AccelStruct tlas;
@@ -252,9 +248,6 @@ RtTraceOutputs addRtTracePass(rg::Graph& graph, RtTracePipelines& pipelines, con
             // The procedural sky reads no texture: the normal fills the binding.
             d.environment = inputs.environment.valid() ? b.read(inputs.environment, rg::Access::SampledRead) : d.normal;
             d.shadowMap = shadowMap ? b.read(gbuf.shadowMap, rg::Access::SampledRead) : d.depth;
-            d.clearDistance = inputs.clearDistance.valid() ? b.read(inputs.clearDistance, rg::Access::SampledRead)
-                                                           : d.depth;
-            d.clearStart = clearStart;
             d.rayList = b.read(inputs.rayList, rg::Access::StorageRead);
             // The indirect command, and the list's length for the ray query
             // backend's last, partial group.
@@ -286,8 +279,6 @@ RtTraceOutputs addRtTracePass(rg::Graph& graph, RtTracePipelines& pipelines, con
                               pc.layout(d.environment))
                 .sampledImage("depthTexture", pc.view(d.depth), sampler, pc.layout(d.depth))
                 .sampledImage("shadowMapTexture", pc.view(d.shadowMap), sampler, pc.layout(d.shadowMap))
-                .sampledImage("clearDistanceTexture", pc.view(d.clearStart ? d.clearDistance : d.depth), sampler,
-                              pc.layout(d.clearStart ? d.clearDistance : d.depth))
                 .sampledImage("normalTexture", pc.view(d.normal), sampler, pc.layout(d.normal))
                 .sampledImage("roughnessMetalTexture", pc.view(d.roughnessMetal), sampler, pc.layout(d.roughnessMetal))
                 .storageBuffer("RayList", pc.buffer(d.rayList))

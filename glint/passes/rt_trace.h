@@ -11,9 +11,7 @@
 //     and with the depth reconstruction's error (the rasteriser's
 //     sub-pixel snapping included);
 //   - its length is maxDistance (the BVH's radius), shrinking as the
-//     surface's roughness grows (Far Cry 6 talk); a hybrid ray SSLR handed
-//     on starts where SSLR's march found it clear (RtTraceSettings::
-//     clearStart), its hit distance still measured from the origin;
+//     surface's roughness grows (Far Cry 6 talk);
 //   - a hit reads its triangle from the packed primitive pool through the
 //     primitive offset buffer, interpolates it at the barycentrics and
 //     lights it as the G-buffer lights its surfaces (glint/brdf.glsl's
@@ -87,16 +85,6 @@ struct RtTraceInputs {
     // Length of shadow rays: the BVH's diameter, so that an occluder anywhere
     // in the TLAS can shadow a hit anywhere in it.
     float shadowDistance = 2.0f * scene::kDefaultBvhRadius;
-    // SSLR's clear stretches (SslrOutputs::clearDistance, SampledRead) when
-    // rayList is SSLR's, else invalid: entries marked kRayClearStart start
-    // there (RtTraceSettings::clearStart).
-    rg::Texture clearDistance;
-    // clearDistance is declared all the same, so that the frame keeps its
-    // plan, but not read: a hybrid frame the host renders as rt
-    // (SslrInputs::screenSpaceIdle: SSLR handed nothing on), or a probe
-    // that renders as rt (SslrInputs::handEveryRay), whose RT result must
-    // be rt mode's.
-    bool ignoreClearDistance = false;
 };
 
 struct RtTraceSettings {
@@ -129,11 +117,6 @@ struct RtTraceSettings {
     // 0.661 -> 0.631 and 0.902 -> 0.783 at the same FLIP (docs/results.md,
     // fifth session). Off: a shadow ray from every hit (the reference's).
     bool shadowMapAtHits = true;
-    // A hybrid ray SSLR handed on starts where its march found it clear
-    // (RtTraceInputs::clearDistance, glint/sslr_shared.h): the camera sees
-    // nothing on that stretch, so the traversal skips it. Off: every ray
-    // starts at its surface.
-    bool clearStart = true;
     // Multiplies the robust origin offset (glint/rt_trace_shared.h); 0 turns
     // it off, which tests and the bench use to show what it prevents.
     float originOffsetScale = 1.0f;

@@ -79,10 +79,9 @@ SslrOutputs addSslrPass(rg::Graph& graph, SslrPipelines& pipelines, const SslrIn
     rg::Texture radiance = texture("sslr.radiance", kSslrRadianceFormat);
     rg::Texture confidence = texture("sslr.confidence", kSslrConfidenceFormat);
     rg::Texture hitDebug = texture("sslr.hit_debug", kSslrHitDebugFormat);
-    rg::Texture clearDistance = texture("sslr.clear_distance", kSslrClearDistanceFormat);
     if (settings.clearUntraced) {
         struct ClearData {
-            rg::Texture radiance, confidence, hitDebug, clearDistance;
+            rg::Texture radiance, confidence, hitDebug;
         };
         const ClearData& clear = graph.addPass<ClearData>(
             "sslr.clear", rg::Queue::Graphics,
@@ -90,17 +89,15 @@ SslrOutputs addSslrPass(rg::Graph& graph, SslrPipelines& pipelines, const SslrIn
                 d.radiance = b.write(radiance, rg::Access::StorageWrite);
                 d.confidence = b.write(confidence, rg::Access::StorageWrite);
                 d.hitDebug = b.write(hitDebug, rg::Access::StorageWrite);
-                d.clearDistance = b.write(clearDistance, rg::Access::StorageWrite);
             },
             [&pipelines](const ClearData& d, rg::PassContext& pc) {
-                for (const rg::Texture t : {d.radiance, d.confidence, d.hitDebug, d.clearDistance}) {
+                for (const rg::Texture t : {d.radiance, d.confidence, d.hitDebug}) {
                     pipelines.clearer_.clear(pc, t);
                 }
             });
         radiance = clear.radiance;
         confidence = clear.confidence;
         hitDebug = clear.hitDebug;
-        clearDistance = clear.clearDistance;
     }
 
     // The cone trace's colour pyramid (glint/sslr_shared.h): two passes,
@@ -223,7 +220,6 @@ SslrOutputs addSslrPass(rg::Graph& graph, SslrPipelines& pipelines, const SslrIn
             d.out.radiance = b.write(radiance, rg::Access::StorageWrite);
             d.out.confidence = b.write(confidence, rg::Access::StorageWrite);
             d.out.hitDebug = b.write(hitDebug, rg::Access::StorageWrite);
-            d.out.clearDistance = b.write(clearDistance, rg::Access::StorageWrite);
             // Appends after ray generation's RT rays.
             d.out.rtRayList = b.write(rays.rtRays, rg::Access::StorageReadWrite);
             d.out.rtArgs = b.write(rays.rtArgs, rg::Access::StorageReadWrite);
@@ -245,7 +241,6 @@ SslrOutputs addSslrPass(rg::Graph& graph, SslrPipelines& pipelines, const SslrIn
                 .storageImage("radianceImage", pc.view(d.out.radiance))
                 .storageImage("confidenceImage", pc.view(d.out.confidence))
                 .storageImage("hitDebugImage", pc.view(d.out.hitDebug))
-                .storageImage("clearDistanceImage", pc.view(d.out.clearDistance))
                 .storageBuffer("RtRays", pc.buffer(d.out.rtRayList))
                 .storageBuffer("RtArgs", pc.buffer(d.out.rtArgs))
                 .sampledImage("roughnessMetalTexture", pc.view(d.roughnessMetal), sampler, pc.layout(d.roughnessMetal))

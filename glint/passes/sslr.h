@@ -8,9 +8,7 @@
 // behind an occluder, shaders/sslr/trace.comp says when). It writes the lit colour at the hit and a confidence in
 // [0, 1], and lists the hybrid rays below the confidence threshold, with
 // indirect args, for the ray-traced pass: it appends them to ray
-// generation's RT ray list, each with the stretch its march found clear,
-// where the RT trace starts it (RtTraceSettings::clearStart). The rays ray
-// generation marks for the cone
+// generation's RT ray list. The rays ray generation marks for the cone
 // trace sample a box-filtered pyramid of the lit colour, built by two
 // passes before the trace that run no groups unless such a ray is listed.
 // Nothing is cleared: only traced pixels are written, and read.
@@ -38,7 +36,6 @@ namespace glint::passes {
 inline constexpr VkFormat kSslrRadianceFormat = VK_FORMAT_R16G16B16A16_SFLOAT;
 inline constexpr VkFormat kSslrConfidenceFormat = VK_FORMAT_R16_SFLOAT;
 inline constexpr VkFormat kSslrHitDebugFormat = VK_FORMAT_R16G16B16A16_SFLOAT;
-inline constexpr VkFormat kSslrClearDistanceFormat = VK_FORMAT_R32_SFLOAT;
 
 // The Far Cry 6 talk's SSLR confidence threshold; ReflectionFrameSettings
 // hands one value to SSLR, integrate and the particle trace.
@@ -113,10 +110,6 @@ struct SslrOutputs {
     rg::Texture radiance;    // kSslrRadianceFormat: lit colour at the hit, a = hit
     rg::Texture confidence;  // kSslrConfidenceFormat, [0, 1]
     rg::Texture hitDebug;    // kSslrHitDebugFormat: hit uv, confidence, hit (debug view "sslr_hits")
-    // kSslrClearDistanceFormat: where the RT trace may start a handed ray
-    // marked kRayClearStart (glint/sslr_shared.h); written at those rays'
-    // pixels only.
-    rg::Texture clearDistance;
     rg::Buffer rtRayList;    // ray generation's RT ray list with the unresolved hybrid rays appended
     rg::Buffer rtArgs;       // its args (glint/ray_generation_shared.h kRayList*)
     rg::Texture litPyramid;  // the cone trace's colour pyramid (invalid without cone trace; unbuilt without cone rays)

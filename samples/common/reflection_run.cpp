@@ -61,7 +61,7 @@ constexpr std::array<bool, 3> kEveryMode{true, true, true};
 
 // The one table of parameters: name, field, the viewer's range, the
 // bench's sweep, and where the value lives.
-const std::array<ParameterSlot, 32> kParameters = {{
+const std::array<ParameterSlot, 31> kParameters = {{
     // A confidence; the talk's 0.9 (default) bracketed from "trust SSLR
     // often" to "almost never".
     {{"sslr_threshold", "ReflectionFrameSettings::confidenceThreshold", 0.0f, 1.0f, false, {0.5, 0.7, 0.8, 0.95, 0.99},
@@ -169,10 +169,6 @@ const std::array<ParameterSlot, 32> kParameters = {{
     // a shadow ray from every hit: the G-buffer's shadows or exact ones.
     {{"rt_shadow_map", "RtTraceSettings::shadowMapAtHits (0 or 1)", 0.0f, 1.0f, true, {0}, {}, kTraced}, nullptr,
      nullptr, [](ReflectionRunOptions& o) { return &o.frame.rt.shadowMapAtHits; }},
-    // Hybrid rays SSLR hands on start where its march found them clear
-    // (default on) against from their surface: what the clear stretch saves.
-    {{"rt_clear_start", "RtTraceSettings::clearStart (0 or 1)", 0.0f, 1.0f, true, {0}, {}, kHybrid}, nullptr,
-     nullptr, [](ReflectionRunOptions& o) { return &o.frame.rt.clearStart; }},
     // BLASes from full detail instead of the reflection LODs (default on):
     // what the LODs cost in error.
     {{"reflection_lods", "BvhSettings::reflectionLods (0: BLASes from full detail)", 0.0f, 1.0f, true, {0}, {0},

@@ -27,12 +27,12 @@ void rtProceed(rayQueryEXT query) {
     }
 }
 
-RtHit rtTraceClosest(vec3 origin, vec3 direction, float tMin, float tMax) {
+RtHit rtTraceClosest(vec3 origin, vec3 direction, float tMax) {
     rayQueryEXT query;
     // Through the back of single-sided triangles (glTF doubleSided false;
     // double-sided instances disable the culling, passes/bvh_update.cpp).
     rayQueryInitializeEXT(query, tlas, rtRayFlags() | gl_RayFlagsCullBackFacingTrianglesEXT, rt.instanceMask,
-                          origin, tMin, direction, tMax);
+                          origin, 0.0, direction, tMax);
     rtProceed(query);
     RtHit h;
     h.hit = 0u;

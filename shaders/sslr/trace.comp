@@ -38,8 +38,6 @@ layout(set = 0, binding = 12) uniform sampler2D pyramidTexture;
 layout(set = 0, binding = 13, scalar) readonly buffer SslrArgs { uint sslrArgs[]; };
 // Ray generation's spatiotemporal blue noise (glint/sampling.glsl); read only when pc.blueNoise is 1.
 layout(set = 0, binding = 14, scalar) readonly buffer BlueNoise { uvec2 blueNoise[]; };
-// Where the ray tracer may start a handed ray (glint/sslr_shared.h).
-layout(set = 0, binding = 15, r32f) uniform writeonly image2D clearDistanceImage;
 
 layout(push_constant, scalar) uniform Constants { SslrConstants pc; };
 
@@ -185,10 +183,6 @@ void main() {
     // docs/results.md, third round).
     bool wasBehind = false;
     float lastSurface = 0.0;
-    // The last step in front before the first one behind: the ray's clear
-    // stretch, which RT need not trace again (glint/sslr_shared.h).
-    float tClear = 0.0;
-    bool clear = true;
     for (uint i = 0u; i < steps; ++i) {
         const float t = (float(i) + jitter) * step;
         // Within a pixel of the origin the ray can only find its own surface.
@@ -200,11 +194,9 @@ void main() {
         const float depth = depthUnder(m, t, texel);
         if (inFront(m, t, depth)) {
             tFront = t;
-            tClear = clear ? t : tClear;
             wasBehind = false;
             continue;
         }
-        clear = false;
         const float surface = -viewZ(depth);
         const float d = rayDistance(m, t) - surface;
         const bool sameOccluder = surface <= lastSurface * (1.0 + pc.thickness);
@@ -291,16 +283,6 @@ void main() {
         const uint slot = atomicAdd(rtArgs[kRayListCountOffset], 1u);
         PackedRay handed = ray;
         handed.pixelFlags &= ~kRayCone;  // a mark for SSLR alone
-        // The clear stretch in world units (the view is a rigid motion):
-        // 1 / w is affine in the screen parameter t, so the point at t lies
-        // at the fraction t k1 / (k0 + t dk) of the clipped ray's length.
-        // A cone-traced ray marched the mirror direction, not this one.
-        const float tStart = tClear - kSslrClearMargin / max(pixelsPerT, 1e-6);
-        if (!cone && tStart > 0.0) {
-            const float fraction = tStart * (m.k0 + m.dk) / (m.k0 + tStart * m.dk);
-            handed.pixelFlags |= kRayClearStart;
-            imageStore(clearDistanceImage, p, vec4(fraction * rayLength));
-        }
         rtRays[slot] = handed;
         if (rayListOpensGroup(slot, slot + 1u)) {
             atomicMax(rtArgs[kRayListDispatchOffset], slot / kRayListGroupSize + 1u);

@@ -9,7 +9,6 @@
 #pragma once
 
 #include "support/gpu_test.h"
-#include "support/graph_upload.h"
 #include "support/pass_test_scene.h"
 
 #include "glint/graph/executor.h"
@@ -19,7 +18,6 @@
 #include "glint/passes/bvh_update.h"
 #include "glint/passes/gbuffer.h"
 #include "glint/passes/rt_trace.h"
-#include "glint/passes/sslr.h"
 #include "glint/scene/bvh_planner.h"
 #include "glint/scene/packed_primitives.h"
 
@@ -300,13 +298,9 @@ public:
                             raster);
     }
 
-    // clearDistance: SSLR's clear stretches (SslrOutputs::clearDistance),
-    // one per pixel, read by the entries marked kRayClearStart; none: the
-    // pass gets no such texture.
     RtFrame trace(passes::RtTracePipelines& pipelines, const RayList& list, const shader::SceneLighting& lighting,
                   const passes::RtTraceSettings& settings, float maxDistance = scene::kDefaultBvhRadius,
-                  float shadowDistance = 2.0f * scene::kDefaultBvhRadius,
-                  const std::vector<float>* clearDistance = nullptr) {
+                  float shadowDistance = 2.0f * scene::kDefaultBvhRadius) {
         REQUIRE(list.entries.size() <= size_t(kSize) * kSize);
         REQUIRE(list.count <= list.entries.size());
         std::memcpy(rays_.mapped(), list.entries.data(), list.entries.size() * sizeof(shader::PackedRay));
@@ -339,12 +333,6 @@ public:
         passes::RtTraceInputs inputs{gbuf, rays, args, bvh, lighting, camera_, frame_};
         inputs.maxDistance = maxDistance;
         inputs.shadowDistance = shadowDistance;
-        if (clearDistance != nullptr) {
-            REQUIRE(clearDistance->size() == size_t(kPixels));
-            std::memcpy(clearStaging_.mapped(), clearDistance->data(), kPixels * sizeof(float));
-            inputs.clearDistance = test::uploadTexture(graph, resources, clearStaging_, "rt_test.clear_distance",
-                                                       passes::kSslrClearDistanceFormat, kSize, kSize);
-        }
         const passes::RtTraceOutputs out = passes::addRtTracePass(graph, pipelines, inputs, settings);
         REQUIRE(out.width == kSize);
         REQUIRE(out.height == kSize);
@@ -394,8 +382,6 @@ private:
     rg::HostReadback radianceReadback_{ctx_, kPixels * 8, "rt_test.readback.radiance"};
     rg::HostReadback distanceReadback_{ctx_, kPixels * 4, "rt_test.readback.hit_distance"};
     rg::HostReadback depthReadback_{ctx_, kPixels * 4, "rt_test.readback.depth"};
-    gpu::Buffer clearStaging_{ctx_, {kPixels * sizeof(float), VK_BUFFER_USAGE_TRANSFER_SRC_BIT,
-                                     gpu::MemoryUsage::Upload, "rt_test.clear_distance"}};
 };
 
 inline std::vector<passes::RtBackend> availableBackends(const gpu::Context& ctx) {

@@ -27,7 +27,6 @@
 #include <bit>
 #include <cmath>
 #include <cstring>
-#include <map>
 #include <set>
 #include <string>
 #include <vector>
@@ -57,7 +56,6 @@ struct SslrFrame {
     std::vector<float> confidence;
     std::vector<glm::vec4> hitDebug;
     std::vector<glm::vec4> lit;
-    std::vector<float> clearDistance;
 
     size_t at(uint32_t x, uint32_t y) const { return size_t(y) * kSize + x; }
 };
@@ -67,13 +65,13 @@ struct SslrFrame {
 class Readback {
 public:
     static constexpr size_t kBuffers = 4;
-    static constexpr size_t kTextures = 5;
+    static constexpr size_t kTextures = 4;
 
     explicit Readback(gpu::Context& ctx) {
         const uint64_t pixels = kSize * kSize;
         const std::array<uint64_t, kBuffers + kTextures> bytes = {
             pixels * sizeof(shader::PackedRay), pixels * 4, pixels * sizeof(shader::PackedRay),
-            shader::kRayListArgsWords * 4, pixels * 8, pixels * 2, pixels * 8, pixels * 8, pixels * 4};
+            shader::kRayListArgsWords * 4, pixels * 8, pixels * 2, pixels * 8, pixels * 8};
         for (size_t i = 0; i < bytes.size(); ++i) {
             buffers_.emplace_back(ctx, bytes[i], "sslr_test.readback" + std::to_string(i));
         }
@@ -82,8 +80,7 @@ public:
     void add(rg::Graph& graph, const passes::RayGenerationOutputs& rays, const passes::SslrOutputs& sslr,
              const passes::GBufferOutputs& gbuf, rg::FrameResources& frame) const {
         const std::array<rg::Buffer, kBuffers> buffers = {rays.rays, rays.classes, sslr.rtRayList, sslr.rtArgs};
-        const std::array<rg::Texture, kTextures> textures = {sslr.radiance, sslr.confidence, sslr.hitDebug, gbuf.lit,
-                                                             sslr.clearDistance};
+        const std::array<rg::Texture, kTextures> textures = {sslr.radiance, sslr.confidence, sslr.hitDebug, gbuf.lit};
         for (size_t i = 0; i < kBuffers; ++i) buffers_[i].copy(graph, frame, buffers[i]);
         for (size_t i = 0; i < kTextures; ++i) buffers_[kBuffers + i].copy(graph, frame, textures[i]);
     }
@@ -108,7 +105,6 @@ public:
         f.confidence.resize(n);
         f.hitDebug.resize(n);
         f.lit.resize(n);
-        f.clearDistance.resize(n);
         for (size_t i = 0; i < n; ++i) {
             f.lit[i] = halves(buffers_[7], i, 4);
             // SSLR writes its ray leaders' pixels only (SSLR and hybrid
@@ -121,8 +117,6 @@ public:
             f.radiance[i] = halves(buffers_[4], i, 4);
             f.confidence[i] = halves(buffers_[5], i, 1).x;
             f.hitDebug[i] = halves(buffers_[6], i, 4);
-            // Written for the handed rays marked kRayClearStart only.
-            f.clearDistance[i] = buffers_[8].as<float>()[i];
         }
         return f;
     }
@@ -344,9 +338,7 @@ TEST_CASE("SSLR lists exactly the hybrid rays below the confidence threshold for
         REQUIRE(p.x < kSize);
         REQUIRE(p.y < kSize);
         CHECK(ray.direction == f.rays[f.at(p.x, p.y)].direction);
-        // Only SSLR's hand-offs carry its clear-stretch mark.
-        CHECK(((ray.pixelFlags & shader::kRayClearStart) == 0u || f.classes[f.at(p.x, p.y)] == shader::kPixelHybrid));
-        listed.insert(ray.pixelFlags & ~shader::kRayClearStart);
+        listed.insert(ray.pixelFlags);
     }
     CHECK(listed == expected);
 }
@@ -364,9 +356,7 @@ TEST_CASE("rays from a mirror wall back toward the camera leave the screen with 
     const passes::SslrSettings settings;
     const SslrFrame f = trace(gpu, 2, settings, 0.0f);
     std::set<uint32_t> listed;
-    for (uint32_t k = 0; k < f.rtArgs[shader::kRayListCountOffset]; ++k) {
-        listed.insert(f.rtRays[k].pixelFlags & ~shader::kRayClearStart);
-    }
+    for (uint32_t k = 0; k < f.rtArgs[shader::kRayListCountOffset]; ++k) listed.insert(f.rtRays[k].pixelFlags);
     uint32_t checked = 0;
     const float wallTopPixel = wallPixel({0.0f, kWallTop}).y;
     for (uint32_t y = 0; y < kSize; ++y) {
@@ -386,72 +376,6 @@ TEST_CASE("rays from a mirror wall back toward the camera leave the screen with 
         }
     }
     CHECK(checked >= 3 * kSize);
-}
-
-TEST_CASE("a handed ray that left the screen over nothing is marked clear up to near where it left") {
-    test::GpuTest gpu;
-    const passes::SslrSettings settings;
-    const SslrFrame f = trace(gpu, 2, settings, 0.0f);
-    std::map<uint32_t, uint32_t> listed;  // pixel -> its entry's flags
-    for (uint32_t k = 0; k < f.rtArgs[shader::kRayListCountOffset]; ++k) {
-        listed[f.rtRays[k].pixelFlags & ~shader::kRayClearStart] = f.rtRays[k].pixelFlags;
-    }
-    // The image position of a world point (the test camera: 90 degrees,
-    // at the origin, looking down -Z; +y down the image).
-    const auto pixelOf = [](glm::vec3 q) {
-        return glm::vec2((q.x / -q.z * 0.5f + 0.5f) * float(kSize), (q.y / q.z * 0.5f + 0.5f) * float(kSize));
-    };
-    const auto onScreen = [&](glm::vec3 q) {
-        const glm::vec2 s = pixelOf(q);
-        return -q.z > kNear && s.x >= 0.0f && s.y >= 0.0f && s.x <= float(kSize) && s.y <= float(kSize);
-    };
-    uint32_t checked = 0;
-    const float wallTopPixel = wallPixel({0.0f, kWallTop}).y;
-    for (uint32_t y = 0; y < kSize; ++y) {
-        for (uint32_t x = 0; x < kSize; ++x) {
-            // The mirror wall's pixels above the image's centre: their rays
-            // climb towards the camera over the sky and the wall itself
-            // (in front of the depth buffer all the way) and leave the image.
-            if (float(y) < wallTopPixel + 1.0f || float(y) + 0.5f > float(kSize) / 2.0f - 1.0f) continue;
-            INFO("pixel " << x << ", " << y);
-            const size_t i = f.at(x, y);
-            const auto entry = listed.find(shader::packRayPixel({x, y}, false));
-            REQUIRE(entry != listed.end());
-            const glm::vec2 n = test::pixelNdc(x, y);
-            const glm::vec3 origin = kWallDistance * glm::vec3(n.x, -n.y, -1.0f);
-            const glm::vec3 dir = shader::unpackRayDirection(f.rays[i].direction);
-            // Where the ray leaves the image (or comes to the near plane),
-            // by bisection: it starts inside, and the view is convex.
-            float lo = 0.0f, hi = 100.0f;
-            REQUIRE_FALSE(onScreen(origin + hi * dir));
-            for (int k = 0; k < 40; ++k) {
-                const float mid = 0.5f * (lo + hi);
-                (onScreen(origin + mid * dir) ? lo : hi) = mid;
-            }
-            const glm::vec2 exit = pixelOf(origin + lo * dir);
-            const float lengthPixels = glm::distance(pixelOf(origin), exit);
-            // A 64-pixel image's rays take steps of a pixel or so
-            // (minStepPixels); the march tests nothing within a pixel of
-            // the origin, so a ray that leaves within a few pixels of it
-            // has no clear stretch.
-            const float stepPixels = lengthPixels / std::clamp(std::ceil(lengthPixels / settings.minStepPixels), 1.0f,
-                                                               float(settings.linearSteps));
-            if (lengthPixels < shader::kSslrClearMargin + 2.0f * stepPixels + 1.0f) continue;
-            REQUIRE((entry->second & shader::kRayClearStart) != 0u);
-            const float d = f.clearDistance[i];
-            REQUIRE(d > 0.0f);
-            // The stretch ends on screen, before the exit, and within the
-            // march's last step and the margin of it.
-            const glm::vec3 end = origin + d * dir;
-            REQUIRE(onScreen(end));
-            REQUIRE(d < lo);
-            const float exitPixels = glm::distance(pixelOf(end), exit);
-            CHECK(exitPixels >= shader::kSslrClearMargin - 0.5f);
-            CHECK(exitPixels <= shader::kSslrClearMargin + stepPixels + 0.5f);
-            ++checked;
-        }
-    }
-    CHECK(checked >= 2 * kSize);  // 162 on lavapipe
 }
 
 TEST_CASE("rough pixels cone-trace: their reflection of thin stripes is the stripes' mean, a mirror's is one stripe") {

@@ -35,10 +35,7 @@ GLINT_CONST uint kPixelClassCount = 5u;
 //               kRayReused: this pixel reuses that (quad leader's) ray,
 //               bit 30 kRayCone (SSLR list entries only): SSLR cone-traces
 //               it (its roughness is at least the cone roughness), bit 31
-//               kRayClearStart (RT list entries only): SSLR handed the ray
-//               on after finding its first stretch clear; the RT trace
-//               starts it at the distance SSLR's clearDistance image holds
-//               at the pixel (glint/sslr_shared.h)
+//               unused
 //   direction:  world-space unit direction, octahedral, two 16-bit snorms
 // A leader's own entry has its own pixel; a follower's entry names the
 // leader, so later passes trace leaders only and followers read the
@@ -51,7 +48,6 @@ struct PackedRay {
 GLINT_CONST uint kNoRay = 0xFFFFFFFFu;
 GLINT_CONST uint kRayReused = 1u << 29u;
 GLINT_CONST uint kRayCone = 1u << 30u;
-GLINT_CONST uint kRayClearStart = 1u << 31u;
 GLINT_CONST uint kRayPixelXMask = 0x7FFFu;
 GLINT_CONST uint kRayPixelYShift = 15u;
 GLINT_CONST uint kRayPixelYMask = 0x3FFFu;

@@ -55,16 +55,13 @@ layout(set = 0, binding = 16, scalar) readonly buffer DeformMotions { DeformMoti
 // The G-buffer's shadow map (read where rt.shadowMapAtHits is 1; otherwise
 // a stand-in texture).
 layout(set = 0, binding = 17) uniform sampler2D shadowMapTexture;
-// Where SSLR found a handed ray's first stretch clear (glint/sslr_shared.h;
-// read where rt.clearStartBound is 1, otherwise a stand-in texture).
-layout(set = 0, binding = 18) uniform sampler2D clearDistanceTexture;
 #include "glint/sun_shadow.glsl"
 
 // The backend's traversals, both with rt.instanceMask and rtRayFlags():
 // alpha-tested geometry is not opaque in its BLAS, and a candidate counts
 // only where rtAlphaCovers() says so (an any-hit shader, or the ray query's
 // candidate loop).
-RtHit rtTraceClosest(vec3 origin, vec3 direction, float tMin, float tMax);
+RtHit rtTraceClosest(vec3 origin, vec3 direction, float tMax);
 // Whether anything lies on the segment (it may stop at the first hit).
 bool rtTraceOccluded(vec3 origin, vec3 direction, float tMax);
 
@@ -72,7 +69,6 @@ struct RtRay {
     ivec2 pixel;      // where the result goes (the ray's own pixel or its quad leader's)
     vec3 origin;      // world, off the surface
     vec3 direction;   // world, unit
-    float tMin;       // where the traversal starts (SSLR's clear stretch, else 0)
     float tMax;
     float roughness;  // perceptual, of the surface the ray leaves
 };
@@ -113,7 +109,6 @@ bool rtSetupRay(uint index, out RtRay ray) {
     ray.pixel = ivec2(0);
     ray.origin = vec3(0.0);
     ray.direction = vec3(0.0, 1.0, 0.0);
-    ray.tMin = 0.0;
     ray.tMax = 0.0;
     ray.roughness = 0.0;
     if (packed.pixelFlags == kNoRay) {
@@ -141,16 +136,6 @@ bool rtSetupRay(uint index, out RtRay ray) {
     ray.direction = unpackRayDirection(packed.direction);
     ray.roughness = clamp(texelFetch(roughnessMetalTexture, p, 0).x, 0.0, 1.0);
     ray.tMax = rtRayLength(ray.roughness);
-    // A hybrid ray SSLR found clear up to some distance starts there:
-    // nothing the camera sees lies before it (glint/sslr_shared.h), and the
-    // traversal skips every node that ends before it. Hits still measure t
-    // from the origin.
-    if (rt.clearStartBound != 0u && (packed.pixelFlags & kRayClearStart) != 0u) {
-        const float clearDistance = texelFetch(clearDistanceTexture, p, 0).x;
-        if (clearDistance > 0.0) {
-            ray.tMin = min(clearDistance, ray.tMax);
-        }
-    }
     return true;
 }
 
@@ -208,7 +193,7 @@ void rtTraceListEntry(uint index) {
     if (!rtSetupRay(index, ray)) {
         return;
     }
-    const RtHit hit = rtTraceClosest(ray.origin, ray.direction, ray.tMin, ray.tMax);
+    const RtHit hit = rtTraceClosest(ray.origin, ray.direction, ray.tMax);
     if (hit.hit == 0u) {
         rtWriteResult(ray, environmentRadiance(rt.lighting, ray.direction, ray.roughness), kMissHitDistance, vec3(0.0));
         return;

@@ -63,7 +63,7 @@ GLINT_CONST float kRtOriginMinimum = 1.0f / 32.0f;
 // size, so the list's dispatch command (word 0) fits it.
 GLINT_CONST uint kRtTraceGroupSize = 64u;
 
-// Scene constants of one frame (484 bytes: more than push constants
+// Scene constants of one frame (360 bytes: more than push constants
 // guarantee, so a small buffer the pass fills with vkCmdUpdateBuffer).
 struct RtTraceConstants {
     mat4 inverseViewProjection;  // of the G-buffer's rasterisation (jittered): its depth -> world
@@ -85,16 +85,12 @@ struct RtTraceConstants {
     // shadow ray. 0: every hit traces one.
     uint shadowMapAtHits;
     GBufferShadow shadow;        // the G-buffer's shadow map fit this frame
-    // 1: list entries marked kRayClearStart (hybrid rays SSLR handed on)
-    // start at the distance SSLR's clearDistance image holds at their pixel
-    // (glint/sslr_shared.h); 0: every ray starts at its origin.
-    uint clearStartBound;
 };
 
 GLINT_END
 
 #ifdef __cplusplus
-static_assert(sizeof(glint::shader::RtTraceConstants) == 364 + 4 + 112 + 4);
+static_assert(sizeof(glint::shader::RtTraceConstants) == 364 + 4 + 112);
 #endif
 
 #endif

@@ -16,20 +16,6 @@
 // The threshold is one the confidence image holds exactly
 // (passes::sslrStoredThreshold), so a reader that finds the stored
 // confidence below it knows the ray was handed on and its RT result exists.
-// A handed ray that marched its own direction (not a cone-traced one) and
-// lay in front of the depth buffer at its first steps carries
-// kRayClearStart, and
-//   clearDistance  world distance along the ray, from the pixel's surface,
-//                  up to which every step of the march lay in front of the
-//                  depth buffer (or over the sky), less kSslrClearMargin
-//                  pixels
-// holds at its pixel where the ray tracer may start it: no surface the
-// camera sees lies on that stretch (the depth buffer holds the nearest
-// one along every view ray), so tracing it again finds nothing there. What
-// the depth buffer does not hold can lie on it: a surface thinner than
-// the march's step between two steps, a single-sided face the camera sees
-// from behind (Lumen's screen traces hand their rays to hardware ray
-// tracing the same way).
 #ifndef GLINT_SSLR_SHARED_H
 #define GLINT_SSLR_SHARED_H
 
@@ -62,11 +48,6 @@ struct SslrConstants {
 // The pyramid stops at 2^(kSslrPyramidMaxMips - 1) pixels per texel: wider
 // footprints belong to pixels rougher than the cutoff, which trace nothing.
 GLINT_CONST uint kSslrPyramidMaxMips = 8u;
-
-// The clear stretch ends this many pixels before its last step in front:
-// that step compared the ray with the depth of the texel it fell in, and a
-// slanted surface's depth varies across a texel.
-GLINT_CONST float kSslrClearMargin = 2.0f;
 
 // The colour pyramid is built by two passes of pyramid.glsl, each a 16 x 16
 // workgroup per 32 x 32 texels of its source level that writes the five
