@@ -103,6 +103,7 @@ IntegrateOutputs addIntegratePass(rg::Graph& graph, IntegratePipelines& pipeline
     constants.rtHitMotionBound = inputs.rtHitMotion.valid() ? 1u : 0u;
     constants.minFrameHits = (variant & kVariantFeedback) != 0 ? feedback.minFrameHits : 0u;
     constants.sslrCountsOnly = inputs.sslrCountsOnly && (variant & kVariantSslr) != 0 ? 1u : 0u;
+    constants.debugOutputs = inputs.debugOutputs ? 1u : 0u;
 
     // The constants outgrow push constants (glint/integrate_shared.h); a
     // transfer inside the frame keeps their lifetime the graph's.
@@ -200,7 +201,12 @@ IntegrateOutputs addIntegratePass(rg::Graph& graph, IntegratePipelines& pipeline
             pc.dispatch(pipeline, (d.out.width + shader::kTileSize - 1) / shader::kTileSize,
                         (d.out.height + shader::kTileSize - 1) / shader::kTileSize);
         });
-    return integrate.out;
+    IntegrateOutputs result = integrate.out;
+    if (!inputs.debugOutputs) {
+        // Declared (the binding needs an image) but never stored to.
+        result.sourceDebug = {};
+    }
+    return result;
 }
 
 } // namespace glint::passes

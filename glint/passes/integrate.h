@@ -95,6 +95,11 @@ struct IntegrateInputs {
     // SSLR handed every ray on): SSLR's hits are counted into the feedback,
     // and the reflection is the ray tracer's, as in rt mode.
     bool sslrCountsOnly = false;
+    // Write IntegrateOutputs::sourceDebug (its debug view, tests). Off,
+    // nothing writes it and the output is an invalid handle: 4 bytes a
+    // pixel the frame does not store (the reflection frame turns it on for
+    // its debug view only).
+    bool debugOutputs = true;
 };
 
 struct IntegrateSettings {
@@ -115,7 +120,9 @@ struct IntegrateOutputs {
     // motion, an SSLR hit's G-buffer motion at the hit (at the view depth
     // last frame's camera gives it); zero at infinity.
     rg::Texture hitMotion;
-    rg::Texture sourceDebug;  // kReflectionSourceDebugFormat: a colour per source (debug view "reflection_source")
+    // kReflectionSourceDebugFormat: a colour per source (debug view
+    // "reflection_source"); with IntegrateInputs::debugOutputs, else invalid.
+    rg::Texture sourceDebug;
     rg::Buffer counters;      // the new version of feedback.counters.current (invalid without feedback)
     uint32_t width = 0;
     uint32_t height = 0;

@@ -310,6 +310,7 @@ ReflectionFrame ReflectionRenderer::addFrame(rg::Graph& graph, const scene::Came
     integrateInputs.confidenceThreshold = settings.confidenceThreshold;
     integrateInputs.screenSpaceIdle = f.screenSpaceIdle;
     integrateInputs.sslrCountsOnly = f.sslrCountsOnly;
+    integrateInputs.debugOutputs = view == "reflection_source";
     if (f.particles) {
         integrateInputs.particles = f.particles->radiance;
     }

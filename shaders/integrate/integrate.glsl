@@ -29,6 +29,7 @@ layout(set = 0, binding = 4, scalar) readonly buffer Rays { PackedRay rays[]; };
 layout(set = 0, binding = 5, scalar) readonly buffer Classes { uint classes[]; };
 layout(set = 0, binding = 6, rgba16f) uniform writeonly image2D radianceImage;
 layout(set = 0, binding = 7, r32f) uniform writeonly image2D hitDistanceImage;
+// The source's debug colour, written where C.debugOutputs says so.
 layout(set = 0, binding = 8, rgba8) uniform writeonly image2D sourceImage;
 // RGBA16F has no required storage format: the context enables
 // shaderStorageImageWriteWithoutFormat.
@@ -279,7 +280,9 @@ void main() {
         imageStore(radianceImage, p, vec4(finite ? radiance : vec3(0.0), r.reflects));
         imageStore(hitDistanceImage, p, vec4(finite ? r.hitDistance : kMissHitDistance));
         imageStore(hitMotionImage, p, vec4(finite ? r.hitMotion : vec3(0.0), 0.0));
-        imageStore(sourceImage, p, integrateSourceColour(r.source));
+        if (C.debugOutputs != 0u) {
+            imageStore(sourceImage, p, integrateSourceColour(r.source));
+        }
     }
     barrier();
 

@@ -15,7 +15,7 @@
 #include "glint/temporal_shared.h"
 #include "temporal_common.glsl"
 
-layout(local_size_x = 8, local_size_y = 8) in;
+layout(local_size_x = kTemporalGroupSize, local_size_y = kTemporalGroupSize) in;
 
 layout(set = 0, binding = 1) uniform sampler2D depthTexture;
 // This frame's surface as the accumulation wrote it (temporal.surface:

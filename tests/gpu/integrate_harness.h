@@ -510,6 +510,8 @@ struct RunOptions {
     // Runs the real SSLR pass instead of uploading traces.sslr*.
     passes::SslrPipelines* realSslr = nullptr;
     passes::FeedbackSettings feedback;
+    // IntegrateInputs::debugOutputs: off, the source colours are not read back.
+    bool debugOutputs = true;
 };
 
 // One scene, one executor (the history persists across frames), the real
@@ -577,6 +579,7 @@ public:
         in.lighting = lighting_;
         in.camera = camera;
         in.confidenceThreshold = options.confidenceThreshold;
+        in.debugOutputs = options.debugOutputs;
         in.sslrCountsOnly = present.sslrCountsOnly;
         const passes::IntegrateOutputs out =
             passes::addIntegratePass(graph, integratePipelines_, in, options.integrate);
@@ -587,7 +590,8 @@ public:
         const size_t roughness = transfers_.readTexture(graph, resources, gbuf.roughnessMetal, 4);
         const size_t radiance = transfers_.readTexture(graph, resources, out.radiance, 8);
         const size_t hitDistance = transfers_.readTexture(graph, resources, out.hitDistance, 4);
-        const size_t source = transfers_.readTexture(graph, resources, out.sourceDebug, 4);
+        REQUIRE(out.sourceDebug.valid() == options.debugOutputs);
+        const size_t source = options.debugOutputs ? transfers_.readTexture(graph, resources, out.sourceDebug, 4) : 0;
         size_t counters = 0, reprojected = 0, modes = 0, sslrRadiance = 0, sslrConfidence = 0, sslrHit = 0;
         if (in.sslr) {
             sslrRadiance = transfers_.readTexture(graph, resources, in.sslr->radiance, 8);
@@ -627,7 +631,7 @@ public:
             for (int c = 0; c < 4; ++c) f.radiance[i][c] = glm::unpackHalf1x16(radianceHalves[i * 4 + c]);
         }
         f.hitDistance = transfers_.get<float>(hitDistance);
-        f.source = transfers_.get<glm::u8vec4>(source);
+        if (options.debugOutputs) f.source = transfers_.get<glm::u8vec4>(source);
         if (feedback) {
             f.counters = transfers_.get<uint32_t>(counters);
             f.frameHitsWord = f.counters.back();

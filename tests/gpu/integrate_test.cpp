@@ -42,6 +42,23 @@ TEST_CASE("integrate takes each pixel's reflection from the source its class and
     CHECK(cov.sslrHitDistances > 50);
 }
 
+TEST_CASE("without its debug output integrate writes the same reflections, and no source colours") {
+    test::GpuTest gpu;
+    const Traces traces = makeTraces(0, false);
+    const Presence all;
+    Harness with(gpu, floorScene());
+    const Frame a = with.run(testCamera(), 0, traces, all);
+    RunOptions options;
+    options.debugOutputs = false;
+    Harness without(gpu, floorScene());
+    const Frame b = without.run(testCamera(), 0, traces, all, options);
+    REQUIRE(a.source.size() == kPixels);
+    CHECK(b.source.empty());
+    CHECK(std::memcmp(a.radiance.data(), b.radiance.data(), kPixels * sizeof(glm::vec4)) == 0);
+    CHECK(a.hitDistance == b.hitDistance);
+    CHECK(a.counters == b.counters);
+}
+
 TEST_CASE("integrate lets no NaN or Inf from the traces through; poisoned traces count as misses") {
     test::GpuTest gpu;
     Harness harness(gpu, floorScene());

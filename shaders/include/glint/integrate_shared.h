@@ -101,12 +101,14 @@ struct IntegrateConstants {
     // 1: SSLR's hits are counted, not used (FeedbackSettings::
     // probesRenderAsRt; SSLR handed every ray on).
     uint sslrCountsOnly;
+    // 1: write the source debug colour (IntegrateInputs::debugOutputs).
+    uint debugOutputs;
 };
 
 GLINT_END
 
 #ifdef __cplusplus
-static_assert(sizeof(glint::shader::IntegrateConstants) == 504);
+static_assert(sizeof(glint::shader::IntegrateConstants) == 508);
 #endif
 
 #endif
