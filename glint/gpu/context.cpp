@@ -124,6 +124,12 @@ bool validationRequested(const ContextOptions& options) {
     return env != nullptr && std::string_view(env) == "1";
 }
 
+bool pipelineStatisticsRequested(const ContextOptions& options) {
+    if (options.pipelineStatistics) return true;
+    const char* env = std::getenv("GLINT_PIPELINE_STATS");
+    return env != nullptr && std::string_view(env) == "1";
+}
+
 std::string versionString(uint32_t v) {
     return std::to_string(VK_API_VERSION_MAJOR(v)) + "." + std::to_string(VK_API_VERSION_MINOR(v)) + "." +
            std::to_string(VK_API_VERSION_PATCH(v));
@@ -346,6 +352,8 @@ void Context::createDevice(const ContextOptions& options) {
     VkPhysicalDeviceRayTracingPipelineFeaturesKHR rtFeatures{
         VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_RAY_TRACING_PIPELINE_FEATURES_KHR};
     VkPhysicalDeviceRayQueryFeaturesKHR rqFeatures{VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_RAY_QUERY_FEATURES_KHR};
+    VkPhysicalDevicePipelineExecutablePropertiesFeaturesKHR statsFeatures{
+        VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_PIPELINE_EXECUTABLE_PROPERTIES_FEATURES_KHR};
     VkPhysicalDeviceVulkan13Features f13{VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_VULKAN_1_3_FEATURES};
     VkPhysicalDeviceVulkan12Features f12{VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_VULKAN_1_2_FEATURES};
     VkPhysicalDeviceVulkan11Features f11{VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_VULKAN_1_1_FEATURES};
@@ -356,6 +364,8 @@ void Context::createDevice(const ContextOptions& options) {
                        hasExtension(extensions, VK_KHR_DEFERRED_HOST_OPERATIONS_EXTENSION_NAME);
     const bool hasRq = hasAs && hasExtension(extensions, VK_KHR_RAY_QUERY_EXTENSION_NAME) && !options.disableRayQuery;
     const bool hasRt = hasAs && hasExtension(extensions, VK_KHR_RAY_TRACING_PIPELINE_EXTENSION_NAME);
+    const bool statsRequested = pipelineStatisticsRequested(options);
+    const bool hasStats = statsRequested && hasExtension(extensions, VK_KHR_PIPELINE_EXECUTABLE_PROPERTIES_EXTENSION_NAME);
 
     // Build the query chain with only the structures this device knows.
     void* chain = nullptr;
@@ -366,6 +376,7 @@ void Context::createDevice(const ContextOptions& options) {
     if (hasAs) link(asFeatures);
     if (hasRt) link(rtFeatures);
     if (hasRq) link(rqFeatures);
+    if (hasStats) link(statsFeatures);
     link(f13);
     link(f12);
     link(f11);
@@ -394,6 +405,11 @@ void Context::createDevice(const ContextOptions& options) {
     caps_.rayQuery = hasRq && rqFeatures.rayQuery && caps_.accelerationStructure;
     caps_.rayTracingPipeline = hasRt && rtFeatures.rayTracingPipeline && caps_.accelerationStructure;
     caps_.memoryBudget = hasExtension(extensions, VK_EXT_MEMORY_BUDGET_EXTENSION_NAME);
+    caps_.pipelineStatistics = hasStats && statsFeatures.pipelineExecutableInfo;
+    if (statsRequested && !caps_.pipelineStatistics) {
+        spdlog::warn("pipeline statistics requested, but device '{}' has no VK_KHR_pipeline_executable_properties",
+                     caps_.deviceName);
+    }
     if (options.requireRayTracing && !(caps_.rayQuery || caps_.rayTracingPipeline)) {
         throw GpuError("device '" + caps_.deviceName + "' has no usable ray backend (needs accelerationStructure plus "
                        "rayQuery or rayTracingPipeline)" +
@@ -447,6 +463,9 @@ void Context::createDevice(const ContextOptions& options) {
     eRt.rayTracingPipelineTraceRaysIndirect = rtFeatures.rayTracingPipelineTraceRaysIndirect;
     VkPhysicalDeviceRayQueryFeaturesKHR eRq{VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_RAY_QUERY_FEATURES_KHR};
     eRq.rayQuery = VK_TRUE;
+    VkPhysicalDevicePipelineExecutablePropertiesFeaturesKHR eStats{
+        VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_PIPELINE_EXECUTABLE_PROPERTIES_FEATURES_KHR};
+    eStats.pipelineExecutableInfo = VK_TRUE;
 
     std::vector<const char*> enabledExtensions = {VK_KHR_PUSH_DESCRIPTOR_EXTENSION_NAME};
     chain = nullptr;
@@ -468,6 +487,10 @@ void Context::createDevice(const ContextOptions& options) {
     }
     if (caps_.memoryBudget) {
         enabledExtensions.push_back(VK_EXT_MEMORY_BUDGET_EXTENSION_NAME);
+    }
+    if (caps_.pipelineStatistics) {
+        enabledExtensions.push_back(VK_KHR_PIPELINE_EXECUTABLE_PROPERTIES_EXTENSION_NAME);
+        link(eStats);
     }
     link(e13);
     link(e12);
@@ -575,6 +598,10 @@ void Context::createDevice(const ContextOptions& options) {
         load(fn_.getRayTracingShaderGroupHandles, "vkGetRayTracingShaderGroupHandlesKHR");
         load(fn_.cmdTraceRays, "vkCmdTraceRaysKHR");
         load(fn_.cmdTraceRaysIndirect, "vkCmdTraceRaysIndirectKHR");
+    }
+    if (caps_.pipelineStatistics) {
+        load(fn_.getPipelineExecutableProperties, "vkGetPipelineExecutablePropertiesKHR");
+        load(fn_.getPipelineExecutableStatistics, "vkGetPipelineExecutableStatisticsKHR");
     }
     if (debugUtils_) {
         fn_.setDebugUtilsObjectName = reinterpret_cast<PFN_vkSetDebugUtilsObjectNameEXT>(

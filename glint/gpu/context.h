@@ -41,6 +41,13 @@ struct ContextOptions {
     // Disables the ray query backend even where the device has it, so the
     // ray tracing pipeline path can be exercised on any device.
     bool disableRayQuery = false;
+    // Log each pipeline's executable statistics as it is created (register
+    // count, shared memory and the like, whatever the driver reports through
+    // VK_KHR_pipeline_executable_properties; info level), to tell what
+    // limits a shader's occupancy. Where the device lacks the extension, a
+    // warning and nothing else. The environment variable
+    // GLINT_PIPELINE_STATS=1 sets it too, for any program.
+    bool pipelineStatistics = false;
     // Tests only: make the Nth allocation, submission or wait fail
     // (gpu/fault.h).
     std::optional<FaultInjection> fault;
@@ -51,6 +58,8 @@ struct ContextOptions {
 bool rayTracingDisabled(const ContextOptions& options);
 // ContextOptions::validation, or GLINT_VALIDATION=1 in the environment.
 bool validationRequested(const ContextOptions& options);
+// ContextOptions::pipelineStatistics, or GLINT_PIPELINE_STATS=1 in the environment.
+bool pipelineStatisticsRequested(const ContextOptions& options);
 
 struct QueueFamily {
     uint32_t index = 0;
@@ -83,6 +92,9 @@ struct Capabilities {
     RayTracingProperties rayTracing;
 
     bool memoryBudget = false;      // VK_EXT_memory_budget enabled (Context::deviceMemoryInUse)
+    // VK_KHR_pipeline_executable_properties enabled: pipelines log their
+    // statistics (ContextOptions::pipelineStatistics).
+    bool pipelineStatistics = false;
     bool timestamps = false;        // graphics queue can write timestamps
     float timestampPeriodNs = 0.0f; // nanoseconds per tick
     uint64_t bufferImageGranularity = 1;
@@ -118,6 +130,8 @@ struct DeviceFunctions {
     PFN_vkSetDebugUtilsObjectNameEXT setDebugUtilsObjectName = nullptr;
     PFN_vkCmdBeginDebugUtilsLabelEXT cmdBeginDebugUtilsLabel = nullptr;
     PFN_vkCmdEndDebugUtilsLabelEXT cmdEndDebugUtilsLabel = nullptr;
+    PFN_vkGetPipelineExecutablePropertiesKHR getPipelineExecutableProperties = nullptr;
+    PFN_vkGetPipelineExecutableStatisticsKHR getPipelineExecutableStatistics = nullptr;
 };
 
 class Context {

@@ -25,6 +25,58 @@ namespace glint::gpu {
 
 namespace {
 
+// The flag that has the driver keep a pipeline's statistics, where the
+// context enabled them (ContextOptions::pipelineStatistics).
+VkPipelineCreateFlags statisticsFlags(const Context& ctx) {
+    return ctx.caps().pipelineStatistics ? VK_PIPELINE_CREATE_CAPTURE_STATISTICS_BIT_KHR : 0;
+}
+
+// One info line per executable (a shader stage, or what the driver made of
+// it) with every statistic the driver reports for it: on NVIDIA the
+// register count among them, which bounds how many warps an SM holds.
+void logStatistics(const Context& ctx, VkPipeline pipeline, const std::string& name) {
+    if (!ctx.caps().pipelineStatistics) return;
+    const DeviceFunctions& fn = ctx.fn();
+    VkPipelineInfoKHR info{VK_STRUCTURE_TYPE_PIPELINE_INFO_KHR};
+    info.pipeline = pipeline;
+    uint32_t count = 0;
+    if (fn.getPipelineExecutableProperties(ctx.device(), &info, &count, nullptr) != VK_SUCCESS) return;
+    std::vector<VkPipelineExecutablePropertiesKHR> executables(count, {VK_STRUCTURE_TYPE_PIPELINE_EXECUTABLE_PROPERTIES_KHR});
+    if (fn.getPipelineExecutableProperties(ctx.device(), &info, &count, executables.data()) != VK_SUCCESS) return;
+    for (uint32_t e = 0; e < count; ++e) {
+        VkPipelineExecutableInfoKHR which{VK_STRUCTURE_TYPE_PIPELINE_EXECUTABLE_INFO_KHR};
+        which.pipeline = pipeline;
+        which.executableIndex = e;
+        uint32_t statCount = 0;
+        if (fn.getPipelineExecutableStatistics(ctx.device(), &which, &statCount, nullptr) != VK_SUCCESS) continue;
+        std::vector<VkPipelineExecutableStatisticKHR> stats(statCount, {VK_STRUCTURE_TYPE_PIPELINE_EXECUTABLE_STATISTIC_KHR});
+        if (fn.getPipelineExecutableStatistics(ctx.device(), &which, &statCount, stats.data()) != VK_SUCCESS) continue;
+        std::string text;
+        for (const VkPipelineExecutableStatisticKHR& s : stats) {
+            text += text.empty() ? "" : ", ";
+            text += s.name;
+            text += " ";
+            switch (s.format) {
+                case VK_PIPELINE_EXECUTABLE_STATISTIC_FORMAT_BOOL32_KHR:
+                    text += s.value.b32 ? "yes" : "no";
+                    break;
+                case VK_PIPELINE_EXECUTABLE_STATISTIC_FORMAT_INT64_KHR:
+                    text += std::to_string(s.value.i64);
+                    break;
+                case VK_PIPELINE_EXECUTABLE_STATISTIC_FORMAT_UINT64_KHR:
+                    text += std::to_string(s.value.u64);
+                    break;
+                case VK_PIPELINE_EXECUTABLE_STATISTIC_FORMAT_FLOAT64_KHR:
+                    text += std::to_string(s.value.f64);
+                    break;
+                default:
+                    text += "?";
+            }
+        }
+        spdlog::info("pipeline '{}' {} (subgroup {}): {}", name, executables[e].name, executables[e].subgroupSize, text);
+    }
+}
+
 std::vector<std::filesystem::path> shaderSearchPath() {
     std::vector<std::filesystem::path> dirs;
     if (const char* env = std::getenv("GLINT_SHADER_DIR"); env && *env) {
@@ -240,10 +292,12 @@ Pipeline createComputePipeline(Context& ctx, const ComputePipelineDesc& desc) {
     info.stage.module = module.handle();
     info.stage.pName = "main";
     info.layout = p.layout_.handle();
+    info.flags = statisticsFlags(ctx);
     VkPipeline pipeline = VK_NULL_HANDLE;
     check(vkCreateComputePipelines(ctx.device(), VK_NULL_HANDLE, 1, &info, nullptr, &pipeline),
           "vkCreateComputePipelines '" + p.name_ + "'");
     p.pipeline_ = Unique<VkPipeline>(ctx.device(), pipeline, vkDestroyPipeline);
+    logStatistics(ctx, pipeline, p.name_);
     ctx.setName(pipeline, VK_OBJECT_TYPE_PIPELINE, p.name_);
     return p;
 }
@@ -322,10 +376,12 @@ Pipeline createGraphicsPipeline(Context& ctx, const GraphicsPipelineDesc& desc) 
     info.pColorBlendState = &blend;
     info.pDynamicState = &dynamic;
     info.layout = p.layout_.handle();
+    info.flags = statisticsFlags(ctx);
     VkPipeline pipeline = VK_NULL_HANDLE;
     check(vkCreateGraphicsPipelines(ctx.device(), VK_NULL_HANDLE, 1, &info, nullptr, &pipeline),
           "vkCreateGraphicsPipelines '" + p.name_ + "'");
     p.pipeline_ = Unique<VkPipeline>(ctx.device(), pipeline, vkDestroyPipeline);
+    logStatistics(ctx, pipeline, p.name_);
     ctx.setName(pipeline, VK_OBJECT_TYPE_PIPELINE, p.name_);
     return p;
 }
@@ -388,10 +444,12 @@ Pipeline createRayTracingPipeline(Context& ctx, const RayTracingPipelineDesc& de
     info.pGroups = groups.data();
     info.maxPipelineRayRecursionDepth = desc.maxRecursionDepth;
     info.layout = p.layout_.handle();
+    info.flags = statisticsFlags(ctx);
     VkPipeline pipeline = VK_NULL_HANDLE;
     check(ctx.fn().createRayTracingPipelines(ctx.device(), VK_NULL_HANDLE, VK_NULL_HANDLE, 1, &info, nullptr, &pipeline),
           "vkCreateRayTracingPipelinesKHR '" + p.name_ + "'");
     p.pipeline_ = Unique<VkPipeline>(ctx.device(), pipeline, vkDestroyPipeline);
+    logStatistics(ctx, pipeline, p.name_);
     p.groupCount_ = info.groupCount;
     ctx.setName(pipeline, VK_OBJECT_TYPE_PIPELINE, p.name_);
     return p;
