@@ -33,28 +33,6 @@ void checkSettings(const TemporalSettings& s) {
     }
 }
 
-// E(q), the step along the view ray through pixel position q per unit of
-// view depth (temporal_common.glsl's planeDistanceSteps), in its affine
-// form: E(0, 0) and its steps per pixel in x and y. The ray runs from the
-// camera to the near plane (reversed-Z depth 1) through the jittered
-// inverse; the view-projection's w row, which jitter leaves alone, gives
-// the view depth. In double: the shader adds up to thousands of steps.
-void rayBasis(const glm::mat4& jitteredInverse, const glm::mat4& viewProjection, glm::vec3 camera, glm::uvec2 size,
-              glm::vec4 (&rays)[3]) {
-    const glm::dmat4 inverse(jitteredInverse);
-    const glm::dvec3 wRow(viewProjection[0][3], viewProjection[1][3], viewProjection[2][3]);
-    const auto step = [&](glm::dvec2 q) {
-        const glm::dvec2 ndc = q / glm::dvec2(size) * 2.0 - 1.0;
-        const glm::dvec4 p = inverse * glm::dvec4(ndc, 1.0, 1.0);
-        const glm::dvec3 ray = glm::dvec3(p) / p.w - glm::dvec3(camera);
-        return ray / glm::dot(wRow, ray);
-    };
-    const glm::dvec3 origin = step({0.0, 0.0});
-    rays[0] = glm::vec4(glm::vec3(origin), 0.0f);
-    rays[1] = glm::vec4(glm::vec3(step({1.0, 0.0}) - origin), 0.0f);
-    rays[2] = glm::vec4(glm::vec3(step({0.0, 1.0}) - origin), 0.0f);
-}
-
 shader::TemporalFrame frameConstants(const TemporalInputs& in, const TemporalSettings& s) {
     const scene::Camera& c = in.camera;
     shader::TemporalFrame f{};
@@ -90,9 +68,6 @@ shader::TemporalFrame frameConstants(const TemporalInputs& in, const TemporalSet
     f.environmentRoughness = in.environmentRoughness;
     f.debugOutputs = in.debugOutputs ? 1u : 0u;
     f.frame = uint32_t(in.frameIndex);
-    const glm::uvec2 size{in.gbuffer.width, in.gbuffer.height};
-    rayBasis(f.inverseViewProjection, f.viewProjection, c.position, size, f.rays);
-    rayBasis(f.previousInverseViewProjection, f.previousViewProjection, c.previousPosition, size, f.previousRays);
     return f;
 }
 

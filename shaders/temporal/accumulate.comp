@@ -274,7 +274,8 @@ void main() {
     px.planeStep = vec3(0.0);
     if (!px.environment) {
         px.planeOffset = dot(frame.previousCameraPosition.xyz - px.position, px.normal);
-        px.planeStep = planeDistanceSteps(frame.previousRays, centre, px.normal);
+        px.planeStep = planeDistanceSteps(frame.previousInverseViewProjection, frame.previousViewProjection,
+                                          frame.previousCameraPosition.xyz, centre, px.normal);
     }
 
     // 1. This frame's radiance and its neighbourhood's statistics.

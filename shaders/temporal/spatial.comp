@@ -59,7 +59,8 @@ void main() {
     const vec3 position = worldPosition(frame.inverseViewProjection, vec2(p) + 0.5, size, depth);
     const float w = viewDepth(frame.viewProjection, position);
     const float planeOffset = dot(frame.cameraPosition.xyz - position, normal);
-    const vec3 steps = planeDistanceSteps(frame.rays, vec2(p) + 0.5, normal);
+    const vec3 steps = planeDistanceSteps(frame.inverseViewProjection, frame.viewProjection, frame.cameraPosition.xyz,
+                                          vec2(p) + 0.5, normal);
     // Sigma of half the radius (plus half a pixel) keeps the window's
     // corners near zero weight.
     const float sigma = 0.5 * float(radius) + 0.5;

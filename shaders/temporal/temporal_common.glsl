@@ -28,18 +28,26 @@ float viewDepth(mat4 viewProjection, vec3 p) {
 // A point's distance to a plane from its view depth alone. The point at
 // view depth w on a camera's ray through pixel position q is
 // camera + w E(q), where E(q), the step along the ray per unit of view
-// depth, is affine in q (a pinhole camera, jittered or not: the rays meet
-// the near plane, where w is the same everywhere, at points affine in q).
-// So for a plane through `position` with unit `normal`, the point at view
-// depth w on the ray through q = pixelPosition + (dx, dy) lies
+// depth, is affine in q (a pinhole camera, jittered or not). So for a plane
+// through `position` with unit `normal`, the point at view depth w on the
+// ray through q = pixelPosition + (dx, dy) lies
 //   dot(camera - position, normal) + w (s.x + dx s.y + dy s.z)
 // off it, with s the vec3 returned here: e(q) = E(q) . normal at
-// pixelPosition and its steps per pixel in x and y. `rays` is E's affine
-// form for the camera (TemporalFrame::rays or previousRays).
-vec3 planeDistanceSteps(vec4 rays[3], vec2 pixelPosition, vec3 normal) {
-    const float perX = dot(rays[1].xyz, normal);
-    const float perY = dot(rays[2].xyz, normal);
-    return vec3(dot(rays[0].xyz, normal) + pixelPosition.x * perX + pixelPosition.y * perY, perX, perY);
+// pixelPosition and its steps per pixel in x and y. The matrices are the
+// camera's (jittered) inverse view-projection, which gives the rays, and
+// its view-projection, whose w row gives view depth.
+vec3 planeDistanceSteps(mat4 inverseViewProjection, mat4 viewProjection, vec3 camera, vec2 pixelPosition,
+                        vec3 normal) {
+    // w is linear along a ray from the camera, where it is 0.
+    const vec3 wRow = vec3(viewProjection[0][3], viewProjection[1][3], viewProjection[2][3]);
+    vec3 e[3];
+    for (int i = 0; i < 3; ++i) {
+        const vec2 q = pixelPosition + vec2(i == 1 ? 1.0 : 0.0, i == 2 ? 1.0 : 0.0);
+        const vec3 ray = worldPosition(inverseViewProjection, q, vec2(frame.size), 1.0) - camera;
+        e[i] = ray / dot(wRow, ray);
+    }
+    const float e0 = dot(e[0], normal);
+    return vec3(e0, dot(e[1], normal) - e0, dot(e[2], normal) - e0);
 }
 
 #endif

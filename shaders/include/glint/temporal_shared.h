@@ -64,18 +64,12 @@ struct TemporalFrame {
     float environmentRoughness;          // above this roughness the environment alone (above 1: nowhere)
     uint debugOutputs;                   // 1: write the motion and history length images
     uint frame;                          // the frame's index (the history's rounding noise)
-    // The view ray's step per unit of view depth at pixel position q
-    // (pixels), E(q) = rays[0] + q.x rays[1] + q.y rays[2] (xyz), for this
-    // frame's jittered camera and last frame's (temporal_common.glsl's
-    // planeDistanceSteps; passes/temporal.cpp computes them in double).
-    vec4 rays[3];
-    vec4 previousRays[3];
 };
 
 GLINT_END
 
 #ifdef __cplusplus
-static_assert(sizeof(glint::shader::TemporalFrame) == 4 * 64 + 2 * 16 + 100 + 6 * 16);
+static_assert(sizeof(glint::shader::TemporalFrame) == 4 * 64 + 2 * 16 + 100);
 #endif
 
 #endif
