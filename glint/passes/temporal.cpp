@@ -15,7 +15,8 @@ namespace glint::passes {
 
 namespace {
 
-uint32_t groups(uint32_t pixels) { return (pixels + shader::kTemporalGroupSize - 1) / shader::kTemporalGroupSize; }
+// Workgroups of `side` pixels across `pixels`.
+uint32_t groups(uint32_t pixels, uint32_t side) { return (pixels + side - 1) / side; }
 
 void checkSettings(const TemporalSettings& s) {
     const bool ok = std::isfinite(s.maxHistoryFrames) && s.maxHistoryFrames >= 1.0f && std::isfinite(s.clampGamma) &&
@@ -172,7 +173,8 @@ TemporalOutputs addTemporalPass(rg::Graph& graph, TemporalPipelines& pipelines, 
                 .storageImage("motionImage", pc.view(d.motionOut))
                 .storageImage("lengthImage", pc.view(d.lengthOut))
                 .push(pipelines.ctx_, pc.cmd());
-            pc.dispatch(pipeline, groups(width), groups(height));
+            constexpr uint32_t side = shader::kTemporalAccumulateGroupSize;
+            pc.dispatch(pipeline, groups(width, side), groups(height, side));
         });
 
     struct SpatialData {
@@ -201,7 +203,8 @@ TemporalOutputs addTemporalPass(rg::Graph& graph, TemporalPipelines& pipelines, 
                 .sampledImage("accumulatedTexture", pc.view(d.accumulated), sampler, pc.layout(d.accumulated))
                 .storageImage("resolvedImage", pc.view(d.resolved))
                 .push(pipelines.ctx_, pc.cmd());
-            pc.dispatch(pipeline, groups(width), groups(height));
+            constexpr uint32_t side = shader::kTemporalSpatialGroupSize;
+            pc.dispatch(pipeline, groups(width, side), groups(height, side));
         });
 
     out.resolved = spatial.resolved;

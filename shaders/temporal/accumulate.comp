@@ -34,7 +34,7 @@
 #include "glint/temporal_shared.h"
 #include "temporal_common.glsl"
 
-layout(local_size_x = kTemporalGroupSize, local_size_y = kTemporalGroupSize) in;
+layout(local_size_x = kTemporalAccumulateGroupSize, local_size_y = kTemporalAccumulateGroupSize) in;
 
 layout(set = 0, binding = 1) uniform sampler2D depthTexture;
 layout(set = 0, binding = 2) uniform sampler2D normalTexture;
@@ -213,18 +213,18 @@ void writeNothing(ivec2 p, vec2 motion) {
 // statistics want them: YCoCg of the compressed radiance, w = 1 where this
 // frame's radiance there is valid. Loaded once per workgroup: a 5x5 box
 // would otherwise fetch and convert every texel 25 times. The array holds
-// the largest border; only the frame's is loaded (144 texels instead of
-// 196 at the default radius 2: three rounds of the workgroup instead of
-// four), and no pixel reads beyond it.
-const int kTile = int(kTemporalGroupSize) + 2 * int(kTemporalMaxClampRadius);
+// the largest border; only the frame's is loaded (400 texels for the 256
+// pixels of a 16x16 workgroup at the default radius 2, instead of 484),
+// and no pixel reads beyond it.
+const int kTile = int(kTemporalAccumulateGroupSize) + 2 * int(kTemporalMaxClampRadius);
 shared vec4 tile[kTile * kTile];
 
 void loadTile() {
     const int border = int(min(frame.clampRadius, kTemporalMaxClampRadius));
-    const int side = int(kTemporalGroupSize) + 2 * border;
+    const int side = int(kTemporalAccumulateGroupSize) + 2 * border;
     const int skip = int(kTemporalMaxClampRadius) - border;  // the array's unused rows and columns
-    const ivec2 origin = ivec2(gl_WorkGroupID.xy) * int(kTemporalGroupSize) - border;
-    for (int i = int(gl_LocalInvocationIndex); i < side * side; i += int(kTemporalGroupSize * kTemporalGroupSize)) {
+    const ivec2 origin = ivec2(gl_WorkGroupID.xy) * int(kTemporalAccumulateGroupSize) - border;
+    for (int i = int(gl_LocalInvocationIndex); i < side * side; i += int(kTemporalAccumulateGroupSize * kTemporalAccumulateGroupSize)) {
         const ivec2 offset = ivec2(i % side, i / side);
         const ivec2 q = origin + offset;
         vec4 entry = vec4(0.0);

@@ -15,7 +15,7 @@
 #include "glint/temporal_shared.h"
 #include "temporal_common.glsl"
 
-layout(local_size_x = kTemporalGroupSize, local_size_y = kTemporalGroupSize) in;
+layout(local_size_x = kTemporalSpatialGroupSize, local_size_y = kTemporalSpatialGroupSize) in;
 
 layout(set = 0, binding = 1) uniform sampler2D depthTexture;
 // This frame's surface as the accumulation wrote it (temporal.surface:
