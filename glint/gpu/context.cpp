@@ -365,7 +365,8 @@ void Context::createDevice(const ContextOptions& options) {
     const bool hasRq = hasAs && hasExtension(extensions, VK_KHR_RAY_QUERY_EXTENSION_NAME) && !options.disableRayQuery;
     const bool hasRt = hasAs && hasExtension(extensions, VK_KHR_RAY_TRACING_PIPELINE_EXTENSION_NAME);
     const bool statsRequested = pipelineStatisticsRequested(options);
-    const bool hasStats = statsRequested && hasExtension(extensions, VK_KHR_PIPELINE_EXECUTABLE_PROPERTIES_EXTENSION_NAME);
+    const bool hasStats =
+        statsRequested && hasExtension(extensions, VK_KHR_PIPELINE_EXECUTABLE_PROPERTIES_EXTENSION_NAME);
 
     // Build the query chain with only the structures this device knows.
     void* chain = nullptr;

@@ -41,7 +41,8 @@ void logStatistics(const Context& ctx, VkPipeline pipeline, const std::string& n
     info.pipeline = pipeline;
     uint32_t count = 0;
     if (fn.getPipelineExecutableProperties(ctx.device(), &info, &count, nullptr) != VK_SUCCESS) return;
-    std::vector<VkPipelineExecutablePropertiesKHR> executables(count, {VK_STRUCTURE_TYPE_PIPELINE_EXECUTABLE_PROPERTIES_KHR});
+    std::vector<VkPipelineExecutablePropertiesKHR> executables(
+        count, {VK_STRUCTURE_TYPE_PIPELINE_EXECUTABLE_PROPERTIES_KHR});
     if (fn.getPipelineExecutableProperties(ctx.device(), &info, &count, executables.data()) != VK_SUCCESS) return;
     for (uint32_t e = 0; e < count; ++e) {
         VkPipelineExecutableInfoKHR which{VK_STRUCTURE_TYPE_PIPELINE_EXECUTABLE_INFO_KHR};
@@ -49,7 +50,8 @@ void logStatistics(const Context& ctx, VkPipeline pipeline, const std::string& n
         which.executableIndex = e;
         uint32_t statCount = 0;
         if (fn.getPipelineExecutableStatistics(ctx.device(), &which, &statCount, nullptr) != VK_SUCCESS) continue;
-        std::vector<VkPipelineExecutableStatisticKHR> stats(statCount, {VK_STRUCTURE_TYPE_PIPELINE_EXECUTABLE_STATISTIC_KHR});
+        std::vector<VkPipelineExecutableStatisticKHR> stats(statCount,
+                                                            {VK_STRUCTURE_TYPE_PIPELINE_EXECUTABLE_STATISTIC_KHR});
         if (fn.getPipelineExecutableStatistics(ctx.device(), &which, &statCount, stats.data()) != VK_SUCCESS) continue;
         std::string text;
         for (const VkPipelineExecutableStatisticKHR& s : stats) {
@@ -73,7 +75,8 @@ void logStatistics(const Context& ctx, VkPipeline pipeline, const std::string& n
                     text += "?";
             }
         }
-        spdlog::info("pipeline '{}' {} (subgroup {}): {}", name, executables[e].name, executables[e].subgroupSize, text);
+        spdlog::info("pipeline '{}' {} (subgroup {}): {}", name, executables[e].name, executables[e].subgroupSize,
+                     text);
     }
 }
 

@@ -224,7 +224,8 @@ void loadTile() {
     const int side = int(kTemporalAccumulateGroupSize) + 2 * border;
     const int skip = int(kTemporalMaxClampRadius) - border;  // the array's unused rows and columns
     const ivec2 origin = ivec2(gl_WorkGroupID.xy) * int(kTemporalAccumulateGroupSize) - border;
-    for (int i = int(gl_LocalInvocationIndex); i < side * side; i += int(kTemporalAccumulateGroupSize * kTemporalAccumulateGroupSize)) {
+    const int invocations = int(kTemporalAccumulateGroupSize * kTemporalAccumulateGroupSize);
+    for (int i = int(gl_LocalInvocationIndex); i < side * side; i += invocations) {
         const ivec2 offset = ivec2(i % side, i / side);
         const ivec2 q = origin + offset;
         vec4 entry = vec4(0.0);
