@@ -110,24 +110,25 @@ std::string unsuitableReason(VkPhysicalDevice device, const ContextOptions& opti
     return reason;
 }
 
+// An option, or its environment variable set to 1.
+bool optionOrEnvironment(bool option, const char* variable) {
+    if (option) return true;
+    const char* env = std::getenv(variable);
+    return env != nullptr && std::string_view(env) == "1";
+}
+
 } // namespace
 
 bool rayTracingDisabled(const ContextOptions& options) {
-    if (options.disableRayTracing) return true;
-    const char* env = std::getenv("GLINT_NO_RAY_TRACING");
-    return env != nullptr && std::string_view(env) == "1";
+    return optionOrEnvironment(options.disableRayTracing, "GLINT_NO_RAY_TRACING");
 }
 
 bool validationRequested(const ContextOptions& options) {
-    if (options.validation) return true;
-    const char* env = std::getenv("GLINT_VALIDATION");
-    return env != nullptr && std::string_view(env) == "1";
+    return optionOrEnvironment(options.validation, "GLINT_VALIDATION");
 }
 
 bool pipelineStatisticsRequested(const ContextOptions& options) {
-    if (options.pipelineStatistics) return true;
-    const char* env = std::getenv("GLINT_PIPELINE_STATS");
-    return env != nullptr && std::string_view(env) == "1";
+    return optionOrEnvironment(options.pipelineStatistics, "GLINT_PIPELINE_STATS");
 }
 
 std::string versionString(uint32_t v) {
