@@ -226,7 +226,7 @@ ParticleTraceOutputs addParticleTracePass(rg::Graph& graph, ParticlePipelines& p
             if (hasSslr) {
                 d.sslrRadiance = b.read(inputs.sslr->radiance, rg::Access::SampledRead);
                 d.sslrConfidence = b.read(inputs.sslr->confidence, rg::Access::SampledRead);
-                d.sslrHit = b.read(inputs.sslr->hitDebug, rg::Access::SampledRead);
+                d.sslrHit = b.read(inputs.sslr->hit, rg::Access::SampledRead);
             }
             if (hasRt) {
                 d.rtRadiance = b.read(inputs.rtRadiance, rg::Access::SampledRead);

@@ -78,26 +78,26 @@ SslrOutputs addSslrPass(rg::Graph& graph, SslrPipelines& pipelines, const SslrIn
     };
     rg::Texture radiance = texture("sslr.radiance", kSslrRadianceFormat);
     rg::Texture confidence = texture("sslr.confidence", kSslrConfidenceFormat);
-    rg::Texture hitDebug = texture("sslr.hit_debug", kSslrHitDebugFormat);
+    rg::Texture hit = texture("sslr.hit", kSslrHitFormat);
     if (settings.clearUntraced) {
         struct ClearData {
-            rg::Texture radiance, confidence, hitDebug;
+            rg::Texture radiance, confidence, hit;
         };
         const ClearData& clear = graph.addPass<ClearData>(
             "sslr.clear", rg::Queue::Graphics,
             [&](rg::Builder& b, ClearData& d) {
                 d.radiance = b.write(radiance, rg::Access::StorageWrite);
                 d.confidence = b.write(confidence, rg::Access::StorageWrite);
-                d.hitDebug = b.write(hitDebug, rg::Access::StorageWrite);
+                d.hit = b.write(hit, rg::Access::StorageWrite);
             },
             [&pipelines](const ClearData& d, rg::PassContext& pc) {
-                for (const rg::Texture t : {d.radiance, d.confidence, d.hitDebug}) {
+                for (const rg::Texture t : {d.radiance, d.confidence, d.hit}) {
                     pipelines.clearer_.clear(pc, t);
                 }
             });
         radiance = clear.radiance;
         confidence = clear.confidence;
-        hitDebug = clear.hitDebug;
+        hit = clear.hit;
     }
 
     // The cone trace's colour pyramid (glint/sslr_shared.h): two passes,
@@ -219,7 +219,7 @@ SslrOutputs addSslrPass(rg::Graph& graph, SslrPipelines& pipelines, const SslrIn
             d.out = out;
             d.out.radiance = b.write(radiance, rg::Access::StorageWrite);
             d.out.confidence = b.write(confidence, rg::Access::StorageWrite);
-            d.out.hitDebug = b.write(hitDebug, rg::Access::StorageWrite);
+            d.out.hit = b.write(hit, rg::Access::StorageWrite);
             // Appends after ray generation's RT rays.
             d.out.rtRayList = b.write(rays.rtRays, rg::Access::StorageReadWrite);
             d.out.rtArgs = b.write(rays.rtArgs, rg::Access::StorageReadWrite);
@@ -240,7 +240,7 @@ SslrOutputs addSslrPass(rg::Graph& graph, SslrPipelines& pipelines, const SslrIn
                 .storageBuffer("SslrRays", pc.buffer(d.sslrRays))
                 .storageImage("radianceImage", pc.view(d.out.radiance))
                 .storageImage("confidenceImage", pc.view(d.out.confidence))
-                .storageImage("hitDebugImage", pc.view(d.out.hitDebug))
+                .storageImage("hitImage", pc.view(d.out.hit))
                 .storageBuffer("RtRays", pc.buffer(d.out.rtRayList))
                 .storageBuffer("RtArgs", pc.buffer(d.out.rtArgs))
                 .sampledImage("roughnessMetalTexture", pc.view(d.roughnessMetal), sampler, pc.layout(d.roughnessMetal))

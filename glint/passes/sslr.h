@@ -35,7 +35,11 @@ namespace glint::passes {
 
 inline constexpr VkFormat kSslrRadianceFormat = VK_FORMAT_R16G16B16A16_SFLOAT;
 inline constexpr VkFormat kSslrConfidenceFormat = VK_FORMAT_R16_SFLOAT;
-inline constexpr VkFormat kSslrHitDebugFormat = VK_FORMAT_R16G16B16A16_SFLOAT;
+// The hit's texel as the uv of its centre. Float32: a half float's 11
+// bits put uv a texel off from 2048 pixels across (readers floor uv * size
+// to find the hit's depth and motion), and R32G32_SFLOAT is a storage
+// format every device has.
+inline constexpr VkFormat kSslrHitFormat = VK_FORMAT_R32G32_SFLOAT;
 
 // The Far Cry 6 talk's SSLR confidence threshold; ReflectionFrameSettings
 // hands one value to SSLR, integrate and the particle trace.
@@ -109,7 +113,7 @@ float sslrStoredThreshold(float threshold);
 struct SslrOutputs {
     rg::Texture radiance;    // kSslrRadianceFormat: lit colour at the hit, a = hit
     rg::Texture confidence;  // kSslrConfidenceFormat, [0, 1]
-    rg::Texture hitDebug;    // kSslrHitDebugFormat: hit uv, confidence, hit (debug view "sslr_hits")
+    rg::Texture hit;         // kSslrHitFormat: uv of the hit texel's centre (where radiance.a says a hit)
     rg::Buffer rtRayList;    // ray generation's RT ray list with the unresolved hybrid rays appended
     rg::Buffer rtArgs;       // its args (glint/ray_generation_shared.h kRayList*)
     rg::Texture litPyramid;  // the cone trace's colour pyramid (invalid without cone trace; unbuilt without cone rays)

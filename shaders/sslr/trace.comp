@@ -24,10 +24,10 @@ layout(set = 0, binding = 3, scalar) readonly buffer Rays { PackedRay rays[]; };
 layout(set = 0, binding = 4, scalar) readonly buffer Classes { uint classes[]; };
 layout(set = 0, binding = 5, scalar) readonly buffer SslrRays { PackedRay sslrRays[]; };
 layout(set = 0, binding = 6, rgba16f) uniform writeonly image2D radianceImage;
-// R16F is not among the formats every device can store with a format
-// qualifier; the context enables shaderStorageImageWriteWithoutFormat.
+// R16F and RG32F are not among the formats every device can store with a
+// format qualifier; the context enables shaderStorageImageWriteWithoutFormat.
 layout(set = 0, binding = 7) uniform writeonly image2D confidenceImage;
-layout(set = 0, binding = 8, rgba16f) uniform writeonly image2D hitDebugImage;
+layout(set = 0, binding = 8) uniform writeonly image2D hitImage;
 layout(set = 0, binding = 9, scalar) writeonly buffer RtRays { PackedRay rtRays[]; };
 layout(set = 0, binding = 10, scalar) buffer RtArgs { uint rtArgs[]; };
 layout(set = 0, binding = 11) uniform sampler2D roughnessMetalTexture;
@@ -95,7 +95,7 @@ float screenExit(float start, float delta, float size) {
 void writeResult(ivec2 pixel, vec3 radiance, float confidence, vec2 hitUv, bool hit) {
     imageStore(radianceImage, pixel, vec4(radiance, hit ? 1.0 : 0.0));
     imageStore(confidenceImage, pixel, vec4(confidence));
-    imageStore(hitDebugImage, pixel, vec4(hitUv, confidence, hit ? 1.0 : 0.0));
+    imageStore(hitImage, pixel, vec4(hitUv, 0.0, 0.0));
 }
 
 void main() {

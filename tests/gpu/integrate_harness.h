@@ -275,7 +275,7 @@ inline scene::Scene mirrorWallScene() {
 struct Traces {
     std::vector<glm::vec4> sslrRadiance;  // a = hit
     std::vector<float> sslrConfidence;
-    std::vector<glm::vec4> sslrHit;       // uv, confidence, hit
+    std::vector<glm::vec2> sslrHit;       // uv of the hit texel's centre (float32)
     std::vector<glm::vec4> rtRadiance;    // a = traced
     std::vector<float> rtHitDistance;
 };
@@ -303,7 +303,7 @@ inline Traces makeTraces(uint32_t seed, bool poison) {
             t.sslrRadiance[i] = glm::vec4(float(x) / 64.0f + 0.01f, float(y) / 64.0f + 0.02f, 0.25f, hit);
             t.sslrConfidence[i] = c;
             const glm::vec2 uv((float(x) + 0.5f) / float(kSize), (float(hitRow(x, y)) + 0.5f) / float(kSize));
-            t.sslrHit[i] = glm::vec4(uv, c, hit);
+            t.sslrHit[i] = uv;
             const bool traced = (x + 2 * y + seed) % 3 != 0;
             t.rtRadiance[i] = glm::vec4(0.75f, float(x) / 64.0f, float(y) / 64.0f, traced ? 1.0f : 0.0f);
             t.rtHitDistance[i] = 1.0f + 0.5f * float(x) + 0.01f * float(y);
@@ -317,7 +317,6 @@ inline Traces makeTraces(uint32_t seed, bool poison) {
             }
             for (int c4 = 0; c4 < 4; ++c4) {
                 t.sslrRadiance[i][c4] = half(t.sslrRadiance[i][c4]);
-                t.sslrHit[i][c4] = half(t.sslrHit[i][c4]);
                 t.rtRadiance[i][c4] = half(t.rtRadiance[i][c4]);
             }
             t.sslrConfidence[i] = half(t.sslrConfidence[i]);
@@ -559,13 +558,13 @@ public:
             passes::SslrOutputs sslr;
             sslr.width = kSize;
             sslr.height = kSize;
-            const auto r = halves(traces.sslrRadiance), c = halves(traces.sslrConfidence), h = halves(traces.sslrHit);
+            const auto r = halves(traces.sslrRadiance), c = halves(traces.sslrConfidence);
             sslr.radiance = transfers_.uploadTexture(graph, resources, "sslr_radiance", passes::kSslrRadianceFormat,
                                                      r.data(), r.size() * 2);
             sslr.confidence = transfers_.uploadTexture(graph, resources, "sslr_confidence",
                                                        passes::kSslrConfidenceFormat, c.data(), c.size() * 2);
-            sslr.hitDebug = transfers_.uploadTexture(graph, resources, "sslr_hits", passes::kSslrHitDebugFormat,
-                                                     h.data(), h.size() * 2);
+            sslr.hit = transfers_.uploadTexture(graph, resources, "sslr_hits", passes::kSslrHitFormat,
+                                                traces.sslrHit.data(), kPixels * sizeof(glm::vec2));
             in.sslr = sslr;
         }
         if (present.rt) {
@@ -596,7 +595,7 @@ public:
         if (in.sslr) {
             sslrRadiance = transfers_.readTexture(graph, resources, in.sslr->radiance, 8);
             sslrConfidence = transfers_.readTexture(graph, resources, in.sslr->confidence, 2);
-            sslrHit = transfers_.readTexture(graph, resources, in.sslr->hitDebug, 8);
+            sslrHit = transfers_.readTexture(graph, resources, in.sslr->hit, 8);
         }
         if (feedback) {
             const uint64_t bytes = uint64_t(kTiles) * kTiles * 4;
@@ -613,14 +612,12 @@ public:
             // What the SSLR pass (or the upload) left, as integrate read it.
             const auto r = transfers_.get<uint16_t>(sslrRadiance);
             const auto c = transfers_.get<uint16_t>(sslrConfidence);
-            const auto h = transfers_.get<uint16_t>(sslrHit);
+            f.sslr.sslrHit = transfers_.get<glm::vec2>(sslrHit);
             f.sslr.sslrRadiance.resize(kPixels);
             f.sslr.sslrConfidence.resize(kPixels);
-            f.sslr.sslrHit.resize(kPixels);
             for (size_t i = 0; i < kPixels; ++i) {
                 for (int k = 0; k < 4; ++k) {
                     f.sslr.sslrRadiance[i][k] = glm::unpackHalf1x16(r[i * 4 + k]);
-                    f.sslr.sslrHit[i][k] = glm::unpackHalf1x16(h[i * 4 + k]);
                 }
                 f.sslr.sslrConfidence[i] = glm::unpackHalf1x16(c[i]);
             }

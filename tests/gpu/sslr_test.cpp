@@ -54,7 +54,7 @@ struct SslrFrame {
     std::array<uint32_t, shader::kRayListArgsWords> rtArgs{};
     std::vector<glm::vec4> radiance;
     std::vector<float> confidence;
-    std::vector<glm::vec4> hitDebug;
+    std::vector<glm::vec2> hit;
     std::vector<glm::vec4> lit;
 
     size_t at(uint32_t x, uint32_t y) const { return size_t(y) * kSize + x; }
@@ -80,7 +80,7 @@ public:
     void add(rg::Graph& graph, const passes::RayGenerationOutputs& rays, const passes::SslrOutputs& sslr,
              const passes::GBufferOutputs& gbuf, rg::FrameResources& frame) const {
         const std::array<rg::Buffer, kBuffers> buffers = {rays.rays, rays.classes, sslr.rtRayList, sslr.rtArgs};
-        const std::array<rg::Texture, kTextures> textures = {sslr.radiance, sslr.confidence, sslr.hitDebug, gbuf.lit};
+        const std::array<rg::Texture, kTextures> textures = {sslr.radiance, sslr.confidence, sslr.hit, gbuf.lit};
         for (size_t i = 0; i < kBuffers; ++i) buffers_[i].copy(graph, frame, buffers[i]);
         for (size_t i = 0; i < kTextures; ++i) buffers_[kBuffers + i].copy(graph, frame, textures[i]);
     }
@@ -103,7 +103,7 @@ public:
         };
         f.radiance.resize(n);
         f.confidence.resize(n);
-        f.hitDebug.resize(n);
+        f.hit.resize(n);
         f.lit.resize(n);
         for (size_t i = 0; i < n; ++i) {
             f.lit[i] = halves(buffers_[7], i, 4);
@@ -116,7 +116,7 @@ public:
             if (!leader) continue;
             f.radiance[i] = halves(buffers_[4], i, 4);
             f.confidence[i] = halves(buffers_[5], i, 1).x;
-            f.hitDebug[i] = halves(buffers_[6], i, 4);
+            std::memcpy(&f.hit[i], buffers_[6].bytes().data() + i * sizeof(glm::vec2), sizeof(glm::vec2));
         }
         return f;
     }
@@ -264,7 +264,7 @@ TEST_CASE("SSLR finds the wall in a mirror floor within one texel, with its lit 
                 const size_t i = f.at(x, y);
                 REQUIRE(finite(f.radiance[i]));
                 REQUIRE(std::isfinite(f.confidence[i]));
-                REQUIRE(finite(f.hitDebug[i]));
+                REQUIRE((std::isfinite(f.hit[i].x) && std::isfinite(f.hit[i].y)));
                 REQUIRE(f.confidence[i] >= 0.0f);
                 REQUIRE(f.confidence[i] <= 1.0f);
                 if (f.classes[i] != shader::kPixelHybrid) {
@@ -283,8 +283,8 @@ TEST_CASE("SSLR finds the wall in a mirror floor within one texel, with its lit 
                                       expected.x > fadePixels + 1.0f && expected.x < float(kSize) - fadePixels - 1.0f;
                 if (onWall && clearHit) {
                     ++checkedHits;
-                    REQUIRE(f.hitDebug[i].w == 1.0f);
-                    const glm::vec2 got = glm::vec2(f.hitDebug[i]) * float(kSize);
+                    REQUIRE(f.radiance[i].a == 1.0f);
+                    const glm::vec2 got = f.hit[i] * float(kSize);
                     // Within one texel of the analytic hit.
                     REQUIRE(std::abs(got.x - expected.x) <= 1.0f);
                     REQUIRE(std::abs(got.y - expected.y) <= 1.0f);
@@ -348,7 +348,37 @@ TEST_CASE("the start offsets are deterministic per frame") {
     const SslrFrame a = trace(gpu, 7);
     const SslrFrame b = trace(gpu, 7);
     CHECK(a.confidence == b.confidence);
-    CHECK(std::memcmp(a.hitDebug.data(), b.hitDebug.data(), a.hitDebug.size() * sizeof(glm::vec4)) == 0);
+    CHECK(std::memcmp(a.hit.data(), b.hit.data(), a.hit.size() * sizeof(glm::vec2)) == 0);
+}
+
+// A float as an image of `format` stores it (the float formats a hit image
+// could have; anything else fails the test).
+float storedAs(VkFormat format, float x) {
+    switch (format) {
+    case VK_FORMAT_R32G32_SFLOAT:
+    case VK_FORMAT_R32G32B32A32_SFLOAT:
+        return x;
+    case VK_FORMAT_R16G16_SFLOAT:
+    case VK_FORMAT_R16G16B16A16_SFLOAT:
+        return glm::unpackHalf1x16(glm::packHalf1x16(x));
+    default:
+        FAIL("no rounding known for format " << format);
+        return x;
+    }
+}
+
+TEST_CASE("the hit image gives readers the hit's own texel at every image size up to 8K") {
+    // SSLR stores the hit texel's centre as uv; integrate and the particle
+    // trace floor uv * size to read the hit's depth and motion. In half
+    // floats that floor lands on a neighbour from 2048 pixels across.
+    for (const uint32_t size : {1920u, 2048u, 2560u, 3840u, 7680u}) {
+        for (uint32_t x = 0; x < size; ++x) {
+            const float uv = (float(x) + 0.5f) / float(size);
+            const float back = std::floor(storedAs(passes::kSslrHitFormat, uv) * float(size));
+            INFO("size " << size << " texel " << x);
+            REQUIRE(back == float(x));
+        }
+    }
 }
 
 TEST_CASE("rays from a mirror wall back toward the camera leave the screen with zero confidence and go to RT") {
@@ -370,7 +400,7 @@ TEST_CASE("rays from a mirror wall back toward the camera leave the screen with 
             const glm::vec3 d = shader::unpackRayDirection(f.rays[i].direction);
             REQUIRE(d.z > 0.5f);  // toward the camera (+Z)
             REQUIRE(f.confidence[i] == 0.0f);
-            REQUIRE(f.hitDebug[i].w == 0.0f);
+            REQUIRE(f.radiance[i].a == 0.0f);
             REQUIRE(listed.count(shader::packRayPixel({x, y}, false)) == 1);
             ++checked;
         }

@@ -9,7 +9,7 @@
 // SSLR and hybrid pixels:
 //   radiance    lit colour at the hit, rgb; a = 1 where a hit was found
 //   confidence  [0, 1]: 0 for misses (off screen, sky, too thick, back face)
-//   hitDebug    xy = hit uv, z = confidence, w = 1 on a hit
+//   hit         xy = uv of the hit texel's centre (float32: exact at any size)
 // RT hand-off: each hybrid ray whose confidence is not at least the
 // threshold (NaN included) is appended to ray generation's RT ray list
 // (glint/ray_generation_shared.h, kRayList*), after the RT pixels' rays.
