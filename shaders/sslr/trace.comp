@@ -149,9 +149,10 @@ void main() {
     m.dk = 1.0 / clip1.z - m.k0;
 
     // Screen exit: the largest t in [0, 1] with the position inside the
-    // image. Per axis by name: a loop that indexed m's vectors by a variable
-    // is the likely cause of the 16 bytes of local memory NVIDIA reported
-    // for this shader (GLINT_PIPELINE_STATS=1), the size of start and delta.
+    // image, per axis. (Not the 16 bytes of local memory NVIDIA reports for
+    // this shader, GLINT_PIPELINE_STATS=1: they stayed when a loop indexing
+    // m's vectors by a variable gave way to this; the optimised SPIR-V has
+    // no function-local variable left.)
     const float tEnd = max(min(1.0, min(screenExit(m.start.x, m.delta.x, float(pc.size.x)),
                                         screenExit(m.start.y, m.delta.y, float(pc.size.y)))),
                            0.0);
