@@ -140,7 +140,8 @@ RayGenerationOutputs addRayGenerationPass(rg::Graph& graph, RayGenerationPipelin
                       (inputs.tileModes.valid() && !idle ? shader::kRayGenTileModes : 0u) |
                       (settings.checkerboard ? shader::kRayGenCheckerboard : 0u) |
                       (settings.blueNoise ? shader::kRayGenBlueNoise : 0u) |
-                      (settings.sslrFirst ? shader::kRayGenSslrFirst : 0u);
+                      (settings.sslrFirst ? shader::kRayGenSslrFirst : 0u) |
+                      (inputs.debugOutputs ? shader::kRayGenClassDebug : 0u);
     constants.coneRoughness = settings.coneRoughness;
     constants.rtToHybridShare = settings.rtToHybridShare;
     constants.tilesX = out.tilesX;
@@ -201,7 +202,12 @@ RayGenerationOutputs addRayGenerationPass(rg::Graph& graph, RayGenerationPipelin
             pipeline.pushConstants(pc.cmd(), constants);
             pc.dispatch(pipeline, d.out.tilesX, d.out.tilesY);
         });
-    return classify.out;
+    RayGenerationOutputs result = classify.out;
+    if (!inputs.debugOutputs) {
+        // Declared (the binding needs an image) but never stored to.
+        result.classDebug = {};
+    }
+    return result;
 }
 
 } // namespace glint::passes

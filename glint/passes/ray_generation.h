@@ -64,6 +64,11 @@ struct RayGenerationInputs {
     // in rt mode, and `tileModes`, still declared so that the frame keeps
     // its plan, is not read.
     bool screenSpaceIdle = false;
+    // Write RayGenerationOutputs::classDebug (its debug view, tests). Off,
+    // nothing writes it and the output is an invalid handle: 4 bytes a
+    // pixel the frame does not store (the reflection frame turns it on for
+    // its debug view only).
+    bool debugOutputs = true;
 };
 
 struct RayGenerationSettings {
@@ -137,7 +142,9 @@ struct RayGenerationOutputs {
     rg::Buffer sslrArgs;      // shader::kSslrArgsWords: dispatch at kRayListDispatchArgsBytes, SSLR's pyramid after it
     rg::Buffer rtRays;        // RT ray list: shader::PackedRay per RT ray leader (capacity: one per pixel)
     rg::Buffer rtArgs;        // shader::kRayListArgsWords: dispatch at kRayListDispatchArgsBytes, trace at kRayListTraceArgsBytes
-    rg::Texture classDebug;   // kRayClassDebugFormat: a colour per class (debug view "ray_classes")
+    // kRayClassDebugFormat: a colour per class (debug view "ray_classes");
+    // with RayGenerationInputs::debugOutputs, else invalid.
+    rg::Texture classDebug;
     // Whether each list can hold entries this frame: ssr mode lists nothing
     // for RT (SSLR's failures take the environment), rt mode and a frame
     // the gate renders as rt nothing for SSLR. A pass that walks a list

@@ -189,6 +189,7 @@ ReflectionFrame ReflectionRenderer::addFrame(rg::Graph& graph, const scene::Came
     RayGenerationInputs rayInputs{f.gbuffer, frameIndex, camera};
     rayInputs.mode = mode;
     rayInputs.sslrMinDistance = settings.reach;
+    rayInputs.debugOutputs = view == "ray_classes";
     const bool sslrFallback = !f.bvhComplete && settings.sslrWhileBvhBuilds && screenSpace;
     // The traces write only their rays' pixels; a debug view of their raw
     // outputs shows the rest cleared rather than stale.

@@ -183,7 +183,9 @@ void main() {
             ray.direction = direction;
         }
         rays[index] = ray;
-        imageStore(classDebug, ivec2(pixel), kClassColours[pixelClass]);
+        if ((pc.flags & kRayGenClassDebug) != 0u) {
+            imageStore(classDebug, ivec2(pixel), kClassColours[pixelClass]);
+        }
     }
     // Ray leaders take consecutive slots of the tile's range in their list:
     // one global atomic per tile and list, not per ray.

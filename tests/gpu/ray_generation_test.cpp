@@ -42,7 +42,7 @@ using test::testCamera;
 
 constexpr rg::BoundaryState kHostWrite =
     rg::BoundaryState::raw(VK_PIPELINE_STAGE_2_HOST_BIT, VK_ACCESS_2_HOST_WRITE_BIT, VK_IMAGE_LAYOUT_UNDEFINED);
-constexpr size_t kReadbacks = 6;
+constexpr size_t kReadbacks = 7;  // the last: the class debug image, when the pass writes it
 
 // What the pass wrote in one frame, read back on the host.
 struct RayFrame {
@@ -52,6 +52,7 @@ struct RayFrame {
     std::vector<shader::PackedRay> rtRays;
     std::array<uint32_t, shader::kRayListArgsWords> sslrArgs{};
     std::array<uint32_t, shader::kRayListArgsWords> rtArgs{};
+    std::vector<glm::u8vec4> classDebug;  // empty: the pass declared none (RayGenerationInputs::debugOutputs)
 
     size_t at(uint32_t x, uint32_t y) const { return size_t(y) * kSize + x; }
 };
@@ -66,16 +67,19 @@ public:
                                                         kSize * kSize * sizeof(shader::PackedRay),
                                                         kSize * kSize * sizeof(shader::PackedRay),
                                                         shader::kRayListArgsWords * 4,
-                                                        shader::kRayListArgsWords * 4};
+                                                        shader::kRayListArgsWords * 4,
+                                                        kSize * kSize * 4};
         for (size_t i = 0; i < bytes.size(); ++i) {
             buffers_.emplace_back(ctx, bytes[i], "ray_generation_test.readback" + std::to_string(i));
         }
     }
 
-    void add(rg::Graph& graph, const passes::RayGenerationOutputs& out, rg::FrameResources& frame) const {
-        const std::array<rg::Buffer, kReadbacks> sources = {out.rays,   out.classes,  out.sslrRays,
-                                                            out.rtRays, out.sslrArgs, out.rtArgs};
+    void add(rg::Graph& graph, const passes::RayGenerationOutputs& out, rg::FrameResources& frame) {
+        const std::array<rg::Buffer, kReadbacks - 1> sources = {out.rays,   out.classes,  out.sslrRays,
+                                                                out.rtRays, out.sslrArgs, out.rtArgs};
         for (size_t i = 0; i < sources.size(); ++i) buffers_[i].copy(graph, frame, sources[i]);
+        classDebug_ = out.classDebug.valid();
+        if (classDebug_) buffers_[kReadbacks - 1].copy(graph, frame, out.classDebug);
     }
 
     RayFrame decode() const {
@@ -90,11 +94,13 @@ public:
         copy(f.rtRays, buffers_[3]);
         std::memcpy(f.sslrArgs.data(), buffers_[4].bytes().data(), sizeof(f.sslrArgs));
         std::memcpy(f.rtArgs.data(), buffers_[5].bytes().data(), sizeof(f.rtArgs));
+        if (classDebug_) copy(f.classDebug, buffers_[6]);
         return f;
     }
 
 private:
     std::vector<rg::HostReadback> buffers_;
+    bool classDebug_ = false;
 };
 
 // A floor at y = -1 under a camera at the origin looking down -Z: the lower
@@ -129,6 +135,7 @@ glm::vec3 viewRay(uint32_t x, uint32_t y) {
 struct Band {
     passes::ReflectionMode mode = passes::ReflectionMode::Hybrid;
     float sslrMinDistance = scene::kDefaultBvhRadius;
+    bool debugOutputs = true;  // RayGenerationInputs::debugOutputs: the class debug image
 };
 
 // Renders the G-buffer and the ray generation for each frame index, with
@@ -156,6 +163,7 @@ std::vector<RayFrame> generate(test::GpuTest& gpu, const scene::Scene& scene, co
         passes::RayGenerationInputs inputs{gbuf, frame, camera};
         inputs.mode = band.mode;
         inputs.sslrMinDistance = band.sslrMinDistance;
+        inputs.debugOutputs = band.debugOutputs;
         if (!tileModes.empty()) {
             inputs.tileModes = graph.importBuffer(
                 "tile_modes", {{modes.size()}, kHostWrite, rg::BoundaryState::of(rg::Access::StorageRead)});
@@ -387,6 +395,41 @@ TEST_CASE("rough rays stay in the upper hemisphere of the normal over many frame
     // The rays are rough, not mirrors: successive frames differ.
     CHECK(frames[0].rays[frames[0].at(10, 50)].direction != frames[1].rays[frames[1].at(10, 50)].direction);
     CHECK(meanCosine / rays > 0.0);
+}
+
+TEST_CASE("the class colours are written only for their debug view, and the rays are the same without them") {
+    test::GpuTest gpu;
+    const scene::Scene scene = floorScene(0.15f);
+    const RayFrame with = generate(gpu, scene, {3})[0];
+    Band band;
+    band.debugOutputs = false;
+    const RayFrame without = generate(gpu, scene, {3}, {}, band)[0];
+    CHECK(without.classDebug.empty());
+    REQUIRE(with.classDebug.size() == size_t(kSize) * kSize);
+    // A colour per class (shaders/ray_generation/classify.comp's table,
+    // stored as UNORM8: within one step of the value x 255).
+    const std::array<glm::vec3, 5> colours = {glm::vec3(0.0f), glm::vec3(0.5f), glm::vec3(0.1f, 0.3f, 1.0f),
+                                              glm::vec3(0.7f, 0.2f, 0.9f), glm::vec3(1.0f, 0.15f, 0.1f)};
+    std::set<uint32_t> seen;
+    for (size_t i = 0; i < with.classDebug.size(); ++i) {
+        INFO("pixel " << i << " class " << with.classes[i]);
+        REQUIRE(with.classes[i] < colours.size());
+        const glm::vec3 got = glm::vec3(glm::vec3(with.classDebug[i])) / 255.0f;
+        REQUIRE(glm::all(glm::lessThanEqual(glm::abs(got - colours[with.classes[i]]), glm::vec3(1.0f / 255.0f))));
+        REQUIRE(with.classDebug[i].a == 255);
+        seen.insert(with.classes[i]);
+    }
+    // The sky, the floor's hybrid band and its near RT rows.
+    CHECK(seen.count(shader::kPixelSky) == 1);
+    CHECK(seen.count(shader::kPixelHybrid) == 1);
+    CHECK(seen.count(shader::kPixelRt) == 1);
+    CHECK(with.classes == without.classes);
+    for (size_t i = 0; i < with.rays.size(); ++i) {
+        REQUIRE(with.rays[i].pixelFlags == without.rays[i].pixelFlags);
+        REQUIRE(with.rays[i].direction == without.rays[i].direction);
+    }
+    CHECK(with.sslrArgs == without.sslrArgs);
+    CHECK(with.rtArgs == without.rtArgs);
 }
 
 TEST_CASE("the same frame index gives the same rays") {

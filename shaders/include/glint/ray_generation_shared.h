@@ -120,6 +120,7 @@ GLINT_CONST uint kRayGenTileModes = 1u << 3u;  // hybrid pixels follow the feedb
 GLINT_CONST uint kRayGenCheckerboard = 1u << 4u;  // half the smooth hybrid and RT pixels share a neighbour's ray
 GLINT_CONST uint kRayGenBlueNoise = 1u << 5u;  // GGX samples and the hybrid share from the blue noise (glint/sampling.glsl)
 GLINT_CONST uint kRayGenSslrFirst = 1u << 6u;  // hybrid mode: RT pixels try SSLR first (the BVH is building)
+GLINT_CONST uint kRayGenClassDebug = 1u << 7u;  // write the class debug colours (RayGenerationInputs::debugOutputs)
 
 GLINT_END
 
