@@ -15,6 +15,7 @@
 #include "glint/gbuffer_shared.h"
 #include "glint/integrate_shared.h"
 #include "glint/ray_generation_shared.h"
+#include "glint/sslr_shared.h"
 // The prefiltered environment (glint/environment.glsl).
 #define GLINT_ENVIRONMENT_BINDING 17
 #include "glint/brdf.glsl"
@@ -241,7 +242,7 @@ Reflection integratePixel(uvec2 pixel) {
         r.source = kSourceSslr;
         // The reflected point is the surface the depth buffer holds at the
         // hit texel, measured from this pixel's own surface.
-        const ivec2 hitTexel = clamp(ivec2(floor(sslrHitUv * vec2(C.size))), ivec2(0), ivec2(C.size) - 1);
+        const ivec2 hitTexel = ivec2(sslrHitTexel(sslrHitUv, C.size));
         const float hitDepth = texelFetch(depthTexture, hitTexel, 0).x;
         if (hitDepth > 0.0) {
             const vec3 hitPosition = worldPosition(vec2(hitTexel) + 0.5, hitDepth);

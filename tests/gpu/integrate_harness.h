@@ -27,6 +27,7 @@
 #include "glint/feedback_shared.h"
 #include "glint/integrate_shared.h"
 #include "glint/ray_generation_shared.h"
+#include "glint/sslr_shared.h"
 
 #include <glm/gtc/packing.hpp>
 
@@ -451,7 +452,7 @@ inline Expected expect(const Frame& f, const Traces& t, const Presence& present,
         e.radiance = glm::vec3(t.sslrRadiance[li]);
         e.source = shader::kSourceSslr;
         const glm::vec2 uv(t.sslrHit[li]);
-        const glm::uvec2 texel = glm::uvec2(glm::floor(uv * float(kSize)));
+        const glm::uvec2 texel = shader::sslrHitTexel(uv, glm::uvec2(kSize));
         // Floor rows have a surface; the sky row has none.
         if (f.classes[at(texel.x, texel.y)] != shader::kPixelSky) {
             e.hitDistance = glm::length(floorPoint(texel.x, texel.y) - floorPoint(x, y));

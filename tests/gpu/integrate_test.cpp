@@ -161,7 +161,7 @@ TEST_CASE("behind the real SSLR pass, confident wall hits are SSLR with the wall
             // The wall point at the hit texel's centre (the wall is the
             // plane z = -6), measured from this pixel's floor point...
             const glm::vec2 uv(f.sslr.sslrHit[li]);
-            const glm::vec2 texel = glm::floor(uv * float(kSize)) + 0.5f;
+            const glm::vec2 texel = glm::vec2(shader::sslrHitTexel(uv, glm::uvec2(kSize))) + 0.5f;
             const glm::vec2 ndc = texel / float(kSize) * 2.0f - 1.0f;
             const glm::vec3 wall(ndc.x * kMirrorWallDistance, -ndc.y * kMirrorWallDistance, -kMirrorWallDistance);
             const float expected = glm::length(wall - floorPoint(x, y));

@@ -25,6 +25,7 @@
 #include "glint/integrate_shared.h"
 #include "glint/particles_shared.h"
 #include "glint/ray_generation_shared.h"
+#include "glint/sslr_shared.h"
 
 // Bindings (passes/particles.cpp pushes the same).
 layout(set = 0, binding = 0) uniform accelerationStructureEXT particleTlas;
@@ -181,7 +182,7 @@ float particleReflectionDistance(ivec2 p, uint pixelClass, vec3 position, out ui
         return rtHitDistance;
     }
     if (trace == kTraceSslr) {
-        const ivec2 hitTexel = clamp(ivec2(floor(sslrHitUv * vec2(C.size))), ivec2(0), ivec2(C.size) - 1);
+        const ivec2 hitTexel = ivec2(sslrHitTexel(sslrHitUv, C.size));
         const float hitDepth = texelFetch(depthTexture, hitTexel, 0).x;
         if (hitDepth > 0.0) {
             const vec3 hitPosition = particleWorldPosition(vec2(hitTexel) + 0.5, hitDepth);
