@@ -45,10 +45,10 @@ void main() {
         return;
     }
     // Each vertex's results go straight to the buffers: a PackedPrimitive
-    // and a DeformMotion built up in the loop are arrays indexed by k,
-    // which NVIDIA kept in local memory (GLINT_PIPELINE_STATS=1 showed 48
-    // bytes, their size; the optimised SPIR-V held both as function
-    // arrays).
+    // and a DeformMotion built up in the loop are arrays indexed by k (the
+    // optimised SPIR-V held both as function arrays), the likely content
+    // of the 48 bytes of local memory NVIDIA reported for this shader
+    // (GLINT_PIPELINE_STATS=1), their size. Not re-read there since.
     const uint primitive = params.poolOffset + t;
     const uint motionSlot = params.motionOffset + t;
     for (uint k = 0u; k < 3u; ++k) {
