@@ -246,7 +246,7 @@ void main() {
     vec3 radiance = vec3(0.0);
     vec2 hitUv = vec2(0.0);
     if (tHit >= 0.0) {
-        hitUv = (vec2(hitTexel) + 0.5) / vec2(pc.size);
+        hitUv = sslrHitUv(uvec2(hitTexel), pc.size);
         radiance = texelFetch(litTexture, hitTexel, 0).rgb;
         if (cone) {
             // The GGX lobe around the mirror direction falls to half its

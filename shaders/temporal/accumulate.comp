@@ -349,9 +349,9 @@ void main() {
     // 3. This frame's radiance and its neighbourhood's statistics, after
     // the history: the history taps' reads above go out together, and the
     // statistics (mean, sigma, count, this frame's radiance) would be live
-    // across them. On an H100, 60 registers with the statistics first (half
-    // the warps an SM holds), 47 after: the pass 0.1072 -> 0.0975 ms on the
-    // plaza at 1080p.
+    // across them. On an H100, 60 registers with the statistics first (at
+    // most half the warps an SM holds), 47 after: the pass 0.1072 -> 0.0975
+    // ms on the plaza at 1080p.
     vec3 current;
     bool hasCurrent = currentRadiance(p, current);
     vec3 sum = vec3(0.0);

@@ -303,7 +303,7 @@ inline Traces makeTraces(uint32_t seed, bool poison) {
             const float hit = c > 0.0f || x % 2 == 1 ? 1.0f : 0.0f;
             t.sslrRadiance[i] = glm::vec4(float(x) / 64.0f + 0.01f, float(y) / 64.0f + 0.02f, 0.25f, hit);
             t.sslrConfidence[i] = c;
-            const glm::vec2 uv((float(x) + 0.5f) / float(kSize), (float(hitRow(x, y)) + 0.5f) / float(kSize));
+            const glm::vec2 uv = shader::sslrHitUv({x, hitRow(x, y)}, glm::uvec2(kSize));
             t.sslrHit[i] = uv;
             const bool traced = (x + 2 * y + seed) % 3 != 0;
             t.rtRadiance[i] = glm::vec4(0.75f, float(x) / 64.0f, float(y) / 64.0f, traced ? 1.0f : 0.0f);

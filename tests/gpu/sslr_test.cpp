@@ -368,14 +368,14 @@ float storedAs(VkFormat format, float x) {
 }
 
 TEST_CASE("the hit image gives readers the hit's own texel at every image size up to 8K") {
-    // SSLR stores the hit texel's centre as uv; integrate and the particle
-    // trace find the texel again (shader::sslrHitTexel) to read the hit's
-    // depth and motion. In half floats it lands on a neighbour from 2048
-    // pixels across.
+    // SSLR stores the hit texel's centre as uv (shader::sslrHitUv);
+    // integrate and the particle trace find the texel again
+    // (shader::sslrHitTexel) to read the hit's depth and motion. In half
+    // floats it lands on a neighbour from 2048 pixels across.
     for (const uint32_t size : {1920u, 2048u, 2560u, 3840u, 7680u}) {
         for (uint32_t x = 0; x < size; ++x) {
-            const float uv = (float(x) + 0.5f) / float(size);
-            const glm::vec2 stored(storedAs(passes::kSslrHitFormat, uv), storedAs(passes::kSslrHitFormat, 0.5f));
+            const glm::vec2 uv = shader::sslrHitUv({x, 0u}, glm::uvec2(size, 1u));
+            const glm::vec2 stored(storedAs(passes::kSslrHitFormat, uv.x), storedAs(passes::kSslrHitFormat, uv.y));
             INFO("size " << size << " texel " << x);
             REQUIRE(shader::sslrHitTexel(stored, glm::uvec2(size, 1u)) == glm::uvec2(x, 0u));
         }

@@ -74,9 +74,14 @@ GLINT_FUNC uvec2 sslrMipSize(uvec2 size, uint level) {
     return uvec2(max(size.x >> level, 1u), max(size.y >> level, 1u));
 }
 
-// The texel a stored hit uv names (the hit image holds the hit texel's
-// centre as uv, float32): where integrate and the particle trace read the
-// reflected point's depth and motion. Floored, clamped into the image.
+// The hit image's value for a hit texel: the uv of its centre (float32).
+GLINT_FUNC vec2 sslrHitUv(uvec2 texel, uvec2 size) {
+    return (vec2(texel) + 0.5f) / vec2(size);
+}
+
+// The texel a stored hit uv names: where integrate and the particle trace
+// read the reflected point's depth and motion. Floored, clamped into the
+// image.
 GLINT_FUNC uvec2 sslrHitTexel(vec2 uv, uvec2 size) {
     return min(uvec2(max(floor(uv * vec2(size)), vec2(0.0f))), size - uvec2(1u));
 }
