@@ -199,7 +199,7 @@ SslrOutputs addSslrPass(rg::Graph& graph, SslrPipelines& pipelines, const SslrIn
 
     struct TraceData {
         rg::Texture depth, normal, lit, roughnessMetal, pyramid;
-        rg::Buffer rays, classes, sslrRays, sslrArgs;
+        rg::Buffer classes, sslrRays, sslrArgs;
         SslrOutputs out;
     };
     const TraceData& trace = graph.addPass<TraceData>(
@@ -210,7 +210,6 @@ SslrOutputs addSslrPass(rg::Graph& graph, SslrPipelines& pipelines, const SslrIn
             d.lit = b.read(gbuf.lit, rg::Access::SampledRead);
             d.roughnessMetal = b.read(gbuf.roughnessMetal, rg::Access::SampledRead);
             if (pyramid.valid()) d.pyramid = b.read(pyramid, rg::Access::SampledRead);
-            d.rays = b.read(rays.rays, rg::Access::StorageRead);
             d.classes = b.read(rays.classes, rg::Access::StorageRead);
             d.sslrRays = b.read(rays.sslrRays, rg::Access::StorageRead);
             // The dispatch's size, and the list's length for the shader.
@@ -235,7 +234,6 @@ SslrOutputs addSslrPass(rg::Graph& graph, SslrPipelines& pipelines, const SslrIn
                 .sampledImage("depthTexture", pc.view(d.depth), sampler, pc.layout(d.depth))
                 .sampledImage("normalTexture", pc.view(d.normal), sampler, pc.layout(d.normal))
                 .sampledImage("litTexture", pc.view(d.lit), sampler, pc.layout(d.lit))
-                .storageBuffer("Rays", pc.buffer(d.rays))
                 .storageBuffer("Classes", pc.buffer(d.classes))
                 .storageBuffer("SslrRays", pc.buffer(d.sslrRays))
                 .storageImage("radianceImage", pc.view(d.out.radiance))

@@ -10,6 +10,7 @@
 // the screen border, and hybrid rays below the threshold are listed for RT.
 #extension GL_GOOGLE_include_directive : require
 #extension GL_EXT_scalar_block_layout : require
+#extension GL_EXT_control_flow_attributes : require
 
 #include "glint/ray_generation_shared.h"
 #include "glint/sampling.glsl"
@@ -20,24 +21,23 @@ layout(local_size_x = kRayListGroupSize) in;
 layout(set = 0, binding = 0) uniform sampler2D depthTexture;
 layout(set = 0, binding = 1) uniform sampler2D normalTexture;
 layout(set = 0, binding = 2) uniform sampler2D litTexture;
-layout(set = 0, binding = 3, scalar) readonly buffer Rays { PackedRay rays[]; };
-layout(set = 0, binding = 4, scalar) readonly buffer Classes { uint classes[]; };
-layout(set = 0, binding = 5, scalar) readonly buffer SslrRays { PackedRay sslrRays[]; };
-layout(set = 0, binding = 6, rgba16f) uniform writeonly image2D radianceImage;
+layout(set = 0, binding = 3, scalar) readonly buffer Classes { uint classes[]; };
+layout(set = 0, binding = 4, scalar) readonly buffer SslrRays { PackedRay sslrRays[]; };
+layout(set = 0, binding = 5, rgba16f) uniform writeonly image2D radianceImage;
 // R16F and RG32F are not among the formats every device can store with a
 // format qualifier; the context enables shaderStorageImageWriteWithoutFormat.
-layout(set = 0, binding = 7) uniform writeonly image2D confidenceImage;
-layout(set = 0, binding = 8) uniform writeonly image2D hitImage;
-layout(set = 0, binding = 9, scalar) writeonly buffer RtRays { PackedRay rtRays[]; };
-layout(set = 0, binding = 10, scalar) buffer RtArgs { uint rtArgs[]; };
-layout(set = 0, binding = 11) uniform sampler2D roughnessMetalTexture;
+layout(set = 0, binding = 6) uniform writeonly image2D confidenceImage;
+layout(set = 0, binding = 7) uniform writeonly image2D hitImage;
+layout(set = 0, binding = 8, scalar) writeonly buffer RtRays { PackedRay rtRays[]; };
+layout(set = 0, binding = 9, scalar) buffer RtArgs { uint rtArgs[]; };
+layout(set = 0, binding = 10) uniform sampler2D roughnessMetalTexture;
 // The lit colour's box-filtered mip chain (pyramid_*.comp), sampled
 // trilinearly by the cone trace.
-layout(set = 0, binding = 12) uniform sampler2D pyramidTexture;
+layout(set = 0, binding = 11) uniform sampler2D pyramidTexture;
 // The SSLR list's args: its length at kRayListCountOffset.
-layout(set = 0, binding = 13, scalar) readonly buffer SslrArgs { uint sslrArgs[]; };
+layout(set = 0, binding = 12, scalar) readonly buffer SslrArgs { uint sslrArgs[]; };
 // Ray generation's spatiotemporal blue noise (glint/sampling.glsl); read only when pc.blueNoise is 1.
-layout(set = 0, binding = 14, scalar) readonly buffer BlueNoise { uvec2 blueNoise[]; };
+layout(set = 0, binding = 13, scalar) readonly buffer BlueNoise { uvec2 blueNoise[]; };
 
 layout(push_constant, scalar) uniform Constants { SslrConstants pc; };
 
@@ -65,12 +65,22 @@ struct March {
     float dk;
 };
 
+// The depth buffer's texel under the ray at screen parameter t.
+ivec2 texelUnder(March m, float t) { return clamp(ivec2(floor(m.start + t * m.delta)), ivec2(0), ivec2(pc.size) - 1); }
+
 // The depth buffer's depth under the ray at screen parameter t, and its
 // texel.
 float depthUnder(March m, float t, out ivec2 texel) {
-    texel = clamp(ivec2(floor(m.start + t * m.delta)), ivec2(0), ivec2(pc.size) - 1);
+    texel = texelUnder(m, t);
     return texelFetch(depthTexture, texel, 0).x;
 }
+
+// The march reads the depths of this many steps before it tests the first:
+// their reads are in flight together, where one step at a time would wait
+// for each read in turn (the tests branch, and a compiler does not move a
+// read above a branch). Steps past the ray's last, and after its hit, are
+// read for nothing (their texels clamped into the image).
+const uint kMarchBatch = 4u;
 
 // Whether the ray at screen parameter t lies in front of a surface of the
 // depth buffer at `depth`, or over the sky (depth 0), decided in depth
@@ -189,57 +199,66 @@ void main() {
     // docs/results.md, third round).
     bool wasBehind = false;
     float lastSurface = 0.0;
-    for (uint i = 0u; i < steps; ++i) {
-        const float t = (float(i) + jitter) * step;
-        // Within a pixel of the origin the ray can only find its own surface.
-        if (t * pixelsPerT < 1.0) {
-            tFront = t;
-            continue;
+    for (uint first = 0u; first < steps && tHit < 0.0; first += kMarchBatch) {
+        float depths[kMarchBatch];
+        [[unroll]] for (uint k = 0u; k < kMarchBatch; ++k) {
+            depths[k] = texelFetch(depthTexture, texelUnder(m, (float(first + k) + jitter) * step), 0).x;
         }
-        ivec2 texel;
-        const float depth = depthUnder(m, t, texel);
-        if (inFront(m, t, depth)) {
-            tFront = t;
-            wasBehind = false;
-            continue;
-        }
-        const float surface = -viewZ(depth);
-        const float d = rayDistance(m, t) - surface;
-        const bool sameOccluder = surface <= lastSurface * (1.0 + pc.thickness);
-        lastSurface = surface;
-        if (wasBehind && d > pc.thickness * surface && sameOccluder) {
-            tFront = t;
-            continue;
-        }
-        wasBehind = true;
-        // A crossing: refine between the last point in front and this one.
-        float lo = tFront, hi = t;
-        ivec2 hiTexel = texel;
-        float hiDepth = depth;
-        for (uint j = 0u; j < pc.refineSteps; ++j) {
-            const float mid = 0.5 * (lo + hi);
-            ivec2 midTexel;
-            const float midDepth = depthUnder(m, mid, midTexel);
-            if (inFront(m, mid, midDepth)) {
-                lo = mid;
-            } else {
-                hi = mid;
-                hiTexel = midTexel;
-                hiDepth = midDepth;
+        [[unroll]] for (uint k = 0u; k < kMarchBatch; ++k) {
+            const uint i = first + k;
+            if (i >= steps) {
+                break;
             }
+            const float t = (float(i) + jitter) * step;
+            // Within a pixel of the origin the ray can only find its own surface.
+            if (t * pixelsPerT < 1.0) {
+                tFront = t;
+                continue;
+            }
+            const float depth = depths[k];
+            if (inFront(m, t, depth)) {
+                tFront = t;
+                wasBehind = false;
+                continue;
+            }
+            const float surface = -viewZ(depth);
+            const float d = rayDistance(m, t) - surface;
+            const bool sameOccluder = surface <= lastSurface * (1.0 + pc.thickness);
+            lastSurface = surface;
+            if (wasBehind && d > pc.thickness * surface && sameOccluder) {
+                tFront = t;
+                continue;
+            }
+            wasBehind = true;
+            // A crossing: refine between the last point in front and this one.
+            float lo = tFront, hi = t;
+            ivec2 hiTexel = texelUnder(m, t);
+            float hiDepth = depth;
+            for (uint j = 0u; j < pc.refineSteps; ++j) {
+                const float mid = 0.5 * (lo + hi);
+                ivec2 midTexel;
+                const float midDepth = depthUnder(m, mid, midTexel);
+                if (inFront(m, mid, midDepth)) {
+                    lo = mid;
+                } else {
+                    hi = mid;
+                    hiTexel = midTexel;
+                    hiDepth = midDepth;
+                }
+            }
+            const float hiSurface = -viewZ(hiDepth);
+            const float hiGap = rayDistance(m, hi) - hiSurface;
+            // Thickness test: the depth buffer holds only front surfaces, so a
+            // ray found far behind one passed behind it; keep marching.
+            if (hiGap <= pc.thickness * hiSurface) {
+                tHit = hi;
+                hitTexel = hiTexel;
+                hitDepth = hiDepth;
+                gap = hiGap / (pc.thickness * hiSurface);
+                break;
+            }
+            tFront = t;
         }
-        const float hiSurface = -viewZ(hiDepth);
-        const float hiGap = rayDistance(m, hi) - hiSurface;
-        // Thickness test: the depth buffer holds only front surfaces, so a
-        // ray found far behind one passed behind it; keep marching.
-        if (hiGap <= pc.thickness * hiSurface) {
-            tHit = hi;
-            hitTexel = hiTexel;
-            hitDepth = hiDepth;
-            gap = hiGap / (pc.thickness * hiSurface);
-            break;
-        }
-        tFront = t;
     }
 
     float confidence = 0.0;
