@@ -238,6 +238,19 @@ void loadTile() {
     barrier();
 }
 
+// The clip box's sums over the (2 r + 1)^2 tile entries around this pixel.
+void boxSums(const int r, inout vec3 sum, inout vec3 sumSquares, inout float count) {
+    const ivec2 local = ivec2(gl_LocalInvocationID.xy) + int(kTemporalMaxClampRadius);
+    for (int dy = -r; dy <= r; ++dy) {
+        for (int dx = -r; dx <= r; ++dx) {
+            const vec4 entry = tile[(local.y + dy) * kTile + local.x + dx];
+            sum += entry.xyz;
+            sumSquares += entry.xyz * entry.xyz;
+            count += entry.w;
+        }
+    }
+}
+
 void main() {
     const ivec2 p = ivec2(gl_GlobalInvocationID.xy);
     // This pixel's own reads go out before the tile's and its barrier, so
@@ -362,14 +375,13 @@ void main() {
     const bool sharedRays = px.roughness >= frame.sharedRayRoughness && !px.environment;
     const uint radius = sharedRays ? frame.clampRadius : min(frame.clampRadius, 1u);
     const int r = int(min(radius, kTemporalMaxClampRadius));
-    const ivec2 local = ivec2(gl_LocalInvocationID.xy) + int(kTemporalMaxClampRadius);
-    for (int dy = -r; dy <= r; ++dy) {
-        for (int dx = -r; dx <= r; ++dx) {
-            const vec4 entry = tile[(local.y + dy) * kTile + local.x + dx];
-            sum += entry.xyz;
-            sumSquares += entry.xyz * entry.xyz;
-            count += entry.w;
-        }
+    // Literal radii for the two boxes in use: each unrolls.
+    if (r == 1) {
+        boxSums(1, sum, sumSquares, count);
+    } else if (r == 2) {
+        boxSums(2, sum, sumSquares, count);
+    } else {
+        boxSums(r, sum, sumSquares, count);
     }
     const vec3 mean = count > 0.0 ? sum / count : vec3(0.0);
     const vec3 sigma = count > 0.0 ? sqrt(max(sumSquares / count - mean * mean, vec3(0.0))) : vec3(0.0);
