@@ -102,6 +102,57 @@ float screenExit(float start, float delta, float size) {
     return ((delta > 0.0 ? size : 0.0) - start) / delta;
 }
 
+// A binary search for the crossing between lo (in front) and hi (behind),
+// pc.refineSteps halvings, two a round: each round reads the midpoint and
+// both quarter points together, then halves twice, taking the quarter point
+// on the side the midpoint chose, which is the point a second halving reads
+// (the same expressions: the same search, with half the dependent reads).
+void refine(March m, inout float lo, inout float hi, inout ivec2 hiTexel, inout float hiDepth) {
+    uint j = 0u;
+    for (; j + 2u <= pc.refineSteps; j += 2u) {
+        const float mid = 0.5 * (lo + hi);
+        const float lowMid = 0.5 * (lo + mid);
+        const float highMid = 0.5 * (mid + hi);
+        ivec2 midTexel, lowTexel, highTexel;
+        const float midDepth = depthUnder(m, mid, midTexel);
+        const float lowDepth = depthUnder(m, lowMid, lowTexel);
+        const float highDepth = depthUnder(m, highMid, highTexel);
+        if (inFront(m, mid, midDepth)) {
+            lo = mid;
+            if (inFront(m, highMid, highDepth)) {
+                lo = highMid;
+            } else {
+                hi = highMid;
+                hiTexel = highTexel;
+                hiDepth = highDepth;
+            }
+        } else {
+            hi = mid;
+            hiTexel = midTexel;
+            hiDepth = midDepth;
+            if (inFront(m, lowMid, lowDepth)) {
+                lo = lowMid;
+            } else {
+                hi = lowMid;
+                hiTexel = lowTexel;
+                hiDepth = lowDepth;
+            }
+        }
+    }
+    if (j < pc.refineSteps) {
+        const float mid = 0.5 * (lo + hi);
+        ivec2 midTexel;
+        const float midDepth = depthUnder(m, mid, midTexel);
+        if (inFront(m, mid, midDepth)) {
+            lo = mid;
+        } else {
+            hi = mid;
+            hiTexel = midTexel;
+            hiDepth = midDepth;
+        }
+    }
+}
+
 void writeResult(ivec2 pixel, vec3 radiance, float confidence, vec2 hitUv, bool hit) {
     imageStore(radianceImage, pixel, vec4(radiance, hit ? 1.0 : 0.0));
     imageStore(confidenceImage, pixel, vec4(confidence));
@@ -234,18 +285,7 @@ void main() {
             float lo = tFront, hi = t;
             ivec2 hiTexel = texelUnder(m, t);
             float hiDepth = depth;
-            for (uint j = 0u; j < pc.refineSteps; ++j) {
-                const float mid = 0.5 * (lo + hi);
-                ivec2 midTexel;
-                const float midDepth = depthUnder(m, mid, midTexel);
-                if (inFront(m, mid, midDepth)) {
-                    lo = mid;
-                } else {
-                    hi = mid;
-                    hiTexel = midTexel;
-                    hiDepth = midDepth;
-                }
-            }
+            refine(m, lo, hi, hiTexel, hiDepth);
             const float hiSurface = -viewZ(hiDepth);
             const float hiGap = rayDistance(m, hi) - hiSurface;
             // Thickness test: the depth buffer holds only front surfaces, so a
