@@ -102,6 +102,21 @@ float screenExit(float start, float delta, float size) {
     return ((delta > 0.0 ? size : 0.0) - start) / delta;
 }
 
+// One halving's choice at the point t between lo and hi, its depth read at
+// texel: t becomes lo where the ray lies in front of the depth buffer there
+// (the result), else hi.
+bool narrow(March m, float t, float depth, ivec2 texel, inout float lo, inout float hi, inout ivec2 hiTexel,
+            inout float hiDepth) {
+    if (inFront(m, t, depth)) {
+        lo = t;
+        return true;
+    }
+    hi = t;
+    hiTexel = texel;
+    hiDepth = depth;
+    return false;
+}
+
 // A binary search for the crossing between lo (in front) and hi (behind),
 // pc.refineSteps halvings, two a round: each round reads the midpoint and
 // both quarter points together, then halves twice, taking the quarter point
@@ -117,39 +132,17 @@ void refine(March m, inout float lo, inout float hi, inout ivec2 hiTexel, inout 
         const float midDepth = depthUnder(m, mid, midTexel);
         const float lowDepth = depthUnder(m, lowMid, lowTexel);
         const float highDepth = depthUnder(m, highMid, highTexel);
-        if (inFront(m, mid, midDepth)) {
-            lo = mid;
-            if (inFront(m, highMid, highDepth)) {
-                lo = highMid;
-            } else {
-                hi = highMid;
-                hiTexel = highTexel;
-                hiDepth = highDepth;
-            }
+        if (narrow(m, mid, midDepth, midTexel, lo, hi, hiTexel, hiDepth)) {
+            narrow(m, highMid, highDepth, highTexel, lo, hi, hiTexel, hiDepth);
         } else {
-            hi = mid;
-            hiTexel = midTexel;
-            hiDepth = midDepth;
-            if (inFront(m, lowMid, lowDepth)) {
-                lo = lowMid;
-            } else {
-                hi = lowMid;
-                hiTexel = lowTexel;
-                hiDepth = lowDepth;
-            }
+            narrow(m, lowMid, lowDepth, lowTexel, lo, hi, hiTexel, hiDepth);
         }
     }
     if (j < pc.refineSteps) {
         const float mid = 0.5 * (lo + hi);
         ivec2 midTexel;
         const float midDepth = depthUnder(m, mid, midTexel);
-        if (inFront(m, mid, midDepth)) {
-            lo = mid;
-        } else {
-            hi = mid;
-            hiTexel = midTexel;
-            hiDepth = midDepth;
-        }
+        narrow(m, mid, midDepth, midTexel, lo, hi, hiTexel, hiDepth);
     }
 }
 

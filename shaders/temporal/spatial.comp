@@ -51,9 +51,10 @@ void addTaps(const int radius, Window c, inout vec3 sum, inout float weightSum) 
     for (int dy = -radius; dy <= radius; ++dy) {
         for (int dx = -radius; dx <= radius; ++dx) {
             const ivec2 q = c.p + ivec2(dx, dy);
-            const vec4 tap = texelFetch(accumulatedTexture, clamp(q, ivec2(0), last), 0);
-            const vec4 tapSurface = texelFetch(surfaceTexture, clamp(q, ivec2(0), last), 0);
-            if ((dx == 0 && dy == 0) || any(notEqual(q, clamp(q, ivec2(0), last)))) continue;
+            const ivec2 texel = clamp(q, ivec2(0), last);
+            const vec4 tap = texelFetch(accumulatedTexture, texel, 0);
+            const vec4 tapSurface = texelFetch(surfaceTexture, texel, 0);
+            if ((dx == 0 && dy == 0) || any(notEqual(q, texel))) continue;
             if (!(tap.a > 0.0) || !(tapSurface.x > 0.0)) continue;
             const float facing = dot(octDecode(clamp(tapSurface.zw, vec2(-1.0), vec2(1.0))), c.normal);
             if (!(facing > 0.0)) continue;

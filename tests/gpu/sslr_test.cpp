@@ -246,70 +246,59 @@ SslrFrame trace(test::GpuTest& gpu, uint64_t frame, const passes::SslrSettings& 
 
 bool finite(glm::vec4 v) { return std::isfinite(v.x) && std::isfinite(v.y) && std::isfinite(v.z) && std::isfinite(v.w); }
 
-
-// Every hybrid pixel of the mirror floor whose reflection lands well inside
-// the wall hits it within one texel of the analytic hit, with the wall's
-// lit colour and full confidence; those over the wall miss. The numbers of
-// each checked go to hits and misses.
-void requireWallHits(const SslrFrame& f, const passes::SslrSettings& settings, uint32_t& checkedHits,
-                     uint32_t& checkedMisses) {
-    // The wall's lit colour: flat, one normal, a directional sun, so one
-    // value; read where the wall surely is.
-    const glm::vec4 wallLit = f.lit[f.at(kSize / 2, kSize / 2)];
-    REQUIRE(wallLit.r > 2.0f * wallLit.g);  // red: it is the wall
-    checkedHits = checkedMisses = 0;
-    for (uint32_t y = 0; y < kSize; ++y) {
-        for (uint32_t x = 0; x < kSize; ++x) {
-            INFO("pixel " << x << ", " << y);
-            const size_t i = f.at(x, y);
-            REQUIRE(finite(f.radiance[i]));
-            REQUIRE(std::isfinite(f.confidence[i]));
-            REQUIRE((std::isfinite(f.hit[i].x) && std::isfinite(f.hit[i].y)));
-            REQUIRE(f.confidence[i] >= 0.0f);
-            REQUIRE(f.confidence[i] <= 1.0f);
-            if (f.classes[i] != shader::kPixelHybrid) {
-                // The wall (rough) and the sky trace nothing.
-                REQUIRE(f.confidence[i] == 0.0f);
-                continue;
-            }
-            const glm::vec2 hit = wallHit(x, y);
-            const glm::vec2 expected = wallPixel(hit);
-            // Hits well inside the wall and away from the edge fade.
-            const float fadePixels = settings.edgeFade * float(kSize);
-            const bool onWall = hit.y > -1.0f && hit.y < kWallTop;
-            const float wallBottomPixel = wallPixel({0.0f, -1.0f}).y;
-            const float wallTopPixel = wallPixel({0.0f, kWallTop}).y;
-            const bool clearHit = expected.y > wallTopPixel + 1.5f && expected.y < wallBottomPixel - 1.5f &&
-                                  expected.x > fadePixels + 1.0f && expected.x < float(kSize) - fadePixels - 1.0f;
-            if (onWall && clearHit) {
-                ++checkedHits;
-                REQUIRE(f.radiance[i].a == 1.0f);
-                const glm::vec2 got = f.hit[i] * float(kSize);
-                // Within one texel of the analytic hit.
-                REQUIRE(std::abs(got.x - expected.x) <= 1.0f);
-                REQUIRE(std::abs(got.y - expected.y) <= 1.0f);
-                REQUIRE(f.confidence[i] > passes::kDefaultConfidenceThreshold);
-                const glm::vec3 rgb = f.radiance[i];
-                REQUIRE(glm::length(rgb - glm::vec3(wallLit)) <= 0.01f * glm::length(glm::vec3(wallLit)));
-            } else if (hit.y > kWallTop + 0.5f) {
-                // Over the wall: only sky behind, then off the screen.
-                ++checkedMisses;
-                REQUIRE(f.confidence[i] == 0.0f);
-                REQUIRE(f.radiance[i] == glm::vec4(0.0f));
-            }
-        }
-    }
-}
-
 } // namespace
 
 TEST_CASE("SSLR finds the wall in a mirror floor within one texel, with its lit colour and full confidence") {
     test::GpuTest gpu;
     const passes::SslrSettings settings;
     for (const uint64_t frame : {0u, 5u}) {
-        INFO("frame " << frame);
+        const SslrFrame f = trace(gpu, frame, settings);
+        // The wall's lit colour: flat, one normal, a directional sun, so one
+        // value; read where the wall surely is.
+        const glm::vec4 wallLit = f.lit[f.at(kSize / 2, kSize / 2)];
+        REQUIRE(wallLit.r > 2.0f * wallLit.g);  // red: it is the wall
         uint32_t checkedHits = 0, checkedMisses = 0;
-        requireWallHits(trace(gpu, frame, settings), settings, checkedHits, checkedMisses);
+        for (uint32_t y = 0; y < kSize; ++y) {
+            for (uint32_t x = 0; x < kSize; ++x) {
+                INFO("frame " << frame << " pixel " << x << ", " << y);
+                const size_t i = f.at(x, y);
+                REQUIRE(finite(f.radiance[i]));
+                REQUIRE(std::isfinite(f.confidence[i]));
+                REQUIRE((std::isfinite(f.hit[i].x) && std::isfinite(f.hit[i].y)));
+                REQUIRE(f.confidence[i] >= 0.0f);
+                REQUIRE(f.confidence[i] <= 1.0f);
+                if (f.classes[i] != shader::kPixelHybrid) {
+                    // The wall (rough) and the sky trace nothing.
+                    REQUIRE(f.confidence[i] == 0.0f);
+                    continue;
+                }
+                const glm::vec2 hit = wallHit(x, y);
+                const glm::vec2 expected = wallPixel(hit);
+                // Hits well inside the wall and away from the edge fade.
+                const float fadePixels = settings.edgeFade * float(kSize);
+                const bool onWall = hit.y > -1.0f && hit.y < kWallTop;
+                const float wallBottomPixel = wallPixel({0.0f, -1.0f}).y;
+                const float wallTopPixel = wallPixel({0.0f, kWallTop}).y;
+                const bool clearHit = expected.y > wallTopPixel + 1.5f && expected.y < wallBottomPixel - 1.5f &&
+                                      expected.x > fadePixels + 1.0f && expected.x < float(kSize) - fadePixels - 1.0f;
+                if (onWall && clearHit) {
+                    ++checkedHits;
+                    REQUIRE(f.radiance[i].a == 1.0f);
+                    const glm::vec2 got = f.hit[i] * float(kSize);
+                    // Within one texel of the analytic hit.
+                    REQUIRE(std::abs(got.x - expected.x) <= 1.0f);
+                    REQUIRE(std::abs(got.y - expected.y) <= 1.0f);
+                    REQUIRE(f.confidence[i] > passes::kDefaultConfidenceThreshold);
+                    const glm::vec3 rgb = f.radiance[i];
+                    REQUIRE(glm::length(rgb - glm::vec3(wallLit)) <= 0.01f * glm::length(glm::vec3(wallLit)));
+                } else if (hit.y > kWallTop + 0.5f) {
+                    // Over the wall: only sky behind, then off the screen.
+                    ++checkedMisses;
+                    REQUIRE(f.confidence[i] == 0.0f);
+                    REQUIRE(f.radiance[i] == glm::vec4(0.0f));
+                }
+            }
+        }
         CHECK(checkedHits > 200);
         CHECK(checkedMisses > 200);
     }
