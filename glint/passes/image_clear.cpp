@@ -3,6 +3,9 @@
 #include "glint/gpu/descriptors.h"
 #include "glint/gpu/error.h"
 
+#include <algorithm>
+#include <vector>
+
 namespace glint::passes {
 
 namespace {
@@ -34,6 +37,23 @@ void ImageClearer::clear(rg::PassContext& pc, rg::Texture texture, glm::vec4 val
     gpu::PushDescriptors(pipeline_).storageImage("target", pc.view(texture)).push(ctx_, pc.cmd());
     pipeline_.pushConstants(pc.cmd(), constants);
     pc.dispatch(pipeline_, (constants.size.x + 7) / 8, (constants.size.y + 7) / 8);
+}
+
+void ImageClearer::addClearPass(rg::Graph& graph, std::string_view name, std::span<rg::Texture> textures) const {
+    using Cleared = std::vector<rg::Texture>;
+    const Cleared& cleared = graph.addPass<Cleared>(
+        name, rg::Queue::Graphics,
+        [&](rg::Builder& b, Cleared& d) {
+            for (const rg::Texture t : textures) {
+                d.push_back(b.write(t, rg::Access::StorageWrite));
+            }
+        },
+        [this](const Cleared& d, rg::PassContext& pc) {
+            for (const rg::Texture t : d) {
+                clear(pc, t);
+            }
+        });
+    std::copy(cleared.begin(), cleared.end(), textures.begin());
 }
 
 } // namespace glint::passes

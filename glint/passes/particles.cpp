@@ -178,14 +178,7 @@ ParticleTraceOutputs addParticleTracePass(rg::Graph& graph, ParticlePipelines& p
     rg::Texture radiance = graph.createTexture(
         "particles.radiance", {.width = gbuf.width, .height = gbuf.height, .format = kParticleRadianceFormat});
     if (settings.clearUntraced) {
-        struct ClearData {
-            rg::Texture radiance;
-        };
-        const ClearData& clear = graph.addPass<ClearData>(
-            "particles.clear", rg::Queue::Graphics,
-            [&](rg::Builder& b, ClearData& d) { d.radiance = b.write(radiance, rg::Access::StorageWrite); },
-            [&pipelines](const ClearData& d, rg::PassContext& pc) { pipelines.clearer_.clear(pc, d.radiance); });
-        radiance = clear.radiance;
+        pipelines.clearer_.addClearPass(graph, "particles.clear", std::span(&radiance, 1));
     }
 
     struct List {

@@ -205,29 +205,13 @@ RtTraceOutputs addRtTracePass(rg::Graph& graph, RtTracePipelines& pipelines, con
     const auto texture = [&](const char* name, VkFormat format) {
         return graph.createTexture(name, {.width = gbuf.width, .height = gbuf.height, .format = format});
     };
-    rg::Texture radiance = texture("rt_trace.radiance", kRtRadianceFormat);
-    rg::Texture hitDistance = texture("rt_trace.hit_distance", kRtHitDistanceFormat);
-    rg::Texture hitMotion = texture("rt_trace.hit_motion", kRtHitMotionFormat);
+    std::array<rg::Texture, 3> outputs{texture("rt_trace.radiance", kRtRadianceFormat),
+                                       texture("rt_trace.hit_distance", kRtHitDistanceFormat),
+                                       texture("rt_trace.hit_motion", kRtHitMotionFormat)};
     if (settings.clearUntraced) {
-        struct ClearData {
-            rg::Texture radiance, hitDistance, hitMotion;
-        };
-        const ClearData& clear = graph.addPass<ClearData>(
-            "rt_trace.clear", rg::Queue::Graphics,
-            [&](rg::Builder& b, ClearData& d) {
-                d.radiance = b.write(radiance, rg::Access::StorageWrite);
-                d.hitDistance = b.write(hitDistance, rg::Access::StorageWrite);
-                d.hitMotion = b.write(hitMotion, rg::Access::StorageWrite);
-            },
-            [&pipelines](const ClearData& d, rg::PassContext& pc) {
-                for (const rg::Texture t : {d.radiance, d.hitDistance, d.hitMotion}) {
-                    pipelines.clearer_.clear(pc, t);
-                }
-            });
-        radiance = clear.radiance;
-        hitDistance = clear.hitDistance;
-        hitMotion = clear.hitMotion;
+        pipelines.clearer_.addClearPass(graph, "rt_trace.clear", outputs);
     }
+    const auto [radiance, hitDistance, hitMotion] = outputs;
 
     struct TraceData {
         rg::Texture depth, normal, roughnessMetal;

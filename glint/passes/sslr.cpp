@@ -76,29 +76,13 @@ SslrOutputs addSslrPass(rg::Graph& graph, SslrPipelines& pipelines, const SslrIn
     const auto texture = [&](const char* name, VkFormat format) {
         return graph.createTexture(name, {.width = gbuf.width, .height = gbuf.height, .format = format});
     };
-    rg::Texture radiance = texture("sslr.radiance", kSslrRadianceFormat);
-    rg::Texture confidence = texture("sslr.confidence", kSslrConfidenceFormat);
-    rg::Texture hit = texture("sslr.hit", kSslrHitFormat);
+    std::array<rg::Texture, 3> outputs{texture("sslr.radiance", kSslrRadianceFormat),
+                                       texture("sslr.confidence", kSslrConfidenceFormat),
+                                       texture("sslr.hit", kSslrHitFormat)};
     if (settings.clearUntraced) {
-        struct ClearData {
-            rg::Texture radiance, confidence, hit;
-        };
-        const ClearData& clear = graph.addPass<ClearData>(
-            "sslr.clear", rg::Queue::Graphics,
-            [&](rg::Builder& b, ClearData& d) {
-                d.radiance = b.write(radiance, rg::Access::StorageWrite);
-                d.confidence = b.write(confidence, rg::Access::StorageWrite);
-                d.hit = b.write(hit, rg::Access::StorageWrite);
-            },
-            [&pipelines](const ClearData& d, rg::PassContext& pc) {
-                for (const rg::Texture t : {d.radiance, d.confidence, d.hit}) {
-                    pipelines.clearer_.clear(pc, t);
-                }
-            });
-        radiance = clear.radiance;
-        confidence = clear.confidence;
-        hit = clear.hit;
+        pipelines.clearer_.addClearPass(graph, "sslr.clear", outputs);
     }
+    const auto [radiance, confidence, hit] = outputs;
 
     // The cone trace's colour pyramid (glint/sslr_shared.h): two passes,
     // each five levels, dispatched from the SSLR list's args, which give
