@@ -10,7 +10,6 @@
 // the screen border, and hybrid rays below the threshold are listed for RT.
 #extension GL_GOOGLE_include_directive : require
 #extension GL_EXT_scalar_block_layout : require
-#extension GL_EXT_control_flow_attributes : require
 
 #include "glint/ray_generation_shared.h"
 #include "glint/sampling.glsl"
@@ -65,22 +64,12 @@ struct March {
     float dk;
 };
 
-// The depth buffer's texel under the ray at screen parameter t.
-ivec2 texelUnder(March m, float t) { return clamp(ivec2(floor(m.start + t * m.delta)), ivec2(0), ivec2(pc.size) - 1); }
-
 // The depth buffer's depth under the ray at screen parameter t, and its
 // texel.
 float depthUnder(March m, float t, out ivec2 texel) {
-    texel = texelUnder(m, t);
+    texel = clamp(ivec2(floor(m.start + t * m.delta)), ivec2(0), ivec2(pc.size) - 1);
     return texelFetch(depthTexture, texel, 0).x;
 }
-
-// The march reads the depths of this many steps before it tests the first:
-// their reads are in flight together, where one step at a time would wait
-// for each read in turn (the tests branch, and a compiler does not move a
-// read above a branch). Steps past the ray's last, and after its hit, are
-// read for nothing (their texels clamped into the image).
-const uint kMarchBatch = 4u;
 
 // Whether the ray at screen parameter t lies in front of a surface of the
 // depth buffer at `depth`, or over the sky (depth 0), decided in depth
@@ -100,50 +89,6 @@ float rayDistance(March m, float t) { return 1.0 / (m.k0 + t * m.dk); }
 float screenExit(float start, float delta, float size) {
     if (!(abs(delta) > 1e-6)) return 1.0;
     return ((delta > 0.0 ? size : 0.0) - start) / delta;
-}
-
-// One halving's choice at the point t between lo and hi, its depth read at
-// texel: t becomes lo where the ray lies in front of the depth buffer there
-// (the result), else hi.
-bool narrow(March m, float t, float depth, ivec2 texel, inout float lo, inout float hi, inout ivec2 hiTexel,
-            inout float hiDepth) {
-    if (inFront(m, t, depth)) {
-        lo = t;
-        return true;
-    }
-    hi = t;
-    hiTexel = texel;
-    hiDepth = depth;
-    return false;
-}
-
-// A binary search for the crossing between lo (in front) and hi (behind),
-// pc.refineSteps halvings, two a round: each round reads the midpoint and
-// both quarter points together, then halves twice, taking the quarter point
-// on the side the midpoint chose, which is the point a second halving reads
-// (the same expressions: the same search, with half the dependent reads).
-void refine(March m, inout float lo, inout float hi, inout ivec2 hiTexel, inout float hiDepth) {
-    uint j = 0u;
-    for (; j + 2u <= pc.refineSteps; j += 2u) {
-        const float mid = 0.5 * (lo + hi);
-        const float lowMid = 0.5 * (lo + mid);
-        const float highMid = 0.5 * (mid + hi);
-        ivec2 midTexel, lowTexel, highTexel;
-        const float midDepth = depthUnder(m, mid, midTexel);
-        const float lowDepth = depthUnder(m, lowMid, lowTexel);
-        const float highDepth = depthUnder(m, highMid, highTexel);
-        if (narrow(m, mid, midDepth, midTexel, lo, hi, hiTexel, hiDepth)) {
-            narrow(m, highMid, highDepth, highTexel, lo, hi, hiTexel, hiDepth);
-        } else {
-            narrow(m, lowMid, lowDepth, lowTexel, lo, hi, hiTexel, hiDepth);
-        }
-    }
-    if (j < pc.refineSteps) {
-        const float mid = 0.5 * (lo + hi);
-        ivec2 midTexel;
-        const float midDepth = depthUnder(m, mid, midTexel);
-        narrow(m, mid, midDepth, midTexel, lo, hi, hiTexel, hiDepth);
-    }
 }
 
 void writeResult(ivec2 pixel, vec3 radiance, float confidence, vec2 hitUv, bool hit) {
@@ -241,57 +186,65 @@ void main() {
     // 1080p the pass took 0.165 -> 0.116 ms on the plaza, 0.096 -> 0.055
     // on DamagedHelmet, for 0.7% more hybrid rays handed to RT;
     // docs/results.md, third round).
+    // One step's depth read at a time, each after the last step's test:
+    // reading four steps' depths before testing the first (their reads in
+    // flight together), with the refinement's midpoint and quarter points
+    // read together, took 56 registers instead of 40 and made the pass
+    // slower on an H100 at 1080p (0.1107 -> 0.1444 ms on the plaza, 0.1312
+    // -> 0.1320 in the city; docs/results.md, ninth session).
     bool wasBehind = false;
     float lastSurface = 0.0;
-    for (uint first = 0u; first < steps && tHit < 0.0; first += kMarchBatch) {
-        float depths[kMarchBatch];
-        [[unroll]] for (uint k = 0u; k < kMarchBatch; ++k) {
-            depths[k] = texelFetch(depthTexture, texelUnder(m, (float(first + k) + jitter) * step), 0).x;
-        }
-        [[unroll]] for (uint k = 0u; k < kMarchBatch; ++k) {
-            const uint i = first + k;
-            if (i >= steps) {
-                break;
-            }
-            const float t = (float(i) + jitter) * step;
-            // Within a pixel of the origin the ray can only find its own surface.
-            if (t * pixelsPerT < 1.0) {
-                tFront = t;
-                continue;
-            }
-            const float depth = depths[k];
-            if (inFront(m, t, depth)) {
-                tFront = t;
-                wasBehind = false;
-                continue;
-            }
-            const float surface = -viewZ(depth);
-            const float d = rayDistance(m, t) - surface;
-            const bool sameOccluder = surface <= lastSurface * (1.0 + pc.thickness);
-            lastSurface = surface;
-            if (wasBehind && d > pc.thickness * surface && sameOccluder) {
-                tFront = t;
-                continue;
-            }
-            wasBehind = true;
-            // A crossing: refine between the last point in front and this one.
-            float lo = tFront, hi = t;
-            ivec2 hiTexel = texelUnder(m, t);
-            float hiDepth = depth;
-            refine(m, lo, hi, hiTexel, hiDepth);
-            const float hiSurface = -viewZ(hiDepth);
-            const float hiGap = rayDistance(m, hi) - hiSurface;
-            // Thickness test: the depth buffer holds only front surfaces, so a
-            // ray found far behind one passed behind it; keep marching.
-            if (hiGap <= pc.thickness * hiSurface) {
-                tHit = hi;
-                hitTexel = hiTexel;
-                hitDepth = hiDepth;
-                gap = hiGap / (pc.thickness * hiSurface);
-                break;
-            }
+    for (uint i = 0u; i < steps; ++i) {
+        const float t = (float(i) + jitter) * step;
+        // Within a pixel of the origin the ray can only find its own surface.
+        if (t * pixelsPerT < 1.0) {
             tFront = t;
+            continue;
         }
+        ivec2 texel;
+        const float depth = depthUnder(m, t, texel);
+        if (inFront(m, t, depth)) {
+            tFront = t;
+            wasBehind = false;
+            continue;
+        }
+        const float surface = -viewZ(depth);
+        const float d = rayDistance(m, t) - surface;
+        const bool sameOccluder = surface <= lastSurface * (1.0 + pc.thickness);
+        lastSurface = surface;
+        if (wasBehind && d > pc.thickness * surface && sameOccluder) {
+            tFront = t;
+            continue;
+        }
+        wasBehind = true;
+        // A crossing: refine between the last point in front and this one.
+        float lo = tFront, hi = t;
+        ivec2 hiTexel = texel;
+        float hiDepth = depth;
+        for (uint j = 0u; j < pc.refineSteps; ++j) {
+            const float mid = 0.5 * (lo + hi);
+            ivec2 midTexel;
+            const float midDepth = depthUnder(m, mid, midTexel);
+            if (inFront(m, mid, midDepth)) {
+                lo = mid;
+            } else {
+                hi = mid;
+                hiTexel = midTexel;
+                hiDepth = midDepth;
+            }
+        }
+        const float hiSurface = -viewZ(hiDepth);
+        const float hiGap = rayDistance(m, hi) - hiSurface;
+        // Thickness test: the depth buffer holds only front surfaces, so a
+        // ray found far behind one passed behind it; keep marching.
+        if (hiGap <= pc.thickness * hiSurface) {
+            tHit = hi;
+            hitTexel = hiTexel;
+            hitDepth = hiDepth;
+            gap = hiGap / (pc.thickness * hiSurface);
+            break;
+        }
+        tFront = t;
     }
 
     float confidence = 0.0;
