@@ -308,8 +308,7 @@ TEST_CASE("SSLR finds the wall in a mirror floor within one texel, with its lit 
 // decides which hits count: a hit needs the refined point within the
 // thickness behind the wall, and each halving of the crossing's interval
 // halves how far behind it may lie. So the accepted hits about double with
-// every halving until all are (19, 40, 88, 199, 320 on lavapipe), at odd
-// refine counts (whose last halving is a round of its own) as at even, and
+// every halving until all are (19, 40, 88, 199, 320 on lavapipe), and
 // each lies within a texel of the analytic hit.
 TEST_CASE("with a few long steps every refinement halving accepts about twice the hits, each on the wall") {
     test::GpuTest gpu;

@@ -242,9 +242,7 @@ TEST_CASE("the spatial filter smooths a rough reflection in its first frame and 
 // On a flat wall of one roughness every tap's plane, normal and roughness
 // weights are 1, so the filter is the Gaussian of its radius (sigma
 // 0.5 radius + 0.5) over the window's taps inside the image, the centre
-// weighing 1: the default radius has a window of its own in the shader
-// (unrolled), the others share one loop, and taps beyond the image's edge
-// are read at clamped texels and must weigh nothing.
+// weighing 1, and taps beyond the image's edge weigh nothing.
 TEST_CASE("on a flat rough wall the spatial filter is its radius's Gaussian at every radius, up to the image's edge") {
     const std::vector<FrameInput> frames = noisyFrames(1, 0.3f, 11);
     scene::Scene rough = wallScene(material(0.5f, 1.0f));
