@@ -36,6 +36,8 @@
 #include <ctime>
 #include <filesystem>
 #include <memory>
+#include <optional>
+#include <span>
 
 using namespace glint;
 
@@ -69,6 +71,9 @@ const std::vector<app::Flag> kFlags = {
               "other options) at each number of buildings, each with its own reference, every mode with its "
               "defaults; writes DIR/city_scale.{csv,json,png}"},
     {"motion-lamp", "with --motion: how the mirror-motion lamp moves, rigid (default), skinned or morphed"},
+    {"time-limit", "SECONDS: start no configuration (with --scale, no city size) after this long; what was measured "
+                   "is written, and the JSON's cut_short says the run stopped early (default: no limit). The CSV and "
+                   "JSON are rewritten after every configuration, so a run that is killed keeps its rows too"},
 };
 
 double parsePositive(const std::string& flag, const std::string& text, bool allowZero) {
@@ -113,6 +118,10 @@ std::vector<passes::ReflectionMode> parseModes(const std::string& flag, const st
 // already written; scripts/setup installs matplotlib.
 void drawPlot(const std::filesystem::path& path, const std::vector<bench::PlotPoint>& points,
               const bench::PlotOptions& options) {
+    if (points.empty()) {
+        spdlog::warn("no plot: nothing was measured");
+        return;
+    }
     try {
         bench::writePlot(path, points, options);
         spdlog::info("wrote {}", path.string());
@@ -137,6 +146,7 @@ std::string utcNow() {
 
 int main(int argc, char** argv) {
     return app::runMain("glint-bench", [&] {
+        const auto programStart = std::chrono::steady_clock::now();
         const app::Args args(argc, argv, kUsage, kFlags,
                              {{"quick", "a short run: fewer frames and sweep values (what CI runs)"},
                               {"jitter", "jitter the camera as the measured runs would (default off)"},
@@ -170,6 +180,15 @@ int main(int argc, char** argv) {
         const std::filesystem::path csvPath = args.get("csv", (outDir / (stem + suffix + ".csv")).string());
         const std::filesystem::path jsonPath = args.get("json", (outDir / (stem + suffix + ".json")).string());
         const std::filesystem::path plotPath = args.get("plot", (outDir / (stem + suffix + ".png")).string());
+        // --time-limit: a wall-clock budget from the start (a lent GPU's
+        // time is limited); no configuration starts after it.
+        std::optional<std::chrono::steady_clock::time_point> deadline;
+        if (args.has("time-limit")) {
+            deadline = programStart + std::chrono::duration_cast<std::chrono::steady_clock::duration>(
+                                          std::chrono::duration<double>(
+                                              parsePositive("time-limit", args.get("time-limit", ""), false)));
+        }
+        const auto pastDeadline = [&] { return deadline && std::chrono::steady_clock::now() >= *deadline; };
 
         // Error is measured against a ray-traced reference, and the modes
         // compared trace rays: a device without ray tracing is refused.
@@ -238,14 +257,22 @@ int main(int argc, char** argv) {
             scale.warmupFrames = warmupFrames;
             scale.ppd = ppd;
             scale.referenceMaxFrames = referenceMaxFrames;
+            scale.deadline = deadline;
+            info.configurationsPlanned = uint32_t(scale.instances.size() * modes.size());
+            // The CSV and JSON after every row: a run stopped early keeps them.
+            const auto writeScale = [&](std::span<const bench::ScaleRow> rows) {
+                info.cutShort = rows.size() < info.configurationsPlanned;
+                bench::writeText(csvPath, bench::toScaleCsv(rows));
+                bench::writeText(jsonPath, bench::toScaleJson(info, rows));
+            };
+            scale.onRow = writeScale;
             spdlog::info("scale: the city at {} sizes, {}x{}, {} frames from {} s, on {} ({})", scale.instances.size(),
                          width, height, frames, base.startSeconds, info.device, info.deviceType);
             const std::vector<bench::ScaleRow> rows = bench::runScale(ctx, scale);
-            bench::writeText(csvPath, bench::toScaleCsv(rows));
+            writeScale(rows);
             std::fputs(bench::toScaleCsv(rows).c_str(), stdout);
             std::fflush(stdout);
             spdlog::info("wrote {}", csvPath.string());
-            bench::writeText(jsonPath, bench::toScaleJson(info, rows));
             spdlog::info("wrote {}", jsonPath.string());
             bench::PlotOptions plot;
             plot.title = "city " + std::to_string(width) + "x" + std::to_string(height) + ", " + info.device + ", " +
@@ -282,12 +309,20 @@ int main(int argc, char** argv) {
                 }
             }
         }
+        info.configurationsPlanned = uint32_t(configurations.size());
         spdlog::info("{}: {}x{}, {} frames from {} s, {} configurations on {} ({})", scene.name, width, height,
                      frames, base.startSeconds, configurations.size(), ctx.caps().deviceName,
                      gpu::deviceTypeName(ctx.caps().deviceType));
         const auto benchStart = std::chrono::steady_clock::now();
         const auto elapsed = [&] {
             return std::chrono::duration<double>(std::chrono::steady_clock::now() - benchStart).count();
+        };
+        // --time-limit: true (and says so) once no further configuration may start.
+        const auto timeIsUp = [&](size_t measured) {
+            if (!pastDeadline()) return false;
+            spdlog::warn("the time limit passed after {} of {} configurations ({:.0f} s); the rest are not measured",
+                         measured, configurations.size(), elapsed());
+            return true;
         };
 
         if (motionRun) {
@@ -308,7 +343,13 @@ int main(int argc, char** argv) {
             spdlog::info("motion: references of {} path frames and the mirror-motion scene in {:.1f} s",
                          references.pathFrames.size(), elapsed());
             std::vector<bench::MotionRow> rows;
+            const auto writeMotion = [&] {
+                info.cutShort = rows.size() < configurations.size();
+                bench::writeText(csvPath, bench::toMotionCsv(rows));
+                bench::writeText(jsonPath, bench::toMotionJson(info, rows));
+            };
             for (size_t k = 0; k < configurations.size(); ++k) {
+                if (timeIsUp(k)) break;
                 const bench::Configuration& c = configurations[k];
                 const app::ReflectionRunOptions options = bench::configure(base, c);
                 bench::MotionRow row = bench::measureMotion(ctx, scene, motion, options, references);
@@ -322,13 +363,12 @@ int main(int argc, char** argv) {
                              row.flipStill, row.flipMotion, row.ghostEnergy[0], row.ghostEnergy[1],
                              row.ghostEnergy[2], row.lagPixels, row.flicker, elapsed());
                 rows.push_back(std::move(row));
+                writeMotion();
             }
-            const std::string csv = bench::toMotionCsv(rows);
-            std::fputs(csv.c_str(), stdout);
+            writeMotion();
+            std::fputs(bench::toMotionCsv(rows).c_str(), stdout);
             std::fflush(stdout);
-            bench::writeText(csvPath, csv);
             spdlog::info("wrote {}", csvPath.string());
-            bench::writeText(jsonPath, bench::toMotionJson(info, rows));
             spdlog::info("wrote {}", jsonPath.string());
             bench::PlotOptions plot;
             plot.title = stem + " in motion " + std::to_string(width) + "x" + std::to_string(height) + ", " +
@@ -351,10 +391,19 @@ int main(int argc, char** argv) {
                       bench::toSrgb8(referenceTerm.display));
         spdlog::info("reference: {} frames ({}) in {:.1f} s", reference.result.framesRun,
                      reference.result.converged ? "converged" : "frame limit", elapsed());
+        info.referenceFrames = reference.result.framesRun;
+        info.referenceConverged = reference.result.converged;
+        info.referenceLastChange = reference.result.lastChange;
 
         // 2. Every configuration over the same path.
         std::vector<bench::Row> rows;
+        const auto writeStill = [&] {
+            info.cutShort = rows.size() < configurations.size();
+            bench::writeText(csvPath, bench::toCsv(rows));
+            bench::writeText(jsonPath, bench::toJson(info, rows));
+        };
         for (size_t k = 0; k < configurations.size(); ++k) {
+            if (timeIsUp(k)) break;
             const bench::Configuration& c = configurations[k];
             const app::ReflectionRunOptions options = bench::configure(base, c);
             const bool baseline = c.param == bench::kDefaultParam;
@@ -385,6 +434,7 @@ int main(int argc, char** argv) {
             row.reflection =
                 bench::measure(referenceTerm.display, term.display, ppd, &referenceTerm.radiance, &term.radiance);
             rows.push_back(row);
+            writeStill();
             if (baseline) {
                 app::writePng((outDir / (stem + "_" + modeName + ".png")).string(), width, height, result.rgba);
                 app::writePng((outDir / (stem + "_" + modeName + "_reflections.png")).string(), width, height,
@@ -403,13 +453,8 @@ int main(int argc, char** argv) {
         std::fputs(bench::toTable(rows).c_str(), stdout);
         std::fflush(stdout);
 
-        info.referenceFrames = reference.result.framesRun;
-        info.referenceConverged = reference.result.converged;
-        info.referenceLastChange = reference.result.lastChange;
-
-        bench::writeText(csvPath, bench::toCsv(rows));
+        writeStill();
         spdlog::info("wrote {}", csvPath.string());
-        bench::writeText(jsonPath, bench::toJson(info, rows));
         spdlog::info("wrote {}", jsonPath.string());
         bench::PlotOptions plot;
         plot.title = stem + " " + std::to_string(width) + "x" + std::to_string(height) + ", " + std::to_string(frames) +

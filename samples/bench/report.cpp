@@ -102,6 +102,8 @@ std::string toJson(const RunInfo& info, std::span<const Row> rows) {
     j["time_axis"] = info.timeAxis;
     j["pass_timer"] = info.passTimer;
     j["set"] = info.set;
+    j["configurations_planned"] = info.configurationsPlanned;
+    j["cut_short"] = info.cutShort;
     j["reference"] = {{"frames", info.referenceFrames},
                       {"converged", info.referenceConverged},
                       {"last_change", info.referenceLastChange},

@@ -85,6 +85,11 @@ struct RunInfo {
     std::string set;
     // --motion: how the mirror-motion lamp moved (rigid, skinned, morphed).
     std::string mirrorLamp;
+    // The configurations (for --scale, sizes times modes) the run set out
+    // to measure, and whether --time-limit stopped it before the last: the
+    // rows then hold those measured in time.
+    uint32_t configurationsPlanned = 0;
+    bool cutShort = false;
     uint32_t referenceFrames = 0;
     bool referenceConverged = false;
     double referenceLastChange = 0.0;

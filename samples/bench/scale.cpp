@@ -46,6 +46,11 @@ std::vector<ScaleRow> runScale(gpu::Context& ctx, const ScaleSettings& settings)
     };
     std::vector<ScaleRow> rows;
     for (size_t s = 0; s < settings.instances.size(); ++s) {
+        if (settings.deadline && std::chrono::steady_clock::now() >= *settings.deadline) {
+            spdlog::warn("scale: the time limit passed after {} of {} sizes ({:.0f} s); the rest are not measured", s,
+                         settings.instances.size(), elapsed());
+            break;
+        }
         scene::CityOptions city = settings.city;
         city.instances = settings.instances[s];
         scene::Scene scene = scene::makeCity(city);
@@ -90,6 +95,7 @@ std::vector<ScaleRow> runScale(gpu::Context& ctx, const ScaleSettings& settings)
                          row.mode, row.reflectionMs.value_or(0.0), row.reflectionSpanMs.value_or(0.0),
                          row.totalMs.value_or(0.0), row.rtRays, row.flipMean, elapsed());
             rows.push_back(std::move(row));
+            if (settings.onRow) settings.onRow(rows);
         }
     }
     return rows;

@@ -2,8 +2,9 @@
 # and short, validation on, writing CSV, JSON and plot under OUT. Checks the
 # exit code, that the three files exist, the CSV header report.h states,
 # no frame of ssr or rt rendered "as rt" by the hybrid's gate,
-# a row per configuration (three mode defaults and the quick sweeps), and
-# the JSON's provenance keys.
+# a row per configuration (three mode defaults and the quick sweeps), the
+# JSON's provenance keys and that it ran to the end; then a run whose
+# --time-limit has passed.
 cmake_policy(SET CMP0054 NEW)
 file(REMOVE ${OUT}/bench.csv ${OUT}/bench.json ${OUT}/bench.png ${OUT}/bench.svg)
 execute_process(COMMAND ${BENCH} --validate --scene plaza --quick --size 64x48 --frames 3
@@ -51,4 +52,34 @@ string(JSON jrows LENGTH "${json}" rows)
 if(NOT jrows EQUAL rows)
   message(FATAL_ERROR "${OUT}/bench.json: ${jrows} rows, the CSV has ${rows}")
 endif()
+string(JSON planned GET "${json}" configurations_planned)
+string(JSON cut GET "${json}" cut_short)
+if(NOT planned EQUAL rows OR NOT cut STREQUAL "OFF")
+  message(FATAL_ERROR "${OUT}/bench.json: configurations_planned ${planned}, cut_short ${cut}; expected ${rows} and false")
+endif()
 message(STATUS "glint-bench: ${rows} configurations")
+
+# --time-limit: a limit that has passed when the reference is done starts no
+# configuration; the run still exits 0 and writes a CSV of its header alone
+# and a JSON that says it was cut short of what it planned.
+file(REMOVE ${OUT}/limit.csv ${OUT}/limit.json)
+execute_process(COMMAND ${BENCH} --validate --scene plaza --quick --size 64x48 --frames 3
+                        --reference-max-frames 4 --time-limit 0.001 --out-dir ${OUT}/limit
+                        --csv ${OUT}/limit.csv --json ${OUT}/limit.json --plot ${OUT}/limit.png
+                RESULT_VARIABLE rc)
+if(NOT rc EQUAL 0)
+  message(FATAL_ERROR "glint-bench --time-limit exited with ${rc}")
+endif()
+file(STRINGS ${OUT}/limit.csv limitLines)
+list(LENGTH limitLines limitCount)
+if(NOT limitCount EQUAL 1)
+  message(FATAL_ERROR "${OUT}/limit.csv: ${limitCount} lines, expected the header alone")
+endif()
+file(READ ${OUT}/limit.json limitJson)
+string(JSON limitRows LENGTH "${limitJson}" rows)
+string(JSON limitPlanned GET "${limitJson}" configurations_planned)
+string(JSON limitCut GET "${limitJson}" cut_short)
+if(NOT limitRows EQUAL 0 OR NOT limitPlanned EQUAL rows OR NOT limitCut STREQUAL "ON")
+  message(FATAL_ERROR "${OUT}/limit.json: ${limitRows} rows of ${limitPlanned} planned, cut_short ${limitCut}; "
+                      "expected 0 of ${rows}, true")
+endif()
