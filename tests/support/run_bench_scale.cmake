@@ -2,7 +2,8 @@
 # and short, validation on, writing CSV, JSON and plot under OUT. Checks the
 # exit code, the files, the CSV header, a row per size and mode with both
 # reflection times, the instanced triangles growing with the size, the
-# JSON's per-pass times and the occlusion cull's counts.
+# JSON's per-pass times and the occlusion cull's counts, that it ran to
+# the end; then a run whose --time-limit has passed before the first size.
 cmake_policy(SET CMP0054 NEW)
 file(REMOVE ${OUT}/scale.csv ${OUT}/scale.json ${OUT}/scale.png)
 execute_process(COMMAND ${BENCH} --validate --scale 16,32 --scene city:triangles=2000 --size 64x36 --frames 3
@@ -69,3 +70,25 @@ if(drawn GREATER large)
 endif()
 message(STATUS "glint-bench --scale: ${small} and ${large} instanced triangles, ${drawn} drawn at 32 instances "
                "(${occluded} instances occluded)")
+
+# --time-limit that has passed before the first size: no city is built or
+# measured; the CSV holds its header alone and the JSON says the run was
+# cut short of its 2 sizes x 3 modes.
+file(REMOVE ${OUT}/scale_limit.csv ${OUT}/scale_limit.json)
+execute_process(COMMAND ${BENCH} --validate --scale 16,32 --scene city:triangles=2000 --size 64x36 --frames 3
+                        --time-limit 0.001 --out-dir ${OUT}
+                        --csv ${OUT}/scale_limit.csv --json ${OUT}/scale_limit.json --plot ${OUT}/scale_limit.png
+                RESULT_VARIABLE rc)
+if(NOT rc EQUAL 0)
+  message(FATAL_ERROR "glint-bench --scale --time-limit exited with ${rc}")
+endif()
+file(STRINGS ${OUT}/scale_limit.csv limitLines)
+list(LENGTH limitLines limitCount)
+file(READ ${OUT}/scale_limit.json limitJson)
+string(JSON limitRows LENGTH "${limitJson}" rows)
+string(JSON limitPlanned GET "${limitJson}" configurations_planned)
+string(JSON limitCut GET "${limitJson}" cut_short)
+if(NOT limitCount EQUAL 1 OR NOT limitRows EQUAL 0 OR NOT limitPlanned EQUAL 6 OR NOT limitCut STREQUAL "ON")
+  message(FATAL_ERROR "${OUT}/scale_limit: ${limitCount} CSV lines, ${limitRows} rows of ${limitPlanned} planned, "
+                      "cut_short ${limitCut}; expected the header alone, 0 of 6, true")
+endif()
