@@ -6,6 +6,7 @@
 # JSON's provenance keys and that it ran to the end; then a run whose
 # --time-limit has passed.
 cmake_policy(SET CMP0054 NEW)
+include(${CMAKE_CURRENT_LIST_DIR}/bench_checks.cmake)
 file(REMOVE ${OUT}/bench.csv ${OUT}/bench.json ${OUT}/bench.png ${OUT}/bench.svg)
 execute_process(COMMAND ${BENCH} --validate --scene plaza --quick --size 64x48 --frames 3
                         --reference-max-frames 64 --out-dir ${OUT}
@@ -52,11 +53,7 @@ string(JSON jrows LENGTH "${json}" rows)
 if(NOT jrows EQUAL rows)
   message(FATAL_ERROR "${OUT}/bench.json: ${jrows} rows, the CSV has ${rows}")
 endif()
-string(JSON planned GET "${json}" configurations_planned)
-string(JSON cut GET "${json}" cut_short)
-if(NOT planned EQUAL rows OR NOT cut STREQUAL "OFF")
-  message(FATAL_ERROR "${OUT}/bench.json: configurations_planned ${planned}, cut_short ${cut}; expected ${rows} and false")
-endif()
+bench_require_ran_to_end(${OUT}/bench.json ${rows})
 message(STATUS "glint-bench: ${rows} configurations")
 
 # --time-limit: a limit that has passed when the reference is done starts no
@@ -70,16 +67,4 @@ execute_process(COMMAND ${BENCH} --validate --scene plaza --quick --size 64x48 -
 if(NOT rc EQUAL 0)
   message(FATAL_ERROR "glint-bench --time-limit exited with ${rc}")
 endif()
-file(STRINGS ${OUT}/limit.csv limitLines)
-list(LENGTH limitLines limitCount)
-if(NOT limitCount EQUAL 1)
-  message(FATAL_ERROR "${OUT}/limit.csv: ${limitCount} lines, expected the header alone")
-endif()
-file(READ ${OUT}/limit.json limitJson)
-string(JSON limitRows LENGTH "${limitJson}" rows)
-string(JSON limitPlanned GET "${limitJson}" configurations_planned)
-string(JSON limitCut GET "${limitJson}" cut_short)
-if(NOT limitRows EQUAL 0 OR NOT limitPlanned EQUAL rows OR NOT limitCut STREQUAL "ON")
-  message(FATAL_ERROR "${OUT}/limit.json: ${limitRows} rows of ${limitPlanned} planned, cut_short ${limitCut}; "
-                      "expected 0 of ${rows}, true")
-endif()
+bench_require_cut_short_before_start(${OUT}/limit.csv ${OUT}/limit.json ${rows})

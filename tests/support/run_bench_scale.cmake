@@ -5,6 +5,7 @@
 # JSON's per-pass times and the occlusion cull's counts, that it ran to
 # the end; then a run whose --time-limit has passed before the first size.
 cmake_policy(SET CMP0054 NEW)
+include(${CMAKE_CURRENT_LIST_DIR}/bench_checks.cmake)
 file(REMOVE ${OUT}/scale.csv ${OUT}/scale.json ${OUT}/scale.png)
 execute_process(COMMAND ${BENCH} --validate --scale 16,32 --scene city:triangles=2000 --size 64x36 --frames 3
                         --reference-max-frames 8 --out-dir ${OUT}
@@ -49,11 +50,7 @@ string(JSON jrows LENGTH "${json}" rows)
 if(NOT jrows EQUAL 6)
   message(FATAL_ERROR "${OUT}/scale.json: ${jrows} rows, expected 6")
 endif()
-string(JSON planned GET "${json}" configurations_planned)
-string(JSON cut GET "${json}" cut_short)
-if(NOT planned EQUAL 6 OR NOT cut STREQUAL "OFF")
-  message(FATAL_ERROR "${OUT}/scale.json: configurations_planned ${planned}, cut_short ${cut}; expected 6 and false")
-endif()
+bench_require_ran_to_end(${OUT}/scale.json 6)
 string(JSON ms ERROR_VARIABLE err GET "${json}" rows 0 passes gbuffer)
 if(err)
   message(FATAL_ERROR "${OUT}/scale.json: no per-pass times: ${err}")
@@ -82,13 +79,4 @@ execute_process(COMMAND ${BENCH} --validate --scale 16,32 --scene city:triangles
 if(NOT rc EQUAL 0)
   message(FATAL_ERROR "glint-bench --scale --time-limit exited with ${rc}")
 endif()
-file(STRINGS ${OUT}/scale_limit.csv limitLines)
-list(LENGTH limitLines limitCount)
-file(READ ${OUT}/scale_limit.json limitJson)
-string(JSON limitRows LENGTH "${limitJson}" rows)
-string(JSON limitPlanned GET "${limitJson}" configurations_planned)
-string(JSON limitCut GET "${limitJson}" cut_short)
-if(NOT limitCount EQUAL 1 OR NOT limitRows EQUAL 0 OR NOT limitPlanned EQUAL 6 OR NOT limitCut STREQUAL "ON")
-  message(FATAL_ERROR "${OUT}/scale_limit: ${limitCount} CSV lines, ${limitRows} rows of ${limitPlanned} planned, "
-                      "cut_short ${limitCut}; expected the header alone, 0 of 6, true")
-endif()
+bench_require_cut_short_before_start(${OUT}/scale_limit.csv ${OUT}/scale_limit.json 6)
