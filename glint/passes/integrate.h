@@ -113,7 +113,8 @@ struct IntegrateSettings {
 };
 
 struct IntegrateOutputs {
-    rg::Texture radiance;     // kReflectionRadianceFormat: reflected radiance, a = 1 where a surface reflects
+    rg::Texture radiance;     // kReflectionRadianceFormat: reflected radiance, a > 0 where a surface reflects,
+                              // a = kReflectsNoiseFree where it is a cone trace's hit (glint/integrate_shared.h)
     rg::Texture hitDistance;  // kReflectionHitDistanceFormat: world units; kMissHitDistance for env/miss/sky
     // kReflectionHitMotionFormat: xyz, where the reflected point was last
     // frame minus where it is (world units): a ray-traced hit's instance

@@ -25,12 +25,13 @@ void checkSettings(const TemporalSettings& s) {
                     s.surfaceMotionRoughnessStart <= s.surfaceMotionRoughnessEnd &&
                     s.spatialRoughnessStart <= s.spatialRoughnessEnd &&
                     s.spatialRadius <= shader::kTemporalMaxSpatialRadius &&
+                    s.spatialNoiseFreeRadius <= shader::kTemporalMaxSpatialRadius &&
                     s.clampRadius <= shader::kTemporalMaxClampRadius && s.spatialPlaneSigma > 0.0f &&
                     s.spatialRoughnessSigma > 0.0f;
     if (!ok) {
         throw gpu::GpuError(
             "addTemporalPass: invalid settings (maxHistoryFrames >= 1, clampGamma > 0, 0 < maxRadiance <= 65504, "
-            "positive tolerances and sigmas, ramps with start <= end, spatialRadius <= 4, clampRadius <= 3)");
+            "positive tolerances and sigmas, ramps with start <= end, spatialRadius and spatialNoiseFreeRadius <= 4, clampRadius <= 3)");
     }
 }
 
@@ -69,6 +70,7 @@ shader::TemporalFrame frameConstants(const TemporalInputs& in, const TemporalSet
     f.environmentRoughness = in.environmentRoughness;
     f.debugOutputs = in.debugOutputs ? 1u : 0u;
     f.frame = uint32_t(in.frameIndex);
+    f.spatialNoiseFreeRadius = s.spatialNoiseFreeRadius;
     return f;
 }
 
@@ -179,7 +181,7 @@ TemporalOutputs addTemporalPass(rg::Graph& graph, TemporalPipelines& pipelines, 
 
     struct SpatialData {
         rg::Buffer frame;
-        rg::Texture depth, surface, accumulated;
+        rg::Texture depth, surface, accumulated, radiance;
         rg::Texture resolved;
     };
     const SpatialData& spatial = graph.addPass<SpatialData>(
@@ -189,6 +191,7 @@ TemporalOutputs addTemporalPass(rg::Graph& graph, TemporalPipelines& pipelines, 
             d.depth = b.read(gbuf.depth, rg::Access::SampledRead);
             d.surface = b.read(accumulate.surfaceOut, rg::Access::SampledRead);
             d.accumulated = b.read(accumulate.radianceOut, rg::Access::SampledRead);
+            d.radiance = b.read(inputs.radiance, rg::Access::SampledRead);
             d.resolved = b.write(b.createTexture("temporal.resolved", desc(kTemporalResolvedFormat)),
                                  rg::Access::StorageWrite);
         },
@@ -201,6 +204,7 @@ TemporalOutputs addTemporalPass(rg::Graph& graph, TemporalPipelines& pipelines, 
                 .sampledImage("depthTexture", pc.view(d.depth), sampler, pc.layout(d.depth))
                 .sampledImage("surfaceTexture", pc.view(d.surface), sampler, pc.layout(d.surface))
                 .sampledImage("accumulatedTexture", pc.view(d.accumulated), sampler, pc.layout(d.accumulated))
+                .sampledImage("radianceTexture", pc.view(d.radiance), sampler, pc.layout(d.radiance))
                 .storageImage("resolvedImage", pc.view(d.resolved))
                 .push(pipelines.ctx_, pc.cmd());
             constexpr uint32_t side = shader::kTemporalSpatialGroupSize;

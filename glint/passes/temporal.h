@@ -56,7 +56,11 @@ inline constexpr VkFormat kTemporalSurfaceHistoryFormat = VK_FORMAT_R16G16B16A16
 
 struct TemporalInputs {
     GBufferOutputs gbuffer;   // depth, normal, roughnessMetal, motion
-    rg::Texture radiance;     // reflection radiance (any float format), a > 0 where a surface reflects
+    // Reflection radiance (any float format), a > 0 where a surface
+    // reflects; a = shader::kReflectsNoiseFree where this frame's value
+    // carries no ray's noise (IntegrateOutputs::radiance: the SSLR cone
+    // trace's hits).
+    rg::Texture radiance;
     rg::Texture hitDistance;  // r: distance to the reflected hit; >= shader::kMissHitDistance: at infinity
     // This and last frame's unjittered matrices and positions (the
     // G-buffer's camera).
@@ -157,6 +161,12 @@ struct TemporalSettings {
     // remove (the frame passes its cutoff; on the plaza that skips the 5x5
     // filter on over half the pixels).
     float spatialRoughnessMax = 1.0f;
+    // The filter's radius at pixels whose radiance this frame is
+    // noise-free (TemporalInputs::radiance's a = shader::kReflectsNoiseFree:
+    // the SSLR cone trace's hits, which the colour pyramid has already
+    // blurred by the lobe), where it is below spatialRadius; 0: those
+    // pixels are not filtered.
+    uint32_t spatialNoiseFreeRadius = 2;
 };
 
 struct TemporalOutputs {

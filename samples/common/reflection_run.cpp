@@ -61,7 +61,7 @@ constexpr std::array<bool, 3> kEveryMode{true, true, true};
 
 // The one table of parameters: name, field, the viewer's range, the
 // bench's sweep, and where the value lives.
-const std::array<ParameterSlot, 31> kParameters = {{
+const std::array<ParameterSlot, 32> kParameters = {{
     // A confidence; the talk's 0.9 (default) bracketed from "trust SSLR
     // often" to "almost never".
     {{"sslr_threshold", "ReflectionFrameSettings::confidenceThreshold", 0.0f, 1.0f, false, {0.5, 0.7, 0.8, 0.95, 0.99},
@@ -95,6 +95,11 @@ const std::array<ParameterSlot, 31> kParameters = {{
     {{"cone_roughness", "RayGenerationSettings::coneRoughness (SSLR rays this rough cone-trace)", 0.0f, 1.0f, false,
       {0.05, 0.2, 1.0}, {}, kScreenSpace},
      [](ReflectionRunOptions& o) { return &o.frame.rays.coneRoughness; }, nullptr},
+    // The spatial filter's radius at the cone trace's hits (noise-free,
+    // already blurred by the pyramid); 0 leaves them alone.
+    {{"spatial_noise_free_radius", "TemporalSettings::spatialNoiseFreeRadius", 0.0f, 4.0f, true, {0, 1}, {},
+      kScreenSpace},
+     nullptr, [](ReflectionRunOptions& o) { return &o.frame.temporal.spatialNoiseFreeRadius; }},
     // Pixels nearer than this go straight to RT (default 3 world units): 0
     // tries SSLR first everywhere.
     {{"rt_near_distance", "RayGenerationSettings::rtMaxDistance", 0.0f, 50.0f, false, {0, 1, 6, 10}, {0}, kHybrid},
@@ -239,8 +244,12 @@ void setParameter(ReflectionRunOptions& options, std::string_view name, std::str
         }
         *slot.boolField(options) = v == 1.0;
     } else if (slot.uintField) {
-        if (v != std::floor(v) || v < 1.0 || v > 4096.0) {
-            throw std::invalid_argument("parameter " + std::string(name) + "=" + text + ": not an integer in 1..4096");
+        // From the parameter's own least value (a count of steps starts at
+        // 1, a radius at 0); the settings' checks bound the rest.
+        const double least = slot.parameter.min;
+        if (v != std::floor(v) || v < least || v > 4096.0) {
+            throw std::invalid_argument("parameter " + std::string(name) + "=" + text + ": not an integer in " +
+                                        std::to_string(int(least)) + "..4096");
         }
         *slot.uintField(options) = uint32_t(v);
     } else {

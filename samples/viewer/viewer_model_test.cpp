@@ -109,6 +109,17 @@ TEST_CASE("every parameter's bench sweep lies in its range, runs in some mode an
     CHECK(swept >= 10u);
 }
 
+TEST_CASE("an integer parameter takes integers from its own least value, and says which when refused") {
+    app::ReflectionRunOptions o;
+    app::setParameter(o, "spatial_noise_free_radius", "0");  // a radius: 0 turns it off
+    CHECK(o.frame.temporal.spatialNoiseFreeRadius == 0u);
+    CHECK_THROWS_WITH_AS(app::setParameter(o, "sslr_steps", "0"), doctest::Contains("not an integer in 1..4096"),
+                         std::invalid_argument);
+    CHECK_THROWS_WITH_AS(app::setParameter(o, "spatial_noise_free_radius", "1.5"),
+                         doctest::Contains("not an integer in 0..4096"), std::invalid_argument);
+    CHECK(o.frame.sslr.linearSteps == passes::SslrSettings{}.linearSteps);
+}
+
 TEST_CASE("a slider sets its parameter through setParameter, clamped and rounded") {
     const std::vector<viewer::ParameterSlider> sliders = viewer::parameterSliders();
     const auto find = [&](std::string_view name) {

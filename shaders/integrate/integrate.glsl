@@ -109,7 +109,7 @@ vec3 surfaceMotion(ivec2 texel, vec3 position) {
 
 struct Reflection {
     vec3 radiance;
-    float reflects;     // 1 where a surface reflects
+    float reflects;     // kReflects where a surface reflects, kReflectsNoiseFree for a cone trace's hit
     float hitDistance;
     vec3 hitMotion;     // last frame's reflected point minus this frame's
     uint source;
@@ -138,7 +138,7 @@ Reflection integratePixel(uvec2 pixel) {
     const vec3 position = worldPosition(vec2(pixel) + 0.5, depth);
     const vec3 N = n * inversesqrt(max(dot(n, n), 1e-12));
     const vec3 V = normalize(C.cameraPosition.xyz - position);
-    r.reflects = 1.0;
+    r.reflects = kReflects;
     // The environment map, for env pixels and for traces that found nothing.
     r.radiance = environmentRadiance(C.lighting, reflect(-V, N), roughness);
     r.source = pixelClass == kPixelEnv ? kSourceEnvironment : kSourceFallback;
@@ -171,6 +171,7 @@ Reflection integratePixel(uvec2 pixel) {
     float confidence = 0.0;
     vec3 sslrRadiance = vec3(0.0);
     vec2 sslrHitUv = vec2(0.0);
+    bool sslrCone = false;  // the hit is the cone trace's (glint/sslr_shared.h, kSslrHitCone)
     // The traces write their rays' pixels only (nothing is cleared): the RT
     // outputs hold this ray's result at RT pixels and at the hybrid pixels
     // SSLR handed on, those whose stored confidence is not at least the
@@ -192,6 +193,7 @@ Reflection integratePixel(uvec2 pixel) {
             confidence = sslrHitConfidence(clamp(c, 0.0, 1.0), C.rtMissesTrusted != 0u);
             sslrRadiance = radiance.rgb;
             sslrHitUv = hitUv;
+            sslrCone = radiance.a > 0.5 * (kSslrHitRay + kSslrHitCone);
         }
 #if GLINT_INTEGRATE_FEEDBACK
         // The counters count traced rays: leaders only, once each.
@@ -240,6 +242,9 @@ Reflection integratePixel(uvec2 pixel) {
     if (trace == kTraceSslr) {
         r.radiance = sslrRadiance;
         r.source = kSourceSslr;
+        if (sslrCone) {
+            r.reflects = kReflectsNoiseFree;
+        }
         // The reflected point is the surface the depth buffer holds at the
         // hit texel, measured from this pixel's own surface.
         const ivec2 hitTexel = ivec2(sslrHitTexel(sslrHitUv, C.size));
@@ -259,6 +264,10 @@ Reflection integratePixel(uvec2 pixel) {
         if (isFinite(particles.rgb) && isFinite(particles.a)) {
             const float coverage = clamp(particles.a, 0.0, 1.0);
             r.radiance = max(particles.rgb, vec3(0.0)) + (1.0 - coverage) * r.radiance;
+            // The particles come from the pixel's own (stochastic) ray.
+            if (coverage > 0.0) {
+                r.reflects = kReflects;
+            }
         }
     }
     return r;

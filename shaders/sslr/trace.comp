@@ -91,8 +91,8 @@ float screenExit(float start, float delta, float size) {
     return ((delta > 0.0 ? size : 0.0) - start) / delta;
 }
 
-void writeResult(ivec2 pixel, vec3 radiance, float confidence, vec2 hitUv, bool hit) {
-    imageStore(radianceImage, pixel, vec4(radiance, hit ? 1.0 : 0.0));
+void writeResult(ivec2 pixel, vec3 radiance, float confidence, vec2 hitUv, bool hit, bool cone) {
+    imageStore(radianceImage, pixel, vec4(radiance, hit ? (cone ? kSslrHitCone : kSslrHitRay) : 0.0));
     imageStore(confidenceImage, pixel, vec4(confidence));
     imageStore(hitImage, pixel, vec4(hitUv, 0.0, 0.0));
 }
@@ -282,7 +282,7 @@ void main() {
         const float thick = 1.0 - smoothstep(0.5, 1.0, gap);
         confidence = clamp(facing * edge * thick, 0.0, 1.0);
     }
-    writeResult(p, radiance, confidence, hitUv, tHit >= 0.0);
+    writeResult(p, radiance, confidence, hitUv, tHit >= 0.0, cone);
 
     // Only hybrid rays go on: SSLR-class pixels lie beyond the BVH's reach
     //, where the ray tracer could find nothing better.

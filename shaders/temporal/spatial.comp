@@ -11,6 +11,7 @@
 #extension GL_GOOGLE_include_directive : require
 #extension GL_EXT_scalar_block_layout : require
 
+#include "glint/integrate_shared.h"
 #include "glint/packing.h"
 #include "glint/temporal_shared.h"
 #include "temporal_common.glsl"
@@ -24,6 +25,9 @@ layout(set = 0, binding = 1) uniform sampler2D depthTexture;
 layout(set = 0, binding = 2) uniform sampler2D surfaceTexture;
 layout(set = 0, binding = 3) uniform sampler2D accumulatedTexture;
 layout(set = 0, binding = 4, rgba16f) uniform writeonly image2D resolvedImage;
+// This frame's reflection radiance (the accumulation's input): its a says
+// where it is noise-free (TemporalInputs::radiance).
+layout(set = 0, binding = 5) uniform sampler2D radianceTexture;
 
 float ramp(float x, float start, float end) {
     if (x <= start) return 0.0;
@@ -45,7 +49,12 @@ void main() {
     const vec4 surface = texelFetch(surfaceTexture, p, 0);
     const float roughness = surface.y;
     const float strength = ramp(roughness, frame.spatialRoughnessStart, frame.spatialRoughnessEnd);
-    const int radius = int(min(frame.spatialRadius, kTemporalMaxSpatialRadius));
+    int radius = int(min(frame.spatialRadius, kTemporalMaxSpatialRadius));
+    // A smaller window (or none) where this frame's radiance is noise-free.
+    if (frame.spatialNoiseFreeRadius < uint(radius) &&
+        texelFetch(radianceTexture, p, 0).a > 0.5 * (kReflects + kReflectsNoiseFree)) {
+        radius = int(frame.spatialNoiseFreeRadius);
+    }
     if (radius == 0 || strength <= 0.0 || roughness > frame.spatialRoughnessMax) {
         imageStore(resolvedImage, p, vec4(centre.rgb, 1.0));
         return;

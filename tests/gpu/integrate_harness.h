@@ -274,7 +274,7 @@ inline scene::Scene mirrorWallScene() {
 // (half floats already rounded). Every pixel has values, so a follower
 // that read its own instead of its leader's would be caught.
 struct Traces {
-    std::vector<glm::vec4> sslrRadiance;  // a = hit
+    std::vector<glm::vec4> sslrRadiance;  // a: 0, or the hit's kind (kSslrHitRay, kSslrHitCone)
     std::vector<float> sslrConfidence;
     std::vector<glm::vec2> sslrHit;       // uv of the hit texel's centre (float32)
     std::vector<glm::vec4> rtRadiance;    // a = traced
@@ -299,8 +299,10 @@ inline Traces makeTraces(uint32_t seed, bool poison) {
             const size_t i = at(x, y);
             const float c = confidences[(x * 3 + y * 5 + seed) % confidences.size()];
             // A zero-confidence result is a miss or a rejected hit (a back
-            // face): both occur.
-            const float hit = c > 0.0f || x % 2 == 1 ? 1.0f : 0.0f;
+            // face): both occur. Every fifth hit is a cone trace's.
+            const float hit = c > 0.0f || x % 2 == 1
+                                  ? ((x + 2 * y) % 5 == 0 ? shader::kSslrHitCone : shader::kSslrHitRay)
+                                  : 0.0f;
             t.sslrRadiance[i] = glm::vec4(float(x) / 64.0f + 0.01f, float(y) / 64.0f + 0.02f, 0.25f, hit);
             t.sslrConfidence[i] = c;
             const glm::vec2 uv = shader::sslrHitUv({x, hitRow(x, y)}, glm::uvec2(kSize));
@@ -408,7 +410,7 @@ inline Expected expect(const Frame& f, const Traces& t, const Presence& present,
     if (cls == shader::kPixelSky) {
         return e;
     }
-    e.reflects = 1.0f;
+    e.reflects = shader::kReflects;
     const glm::vec3 d = glm::normalize(floorPoint(x, y));
     const glm::vec3 mirror(d.x, -d.y, d.z);  // reflect about the floor's normal (0, 1, 0)
     e.radiance = environmentRadiance(lighting, mirror, shader::decodeUnorm8(f.roughnessMetal[i].r));
@@ -451,6 +453,10 @@ inline Expected expect(const Frame& f, const Traces& t, const Presence& present,
     if (useSslr) {
         e.radiance = glm::vec3(t.sslrRadiance[li]);
         e.source = shader::kSourceSslr;
+        // A cone trace's hit carries no ray's noise.
+        if (t.sslrRadiance[li].a > 0.5f * (shader::kSslrHitRay + shader::kSslrHitCone)) {
+            e.reflects = shader::kReflectsNoiseFree;
+        }
         const glm::vec2 uv(t.sslrHit[li]);
         const glm::uvec2 texel = shader::sslrHitTexel(uv, glm::uvec2(kSize));
         // Floor rows have a surface; the sky row has none.
@@ -710,6 +716,7 @@ struct Coverage {
     uint32_t followerSslr = 0;
     uint32_t followerRt = 0;
     uint32_t sslrHitDistances = 0;
+    uint32_t noiseFree = 0;  // pixels marked kReflectsNoiseFree
     uint32_t count(uint32_t cls, uint32_t source) const {
         const auto it = classSource.find({cls, source});
         return it == classSource.end() ? 0u : it->second;
@@ -734,6 +741,7 @@ inline Coverage checkFrame(const Frame& f, const Traces& t, const Presence& pres
                            << f.radiance[i].b << " hit " << f.hitDistance[i]);
             REQUIRE(f.source[i] == sourceColour(e.source));
             REQUIRE(f.radiance[i].a == e.reflects);
+            cov.noiseFree += e.reflects == shader::kReflectsNoiseFree ? 1u : 0u;
             const glm::vec3 got(f.radiance[i]);
             const glm::vec3 want(half(e.radiance.x), half(e.radiance.y), half(e.radiance.z));
             if (e.source == shader::kSourceSslr || e.source == shader::kSourceRt) {

@@ -40,6 +40,8 @@ TEST_CASE("integrate takes each pixel's reflection from the source its class and
     CHECK(cov.followerSslr > 0);
     CHECK(cov.followerRt > 0);
     CHECK(cov.sslrHitDistances > 50);
+    // Cone traces' hits taken alone are marked noise-free, followers' too.
+    CHECK(cov.noiseFree > 20);
 }
 
 TEST_CASE("without its debug output integrate writes the same reflections, and no source colours") {

@@ -28,7 +28,7 @@ const gpu::ReflectedBinding& find(const gpu::ShaderInterface& s, uint32_t bindin
 TEST_CASE("a shader's bindings, names and push-constant size come from its SPIR-V") {
     const gpu::ShaderInterface spatial =
         gpu::reflectShader(gpu::loadSpirv("temporal/spatial.comp"), VK_SHADER_STAGE_COMPUTE_BIT, "spatial");
-    REQUIRE(spatial.bindings.size() == 5);
+    REQUIRE(spatial.bindings.size() == 6);
     CHECK(find(spatial, 0).type == VK_DESCRIPTOR_TYPE_UNIFORM_BUFFER);
     CHECK(find(spatial, 0).name == "Frame");  // a block: its block name
     CHECK(find(spatial, 1).type == VK_DESCRIPTOR_TYPE_COMBINED_IMAGE_SAMPLER);
@@ -65,7 +65,7 @@ TEST_CASE("a pipeline takes its layout from the shader, checks a stated table, a
     test::GpuTest gpu;
     auto& ctx = gpu.ctx();
     const gpu::Pipeline reflected = gpu::createComputePipeline(ctx, {"temporal/spatial.comp", {}, 0, "spatial"});
-    REQUIRE(reflected.layout().bindings().size() == 5);
+    REQUIRE(reflected.layout().bindings().size() == 6);
     CHECK(reflected.layout().binding("accumulatedTexture").binding == 3);
     CHECK_THROWS_WITH_AS(reflected.layout().binding("noSuchTexture"),
                          doctest::Contains("pipeline 'spatial' has no binding named 'noSuchTexture'"), gpu::GpuError);

@@ -17,6 +17,7 @@
 #include "glint/passes/gbuffer.h"
 #include "glint/passes/temporal.h"
 
+#include "glint/integrate_shared.h"
 #include "glint/ray_generation_shared.h"
 #include "glint/temporal_shared.h"
 
@@ -236,6 +237,59 @@ TEST_CASE("the spatial filter smooths a rough reflection in its first frame and 
     for (size_t i = 0; i < kPixels; ++i) {
         const glm::vec3 d = glm::vec3(sharp[0].resolved[i]) - glm::vec3(frames[0].radiance[i]);
         REQUIRE(glm::length(d) < 2e-3f);  // half-float rounding
+    }
+}
+
+// The left half of a rough wall marked noise-free (a cone trace's hits,
+// glint/integrate_shared.h's kReflectsNoiseFree): with
+// spatialNoiseFreeRadius 0 those pixels resolve to their own radiance, the
+// right half is filtered as before; at the filter's radius both halves are.
+TEST_CASE("the spatial filter leaves noise-free pixels alone where told to, and filters the rest") {
+    std::vector<FrameInput> frames = noisyFrames(1, 0.3f, 5);
+    const auto marked = [](uint32_t x) { return x < kSize / 2; };
+    for (uint32_t y = 0; y < kSize; ++y) {
+        for (uint32_t x = 0; x < kSize; ++x) {
+            frames[0].radiance[at(x, y)].a = marked(x) ? shader::kReflectsNoiseFree : shader::kReflects;
+        }
+    }
+    scene::Scene rough = wallScene(material(0.5f, 1.0f));
+    passes::TemporalSettings skipping;
+    skipping.spatialNoiseFreeRadius = 0;
+    const std::vector<FrameOutput> skipped = runTemporal(rough, frames, skipping);
+    const std::vector<FrameOutput> filtered = runTemporal(rough, frames);
+    // Each half's rms against the mean, and the largest change from the input.
+    const auto halfStats = [&](const std::vector<glm::vec4>& image, bool left) {
+        double sum = 0.0, count = 0.0;
+        float largest = 0.0f;
+        for (uint32_t y = 0; y < kSize; ++y) {
+            for (uint32_t x = 0; x < kSize; ++x) {
+                if (marked(x) != left) continue;
+                const glm::vec3 d = glm::vec3(image[at(x, y)]) - glm::vec3(meanRadiance(x, y));
+                sum += glm::dot(d, d) / 3.0;
+                count += 1.0;
+                largest = std::max(largest, glm::length(glm::vec3(image[at(x, y)]) -
+                                                        glm::vec3(frames[0].radiance[at(x, y)])));
+            }
+        }
+        return std::pair{float(std::sqrt(sum / count)), largest};
+    };
+    const auto [inputRms, inputChange] = halfStats(frames[0].radiance, true);
+    const auto [skippedLeft, skippedLeftChange] = halfStats(skipped[0].resolved, true);
+    const auto [skippedRight, skippedRightChange] = halfStats(skipped[0].resolved, false);
+    const auto [filteredLeft, filteredLeftChange] = halfStats(filtered[0].resolved, true);
+    MESSAGE("rms: input " << inputRms << ", skipping: left " << skippedLeft << " right " << skippedRight
+                          << ", filtering all: left " << filteredLeft);
+    CHECK(inputChange == 0.0f);
+    CHECK(skippedLeftChange < 2e-3f);  // half-float rounding
+    CHECK(skippedRight < 0.4f * inputRms);
+    CHECK(filteredLeft < 0.4f * inputRms);
+    CHECK(filteredLeftChange > 0.1f);
+    // The right half's filter still takes the marked pixels as taps: the
+    // same image there either way.
+    for (uint32_t y = 0; y < kSize; ++y) {
+        for (uint32_t x = kSize / 2; x < kSize; ++x) {
+            REQUIRE(skipped[0].resolved[at(x, y)] == filtered[0].resolved[at(x, y)]);
+        }
     }
 }
 

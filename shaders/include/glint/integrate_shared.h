@@ -4,7 +4,12 @@
 //
 // Outputs, per pixel:
 //   radiance     rgb: the radiance arriving along the pixel's reflection;
-//                a = 1 where a surface reflects (every class but the sky)
+//                a: 0 for the sky, kReflectsNoiseFree (2) where the
+//                reflection is the SSLR cone trace's hit alone (no ray's
+//                noise: the colour pyramid holds the lobe's blur, and the
+//                spatial filter leaves it as it is,
+//                TemporalSettings::spatialNoiseFreeRadius), kReflects (1)
+//                elsewhere a surface reflects
 //   hitDistance  world distance from the surface to the reflected point;
 //                kMissHitDistance (glint/ray_generation_shared.h) for the
 //                environment, misses and the sky
@@ -20,6 +25,10 @@
 #include "glint/packing.h"         // GLINT_FUNC
 
 GLINT_BEGIN
+
+// radiance.a where a surface reflects (above).
+GLINT_CONST float kReflects = 1.0f;
+GLINT_CONST float kReflectsNoiseFree = 2.0f;
 
 // Where a pixel's reflection came from.
 //   Sky          nothing reflects: no surface

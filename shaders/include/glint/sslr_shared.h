@@ -7,7 +7,10 @@
 // whatever the memory held, unless SslrSettings::clearUntraced zeroes them
 // first (for debug views). Readers look at a pixel's leader, and only for
 // SSLR and hybrid pixels:
-//   radiance    lit colour at the hit, rgb; a = 1 where a hit was found
+//   radiance    lit colour at the hit, rgb; a: 0 no hit, kSslrHitRay (1) a
+//               hit of the pixel's own (stochastic) ray, kSslrHitCone (2) a
+//               cone trace's hit: the lobe's mean from the colour pyramid,
+//               without the ray's noise
 //   confidence  [0, 1]: 0 for misses (off screen, sky, too thick, back face)
 //   hit         xy = uv of the hit texel's centre (float32: exact at any size)
 // RT hand-off: each hybrid ray whose confidence is not at least the
@@ -44,6 +47,10 @@ struct SslrConstants {
     float minStepPixels;        // SslrSettings::minStepPixels
     uint blueNoise;             // 1: start offsets from the blue noise (ray generation's choice)
 };
+
+// radiance.a of a hit (above): the pixel's ray, or the cone trace.
+GLINT_CONST float kSslrHitRay = 1.0f;
+GLINT_CONST float kSslrHitCone = 2.0f;
 
 // The pyramid stops at 2^(kSslrPyramidMaxMips - 1) pixels per texel: wider
 // footprints belong to pixels rougher than the cutoff, which trace nothing.

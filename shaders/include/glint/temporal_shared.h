@@ -71,12 +71,13 @@ struct TemporalFrame {
     float environmentRoughness;          // above this roughness the environment alone (above 1: nowhere)
     uint debugOutputs;                   // 1: write the motion and history length images
     uint frame;                          // the frame's index (the history's rounding noise)
+    uint spatialNoiseFreeRadius;         // the spatial filter's radius where this frame's radiance is noise-free
 };
 
 GLINT_END
 
 #ifdef __cplusplus
-static_assert(sizeof(glint::shader::TemporalFrame) == 4 * 64 + 2 * 16 + 100);
+static_assert(sizeof(glint::shader::TemporalFrame) == 4 * 64 + 2 * 16 + 104);
 #endif
 
 #endif
