@@ -109,10 +109,15 @@ struct RayGenerationSettings {
     // "fast cone trace for rough tiles"; SslrSettings::coneTrace turns it
     // off). Ray generation marks those rays (kRayCone) and opens SSLR's
     // pyramid passes only when it lists one, so a frame without builds no
-    // pyramid. Glint's starting value; glint-bench --motion on the plaza
-    // (docs/results.md): 1 (no cone trace) is 0.025 ms faster and as
-    // accurate in motion but flickers 20% more, 0.2 changes nothing.
-    float coneRoughness = 0.1f;
+    // pyramid. Its hits are noise-free, and the spatial filter leaves them
+    // alone (TemporalSettings::spatialNoiseFreeRadius). 0.05 (was 0.1)
+    // from glint-bench on an H100 at 1080p with that filter
+    // (docs/results.md, 2026-12-07, eleventh session): in the city of
+    // 1,024 buildings 0.002-0.004 ms faster, as accurate still and in motion,
+    // and 13% less flicker, which is what leaving the hits unfiltered had
+    // cost; 1 (no cone trace) flickers 4.5x as much there, 20% more on
+    // the plaza.
+    float coneRoughness = 0.05f;
     // Share of the hybrid-band pixels of a tile the feedback sends to RT that
     // stay hybrid (tried with SSLR first) this frame, so that the tile's
     // counters keep seeing SSLR and it can return to SSLR (Far Cry 6

@@ -164,9 +164,13 @@ struct TemporalSettings {
     // The filter's radius at pixels whose radiance this frame is
     // noise-free (TemporalInputs::radiance's a = shader::kReflectsNoiseFree:
     // the SSLR cone trace's hits, which the colour pyramid has already
-    // blurred by the lobe), where it is below spatialRadius; 0: those
-    // pixels are not filtered.
-    uint32_t spatialNoiseFreeRadius = 2;
+    // blurred by the lobe), where it is below spatialRadius; 0 (default):
+    // those pixels are not filtered. On an H100 at 1080p (docs/results.md,
+    // 2026-12-07, eleventh session) 0 takes the filter from 0.075 to 0.036
+    // ms in the city of 1,024 buildings, where most filtered pixels are
+    // such hits (0.044 -> 0.038 on the plaza), at the same FLIP (+0.1%),
+    // for 13% more flicker there at cone roughness 0.1 (1: 0.051 ms, +4%).
+    uint32_t spatialNoiseFreeRadius = 0;
 };
 
 struct TemporalOutputs {

@@ -89,15 +89,16 @@ const std::array<ParameterSlot, 32> kParameters = {{
       false, {0.0, 0.05, 0.1, 1.0}, {0.0}, kEveryMode},
      [](ReflectionRunOptions& o) { return &o.frame.rays.reuseRoughness; }, nullptr},
     // SSLR and hybrid rays at least this rough cone-trace the lit pyramid
-    // (default 0.1): noise-free but blurred by a box filter and limited to
+    // (default 0.05): noise-free but blurred by a box filter and limited to
     // what is on screen; 1 (above any traced roughness) never does, each
     // ray then takes the lit colour at its own hit.
     {{"cone_roughness", "RayGenerationSettings::coneRoughness (SSLR rays this rough cone-trace)", 0.0f, 1.0f, false,
-      {0.05, 0.2, 1.0}, {}, kScreenSpace},
+      {0.1, 0.2, 1.0}, {}, kScreenSpace},
      [](ReflectionRunOptions& o) { return &o.frame.rays.coneRoughness; }, nullptr},
     // The spatial filter's radius at the cone trace's hits (noise-free,
-    // already blurred by the pyramid); 0 leaves them alone.
-    {{"spatial_noise_free_radius", "TemporalSettings::spatialNoiseFreeRadius", 0.0f, 4.0f, true, {0, 1}, {},
+    // already blurred by the pyramid); 0 (default) leaves them alone, 2 is
+    // the filter's own.
+    {{"spatial_noise_free_radius", "TemporalSettings::spatialNoiseFreeRadius", 0.0f, 4.0f, true, {1, 2}, {},
       kScreenSpace},
      nullptr, [](ReflectionRunOptions& o) { return &o.frame.temporal.spatialNoiseFreeRadius; }},
     // Pixels nearer than this go straight to RT (default 3 world units): 0

@@ -50,12 +50,14 @@ void main() {
     const float roughness = surface.y;
     const float strength = ramp(roughness, frame.spatialRoughnessStart, frame.spatialRoughnessEnd);
     int radius = int(min(frame.spatialRadius, kTemporalMaxSpatialRadius));
-    // A smaller window (or none) where this frame's radiance is noise-free.
-    if (frame.spatialNoiseFreeRadius < uint(radius) &&
+    const bool filtered = radius > 0 && strength > 0.0 && roughness <= frame.spatialRoughnessMax;
+    // A smaller window (or none) where this frame's radiance is noise-free
+    // (read only where the filter would run).
+    if (filtered && frame.spatialNoiseFreeRadius < uint(radius) &&
         texelFetch(radianceTexture, p, 0).a > 0.5 * (kReflects + kReflectsNoiseFree)) {
         radius = int(frame.spatialNoiseFreeRadius);
     }
-    if (radius == 0 || strength <= 0.0 || roughness > frame.spatialRoughnessMax) {
+    if (!filtered || radius == 0) {
         imageStore(resolvedImage, p, vec4(centre.rgb, 1.0));
         return;
     }

@@ -480,7 +480,8 @@ TEST_CASE("the distance split classes pixels, and ray lists and indirect args ag
     // dispatch covers it in 64-wide groups and the trace-rays command is
     // {count, 1, 1}.
     const auto checkList = [&](const char* what, const std::array<uint32_t, shader::kRayListArgsWords>& args,
-                               const std::vector<shader::PackedRay>& list, const std::set<uint32_t>& leaders) {
+                               const std::vector<shader::PackedRay>& list, const std::set<uint32_t>& leaders,
+                               bool coneMarks) {
         INFO(what << " list");
         const uint32_t count = args[shader::kRayListCountOffset];
         REQUIRE(count == leaders.size());
@@ -492,14 +493,17 @@ TEST_CASE("the distance split classes pixels, and ray lists and indirect args ag
         std::set<uint32_t> listed;
         for (uint32_t k = 0; k < count; ++k) {
             const shader::PackedRay& entry = list[k];
-            listed.insert(entry.pixelFlags);
+            // SSLR entries of pixels at least RayGenerationSettings::coneRoughness
+            // rough carry kRayCone; RT entries never do.
+            if (!coneMarks) REQUIRE((entry.pixelFlags & shader::kRayCone) == 0u);
+            listed.insert(entry.pixelFlags & ~shader::kRayCone);
             const glm::uvec2 p = shader::unpackRayPixel(entry.pixelFlags);
             REQUIRE(entry.direction == f.rays[f.at(p.x, p.y)].direction);
         }
         CHECK(listed == leaders);  // and, being sets of the listed size, no duplicates
     };
-    checkList("SSLR", f.sslrArgs, f.sslrRays, sslrLeaders);
-    checkList("RT", f.rtArgs, f.rtRays, rtLeaders);
+    checkList("SSLR", f.sslrArgs, f.sslrRays, sslrLeaders, true);
+    checkList("RT", f.rtArgs, f.rtRays, rtLeaders, false);
 }
 
 TEST_CASE("rough 2x2 quads share their leader's ray, and the leader rotates with the frame") {

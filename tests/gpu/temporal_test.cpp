@@ -242,8 +242,9 @@ TEST_CASE("the spatial filter smooths a rough reflection in its first frame and 
 
 // The left half of a rough wall marked noise-free (a cone trace's hits,
 // glint/integrate_shared.h's kReflectsNoiseFree): with
-// spatialNoiseFreeRadius 0 those pixels resolve to their own radiance, the
-// right half is filtered as before; at the filter's radius both halves are.
+// spatialNoiseFreeRadius 0 (the default) those pixels resolve to their own
+// radiance, the right half is filtered as before; at the filter's own
+// radius both halves are.
 TEST_CASE("the spatial filter leaves noise-free pixels alone where told to, and filters the rest") {
     std::vector<FrameInput> frames = noisyFrames(1, 0.3f, 5);
     const auto marked = [](uint32_t x) { return x < kSize / 2; };
@@ -255,8 +256,10 @@ TEST_CASE("the spatial filter leaves noise-free pixels alone where told to, and 
     scene::Scene rough = wallScene(material(0.5f, 1.0f));
     passes::TemporalSettings skipping;
     skipping.spatialNoiseFreeRadius = 0;
+    passes::TemporalSettings filtering;
+    filtering.spatialNoiseFreeRadius = filtering.spatialRadius;
     const std::vector<FrameOutput> skipped = runTemporal(rough, frames, skipping);
-    const std::vector<FrameOutput> filtered = runTemporal(rough, frames);
+    const std::vector<FrameOutput> filtered = runTemporal(rough, frames, filtering);
     // Each half's rms against the mean, and the largest change from the input.
     const auto halfStats = [&](const std::vector<glm::vec4>& image, bool left) {
         double sum = 0.0, count = 0.0;
