@@ -31,7 +31,8 @@ void checkSettings(const TemporalSettings& s) {
     if (!ok) {
         throw gpu::GpuError(
             "addTemporalPass: invalid settings (maxHistoryFrames >= 1, clampGamma > 0, 0 < maxRadiance <= 65504, "
-            "positive tolerances and sigmas, ramps with start <= end, spatialRadius and spatialNoiseFreeRadius <= 4, clampRadius <= 3)");
+            "positive tolerances and sigmas, ramps with start <= end, spatialRadius and spatialNoiseFreeRadius <= 4, "
+            "clampRadius <= 3)");
     }
 }
 

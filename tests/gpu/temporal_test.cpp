@@ -746,6 +746,10 @@ TEST_CASE("temporal settings out of range are an error naming the pass") {
     CHECK_THROWS_WITH_AS(passes::addTemporalPass(graph, pipelines, {gbuf, fake, fake, testCamera()}, settings),
                          doctest::Contains("addTemporalPass"), gpu::GpuError);
     settings = {};
+    settings.spatialNoiseFreeRadius = shader::kTemporalMaxSpatialRadius + 1;
+    CHECK_THROWS_WITH_AS(passes::addTemporalPass(graph, pipelines, {gbuf, fake, fake, testCamera()}, settings),
+                         doctest::Contains("spatialNoiseFreeRadius"), gpu::GpuError);
+    settings = {};
     settings.clampRadius = shader::kTemporalMaxClampRadius + 1;
     CHECK_THROWS_WITH_AS(passes::addTemporalPass(graph, pipelines, {gbuf, fake, fake, testCamera()}, settings),
                          doctest::Contains("clampRadius <= 3"), gpu::GpuError);
