@@ -115,7 +115,7 @@ struct RayGenerationSettings {
     // (docs/results.md, 2026-12-07, eleventh session): in the city of
     // 1,024 buildings 0.002-0.004 ms faster, as accurate still and in motion,
     // and 13% less flicker, which is what leaving the hits unfiltered had
-    // cost; 1 (no cone trace) flickers 4.5x as much there, 20% more on
+    // cost; 1 (no cone trace) flickers 4.5x as much there, 22% more on
     // the plaza.
     float coneRoughness = 0.05f;
     // Share of the hybrid-band pixels of a tile the feedback sends to RT that

@@ -193,7 +193,7 @@ Reflection integratePixel(uvec2 pixel) {
             confidence = sslrHitConfidence(clamp(c, 0.0, 1.0), C.rtMissesTrusted != 0u);
             sslrRadiance = radiance.rgb;
             sslrHitUv = hitUv;
-            sslrCone = radiance.a > 0.5 * (kSslrHitRay + kSslrHitCone);
+            sslrCone = sslrHitIsCone(radiance.a);
         }
 #if GLINT_INTEGRATE_FEEDBACK
         // The counters count traced rays: leaders only, once each.

@@ -54,7 +54,7 @@ void main() {
     // A smaller window (or none) where this frame's radiance is noise-free
     // (read only where the filter would run).
     if (filtered && frame.spatialNoiseFreeRadius < uint(radius) &&
-        texelFetch(radianceTexture, p, 0).a > 0.5 * (kReflects + kReflectsNoiseFree)) {
+        reflectsNoiseFree(texelFetch(radianceTexture, p, 0).a)) {
         radius = int(frame.spatialNoiseFreeRadius);
     }
     if (!filtered || radius == 0) {

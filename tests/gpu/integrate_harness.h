@@ -454,7 +454,7 @@ inline Expected expect(const Frame& f, const Traces& t, const Presence& present,
         e.radiance = glm::vec3(t.sslrRadiance[li]);
         e.source = shader::kSourceSslr;
         // A cone trace's hit carries no ray's noise.
-        if (t.sslrRadiance[li].a > 0.5f * (shader::kSslrHitRay + shader::kSslrHitCone)) {
+        if (shader::sslrHitIsCone(t.sslrRadiance[li].a)) {
             e.reflects = shader::kReflectsNoiseFree;
         }
         const glm::vec2 uv(t.sslrHit[li]);

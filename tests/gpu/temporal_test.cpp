@@ -276,13 +276,12 @@ TEST_CASE("the spatial filter leaves noise-free pixels alone where told to, and 
         }
         return std::pair{float(std::sqrt(sum / count)), largest};
     };
-    const auto [inputRms, inputChange] = halfStats(frames[0].radiance, true);
+    const float inputRms = halfStats(frames[0].radiance, true).first;
     const auto [skippedLeft, skippedLeftChange] = halfStats(skipped[0].resolved, true);
     const auto [skippedRight, skippedRightChange] = halfStats(skipped[0].resolved, false);
     const auto [filteredLeft, filteredLeftChange] = halfStats(filtered[0].resolved, true);
     MESSAGE("rms: input " << inputRms << ", skipping: left " << skippedLeft << " right " << skippedRight
                           << ", filtering all: left " << filteredLeft);
-    CHECK(inputChange == 0.0f);
     CHECK(skippedLeftChange < 2e-3f);  // half-float rounding
     CHECK(skippedRight < 0.4f * inputRms);
     CHECK(filteredLeft < 0.4f * inputRms);

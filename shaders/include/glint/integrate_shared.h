@@ -30,6 +30,9 @@ GLINT_BEGIN
 GLINT_CONST float kReflects = 1.0f;
 GLINT_CONST float kReflectsNoiseFree = 2.0f;
 
+// Whether a stored radiance.a (any float format) marks a noise-free reflection.
+GLINT_FUNC bool reflectsNoiseFree(float a) { return a > 0.5f * (kReflects + kReflectsNoiseFree); }
+
 // Where a pixel's reflection came from.
 //   Sky          nothing reflects: no surface
 //   Environment  an env-class pixel (rougher than the tracing cutoff)

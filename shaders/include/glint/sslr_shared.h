@@ -52,6 +52,9 @@ struct SslrConstants {
 GLINT_CONST float kSslrHitRay = 1.0f;
 GLINT_CONST float kSslrHitCone = 2.0f;
 
+// Whether a stored radiance.a (a half float) is the cone trace's hit.
+GLINT_FUNC bool sslrHitIsCone(float a) { return a > 0.5f * (kSslrHitRay + kSslrHitCone); }
+
 // The pyramid stops at 2^(kSslrPyramidMaxMips - 1) pixels per texel: wider
 // footprints belong to pixels rougher than the cutoff, which trace nothing.
 GLINT_CONST uint kSslrPyramidMaxMips = 8u;
