@@ -82,7 +82,7 @@ struct FeedbackSettings {
     // (rays at or above the confidence threshold, over the whole frame)
     // reach this share of the pixels; below it the frame's hybrid pixels go
     // straight to RT. 0: SSLR is always tried. Glint's knob, not the talk's:
-    // on the H200 at 1080p (docs/results.md) the SSLR pass and its pyramid
+    // on the H200 at 1080p (docs/results/log/03-2026-12-03-04.md) the SSLR pass and its pyramid
     // cost 0.08 ms at any ray count, about what tracing 5% of the pixels
     // costs there; the scenes where SSLR helps resolve 12-21% of the pixels
     // (the plaza, the city) and those where it does not 0.1-0.4%
@@ -117,7 +117,7 @@ struct FeedbackSettings {
     // this many frames; a report that says SSLR pays, or a cut, goes back
     // to sslrProbeInterval. A probe frame costs what the hybrid costs
     // without the gate (on the H200 at 1080p 0.085-0.11 ms more than rt
-    // where SSLR resolves nothing, docs/results.md); the frames between
+    // where SSLR resolves nothing, docs/results/log/05-2026-12-06-a.md); the frames between
     // render as rt, so backing off costs no accuracy, only the time SSLR
     // takes to come back where it starts to pay. At least sslrProbeInterval; equal: no
     // backing off.

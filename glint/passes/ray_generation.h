@@ -74,13 +74,15 @@ struct RayGenerationInputs {
 struct RayGenerationSettings {
     // Perceptual roughness above which a pixel takes the environment map
     // and traces nothing. 0.3 from glint-bench --motion at 1080p
-    // (docs/results.md): against FidelityFX Hybrid Reflections' 0.22 it
+    // (docs/results/log/03-2026-12-03-04.md): against FidelityFX Hybrid
+    // Reflections' 0.22 it
     // lowers FLIP in motion 2.4% on the plaza and 6% on DamagedHelmet for
     // 0.02 ms; 0.5 lowers it further but, every rough pixel traced with one
     // ray, flickers more than the target allows.
     float roughnessCutoff = 0.3f;
     // Perceptual roughness from which a 2x2 quad shares one ray. 0.15 from
-    // glint-bench --motion at 1080p (docs/results.md): against the starting
+    // glint-bench --motion at 1080p (docs/results/log/03-2026-12-03-04.md):
+    // against the starting
     // value 0.1 (alpha 0.01, a lobe of a few degrees) it lowers FLIP in
     // motion 2.5% on DamagedHelmet and 0.2% on the plaza and flicker 9-20%,
     // for 0.007-0.035 ms; 1 (never shared) is a little more accurate again
@@ -112,7 +114,7 @@ struct RayGenerationSettings {
     // pyramid. Its hits are noise-free, and the spatial filter leaves them
     // alone (TemporalSettings::spatialNoiseFreeRadius). 0.05 (was 0.1)
     // from glint-bench on an H100 at 1080p with that filter
-    // (docs/results.md, 2026-12-07, eleventh session): in the city of
+    // (docs/results/log/07-2026-12-07.md, eleventh session): in the city of
     // 1,024 buildings 0.002-0.004 ms faster, as accurate still and in motion,
     // and 13% less flicker, which is what leaving the hits unfiltered had
     // cost; 1 (no cone trace) flickers 4.5x as much there, 22% more on

@@ -109,7 +109,8 @@ struct ReflectionFrameSettings {
     // motion; IntegrateOutputs::hitMotion). Off: only the camera's motion
     // reprojects, and a moving object's reflection looks its history up
     // where the object no longer is (the temporal pass's clip hides most of
-    // the trail that leaves, docs/results.md, but the history is lost).
+    // the trail that leaves, docs/results/log/03-2026-12-03-04.md, but the
+    // history is lost).
     bool reflectedMotion = true;
     // Empty or "final": the composited image; otherwise one of
     // debugViews(), shown in `output` instead.

@@ -87,7 +87,8 @@ struct TemporalInputs {
     // last frame's holds a finite one, without the surface tests (which
     // rejected it at every edge the jitter moves across, leaving those
     // pixels unaccumulated, i.e. aliased: on the plaza at 1080p FLIP 0.0617
-    // -> 0.0603 in hybrid, in motion 0.2900 -> 0.2868, docs/results.md),
+    // -> 0.0603 in hybrid, in motion 0.2900 -> 0.2868, docs/results/log/
+    // 05-2026-12-06-a.md),
     // and its clip box is 3x3 (it shares no rays), which is what bounds a
     // disocclusion's ghost there.
     float environmentRoughness = 2.0f;
@@ -101,7 +102,7 @@ struct TemporalInputs {
 struct TemporalSettings {
     // The longest history, in frames: a new frame's weight never drops
     // below 1 / maxHistoryFrames. 64 (was 32) from glint-bench --motion on
-    // the plaza at 1080p (docs/results.md): with the 5x5 clamp it flickers
+    // the plaza at 1080p (docs/results/log/03-2026-12-03-04.md): with the 5x5 clamp it flickers
     // a sixth less than 32 at the same FLIP in motion, and the clamp keeps
     // it from lagging (trails stay under 1% of the object's energy).
     float maxHistoryFrames = 64.0f;
@@ -117,7 +118,7 @@ struct TemporalSettings {
     // quads share one ray a 3x3 window holds only two to four independent
     // samples, and a box estimated from so few jumps from frame to frame
     // and drags the history with it: on the plaza at 1080p 5x5 there halves
-    // the flicker of 3x3 (glint-bench --motion, docs/results.md); where
+    // the flicker of 3x3 (glint-bench --motion, docs/results/log/03-2026-12-03-04.md); where
     // every pixel has its own ray 5x5 only admits more stale history in
     // motion (DamagedHelmet: FLIP in motion +9%).
     uint32_t clampRadius = 2;
@@ -165,8 +166,8 @@ struct TemporalSettings {
     // noise-free (TemporalInputs::radiance's a = shader::kReflectsNoiseFree:
     // the SSLR cone trace's hits, which the colour pyramid has already
     // blurred by the lobe), where it is below spatialRadius; 0 (default):
-    // those pixels are not filtered. On an H100 at 1080p (docs/results.md,
-    // 2026-12-07, eleventh session) 0 takes the filter from 0.075 to 0.036
+    // those pixels are not filtered. On an H100 at 1080p (docs/results/log/
+    // 07-2026-12-07.md, eleventh session) 0 takes the filter from 0.075 to 0.036
     // ms in the city of 1,024 buildings, where most filtered pixels are
     // such hits (0.044 -> 0.038 on the plaza), at the same FLIP (+0.1%),
     // for 13% more flicker there at cone roughness 0.1 (1: 0.051 ms, +4%).

@@ -16,7 +16,7 @@
 
 namespace glint::bench {
 
-// The CSV header, column for column (docs/results.md reads these files). The metric columns
+// The CSV header, column for column (docs/results/ keeps such files). The metric columns
 // are the final image's; the reflection term's go to the JSON only.
 inline constexpr std::string_view kCsvHeader =
     "scene,mode,param,value,width,height,reflection_ms,total_ms,rt_rays,flip_mean,relmse,psnr,ssim,reflection_mean_ms,"

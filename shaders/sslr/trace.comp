@@ -185,13 +185,14 @@ void main() {
     // rays that pass behind something the pass's slowest (on the H200 at
     // 1080p the pass took 0.165 -> 0.116 ms on the plaza, 0.096 -> 0.055
     // on DamagedHelmet, for 0.7% more hybrid rays handed to RT;
-    // docs/results.md, third round).
+    // docs/results/log/03-2026-12-03-04.md, third round).
     // One step's depth read at a time, each after the last step's test:
     // reading four steps' depths before testing the first (their reads in
     // flight together), with the refinement's midpoint and quarter points
     // read together, took 56 registers instead of 40 and made the pass
     // slower on an H100 at 1080p (0.1107 -> 0.1444 ms on the plaza, 0.1312
-    // -> 0.1320 in the city; docs/results.md, ninth session).
+    // -> 0.1320 in the city; docs/results/log/07-2026-12-07.md, ninth
+    // session).
     bool wasBehind = false;
     float lastSurface = 0.0;
     for (uint i = 0u; i < steps; ++i) {

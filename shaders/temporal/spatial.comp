@@ -86,7 +86,8 @@ void main() {
     // A plain loop over the frame's radius: unrolled at the default radius
     // (every tap read before any test) it took 48 registers instead of 38
     // and was slower on an H100 at 1080p (0.0445 -> 0.0472 ms on the plaza,
-    // 0.0754 -> 0.0768 in the city; docs/results.md, ninth session).
+    // 0.0754 -> 0.0768 in the city; docs/results/log/07-2026-12-07.md, ninth
+    // session).
     for (int dy = -radius; dy <= radius; ++dy) {
         for (int dx = -radius; dx <= radius; ++dx) {
             const ivec2 q = p + ivec2(dx, dy);

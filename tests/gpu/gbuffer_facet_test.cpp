@@ -145,7 +145,8 @@ TEST_CASE("the city's G-buffer is the same with its buildings' turned-away faces
     gbuffer_test::checkSameTargets(culled, all);
     CHECK(on.facetedGeometries > 0u);
     // Down the street about two fifths of the buildings' triangles face
-    // away (results.md: 43% in the 1,024-building city at 1080p).
+    // away (docs/results/log/04-2026-12-05.md: 43% of the triangles sent in
+    // the 1,024-building city).
     CHECK(on.facetTrianglesSkipped * 4 > off.triangles);
     CHECK(on.triangles + on.facetTrianglesSkipped == off.triangles);
 }

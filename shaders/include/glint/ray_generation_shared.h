@@ -86,7 +86,7 @@ GLINT_CONST uint kRayListArgsWords = 6u;
 // {groups x, groups y, z}, z = 0 unless a listed ray cone-traces (then 1).
 // They start 128 bytes in, on a cache line of their own, so that the tiles
 // that look at them do not queue behind the count's atomics on the list's
-// line (docs/results.md, "the passes every mode runs": that look cost ray
+// line (docs/results/log/05-2026-12-06-a.md, "the passes every mode runs": that look cost ray
 // generation 0.013 ms of its 0.065 in the city on an H100).
 GLINT_CONST uint kSslrArgsPyramidOffset = 32u;
 GLINT_CONST uint kSslrArgsWords = 38u;
