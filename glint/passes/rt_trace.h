@@ -114,8 +114,9 @@ struct RtTraceSettings {
     // an H100 at 1080p the plaza's reflections 0.667 -> 0.619 ms (hybrid)
     // and 0.593 -> 0.527 (rt) at FLIP 0.06028 -> 0.06026 and 0.06108 ->
     // 0.06105 against the exact reference; the city of 1,024 buildings
-    // 0.661 -> 0.631 and 0.902 -> 0.783 at the same FLIP (docs/results/log/
-    // 06-2026-12-06-b.md, fifth session). Off: a shadow ray from every hit (the reference's).
+    // 0.661 -> 0.631 and 0.902 -> 0.783 at the same FLIP
+    // (docs/results/log/06-2026-12-06-b.md, fifth session). Off: a shadow
+    // ray from every hit (the reference's).
     bool shadowMapAtHits = true;
     // Multiplies the robust origin offset (glint/rt_trace_shared.h); 0 turns
     // it off, which tests and the bench use to show what it prevents.

@@ -87,8 +87,8 @@ struct TemporalInputs {
     // last frame's holds a finite one, without the surface tests (which
     // rejected it at every edge the jitter moves across, leaving those
     // pixels unaccumulated, i.e. aliased: on the plaza at 1080p FLIP 0.0617
-    // -> 0.0603 in hybrid, in motion 0.2900 -> 0.2868, docs/results/log/
-    // 05-2026-12-06-a.md),
+    // -> 0.0603 in hybrid, in motion 0.2900 -> 0.2868,
+    // docs/results/log/05-2026-12-06-a.md),
     // and its clip box is 3x3 (it shares no rays), which is what bounds a
     // disocclusion's ghost there.
     float environmentRoughness = 2.0f;
@@ -166,11 +166,12 @@ struct TemporalSettings {
     // noise-free (TemporalInputs::radiance's a = shader::kReflectsNoiseFree:
     // the SSLR cone trace's hits, which the colour pyramid has already
     // blurred by the lobe), where it is below spatialRadius; 0 (default):
-    // those pixels are not filtered. On an H100 at 1080p (docs/results/log/
-    // 07-2026-12-07.md, eleventh session) 0 takes the filter from 0.075 to 0.036
-    // ms in the city of 1,024 buildings, where most filtered pixels are
-    // such hits (0.044 -> 0.038 on the plaza), at the same FLIP (+0.1%),
-    // for 13% more flicker there at cone roughness 0.1 (1: 0.051 ms, +4%).
+    // those pixels are not filtered. On an H100 at 1080p
+    // (docs/results/log/07-2026-12-07.md, eleventh session) 0 takes the
+    // filter from 0.075 to 0.036 ms in the city of 1,024 buildings, where
+    // most filtered pixels are such hits (0.044 -> 0.038 on the plaza), at
+    // the same FLIP (+0.1%), for 13% more flicker there at cone roughness
+    // 0.1 (1: 0.051 ms, +4%).
     uint32_t spatialNoiseFreeRadius = 0;
 };
 

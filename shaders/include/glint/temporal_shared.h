@@ -27,9 +27,10 @@ GLINT_BEGIN
 // its clip box's tile (its pixels and a border) into shared memory once per
 // workgroup: 16x16 loads 1.56 texels a pixel at the default radius where
 // 8x8 loaded 2.25, and took the pass 0.1123 -> 0.1072 ms on the plaza at
-// 1080p (H100; 0.1395 -> 0.1338 in the city; docs/results/log/
-// 06-2026-12-06-b.md, sixth session). The spatial filter reads its taps directly and was slower in
-// 16x16 (0.0445 -> 0.0482 ms): 8x8.
+// 1080p (H100; 0.1395 -> 0.1338 in the city;
+// docs/results/log/06-2026-12-06-b.md, sixth session). The spatial filter
+// reads its taps directly and was slower in 16x16 (0.0445 -> 0.0482 ms):
+// 8x8.
 GLINT_CONST uint kTemporalAccumulateGroupSize = 16u;
 GLINT_CONST uint kTemporalSpatialGroupSize = 8u;
 
