@@ -72,6 +72,7 @@ shader::TemporalFrame frameConstants(const TemporalInputs& in, const TemporalSet
     f.debugOutputs = in.debugOutputs ? 1u : 0u;
     f.frame = uint32_t(in.frameIndex);
     f.spatialNoiseFreeRadius = s.spatialNoiseFreeRadius;
+    f.oneHistoryCandidate = s.oneHistoryCandidate ? 1u : 0u;
     return f;
 }
 

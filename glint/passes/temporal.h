@@ -139,6 +139,15 @@ struct TemporalSettings {
     // roughness (0.1).
     float surfaceMotionRoughnessStart = 0.1f;
     float surfaceMotionRoughnessEnd = 0.3f;
+    // Between those roughnesses the history is looked up at both motions
+    // and the two histories blended (each a bilinear lookup of four taps,
+    // two texels a tap). On: one lookup, at the blended motion, and the
+    // surface's motion alone where that finds nothing (a disocclusion):
+    // half the history's reads there. Off by default: on lavapipe
+    // (city:64, 192x108, glint-bench --motion) it is as accurate (FLIP in
+    // motion 0.42015 -> 0.42005, still 0.41410 -> 0.41411, flicker +0.1%),
+    // but it has not been timed on NVIDIA, where its reads are the point.
+    bool oneHistoryCandidate = false;
     // Radiance is clamped to [0, maxRadiance] before it is accumulated: the
     // largest half float, so neither the RGBA16F history nor the resolved
     // image overflows to Inf.

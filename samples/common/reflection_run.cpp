@@ -61,7 +61,7 @@ constexpr std::array<bool, 3> kEveryMode{true, true, true};
 
 // The one table of parameters: name, field, the viewer's range, the
 // bench's sweep, and where the value lives.
-const std::array<ParameterSlot, 32> kParameters = {{
+const std::array<ParameterSlot, 33> kParameters = {{
     // A confidence; the talk's 0.9 (default) bracketed from "trust SSLR
     // often" to "almost never".
     {{"sslr_threshold", "ReflectionFrameSettings::confidenceThreshold", 0.0f, 1.0f, false, {0.5, 0.7, 0.8, 0.95, 0.99},
@@ -101,6 +101,11 @@ const std::array<ParameterSlot, 32> kParameters = {{
     {{"spatial_noise_free_radius", "TemporalSettings::spatialNoiseFreeRadius", 0.0f, 4.0f, true, {1, 2}, {},
       kScreenSpace},
      nullptr, [](ReflectionRunOptions& o) { return &o.frame.temporal.spatialNoiseFreeRadius; }},
+    // Glossy pixels look their history up once, at the blended motion,
+    // instead of at the reflected point's and the surface's (default off).
+    {{"one_history_candidate", "TemporalSettings::oneHistoryCandidate (0 or 1)", 0.0f, 1.0f, true, {1}, {},
+      kEveryMode},
+     nullptr, nullptr, [](ReflectionRunOptions& o) { return &o.frame.temporal.oneHistoryCandidate; }},
     // Pixels nearer than this go straight to RT (default 3 world units): 0
     // tries SSLR first everywhere.
     {{"rt_near_distance", "RayGenerationSettings::rtMaxDistance", 0.0f, 50.0f, false, {0, 1, 6, 10}, {0}, kHybrid},

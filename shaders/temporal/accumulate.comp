@@ -324,11 +324,18 @@ void main() {
     const vec2 reflectionMotion = mix(virtualMotion, surfaceMotion, surfaceWeight);
 
     // 2. History at both candidates, blended by roughness; either one alone
-    // where the other is rejected.
+    // where the other is rejected. With frame.oneHistoryCandidate, where
+    // both would be read: one lookup at the blended motion, the surface's
+    // where that finds nothing.
     vec3 history = vec3(0.0);
     float historyLength = 0.0;
     bool hasHistory = false;
-    if (frame.resetHistory == 0u) {
+    if (frame.resetHistory == 0u && frame.oneHistoryCandidate != 0u && surfaceWeight > 0.0 && surfaceWeight < 1.0) {
+        float blendedLength = 0.0;
+        hasHistory = sampleHistory(centre + reflectionMotion, px, history, blendedLength) ||
+                     sampleHistory(centre + surfaceMotion, px, history, blendedLength);
+        historyLength = hasHistory ? max(floor(blendedLength + 0.5), 1.0) : 0.0;
+    } else if (frame.resetHistory == 0u) {
         vec3 virtualHistory = vec3(0.0), surfaceHistoryRadiance = vec3(0.0);
         float virtualLength = 0.0, surfaceLength = 0.0;
         bool virtualOk = false, surfaceOk = false;

@@ -542,6 +542,72 @@ TEST_CASE("reflection motion follows the reflected point for a mirror and the su
     }
 }
 
+// A glossy wall (roughness 0.2: halfway between the two motions) that
+// reflects nothing (misses: the reflected point is at infinity, which the
+// camera's step does not move) while the camera steps 0.5 to the right:
+// the surface moved 0.5 * 32 / 5 = 3.2 pixels, the reflected point 0. Last
+// frame's radiance is a stripe every fourth column, so looking the history
+// up at both motions and blending differs from looking it up once at the
+// blended 1.6 pixels. The clip box and the spatial filter are off: the
+// result is the average of the history and this frame's 0.5. A mirror (one
+// motion) is the same either way.
+TEST_CASE("one history candidate looks a glossy pixel's history up at the blended motion") {
+    constexpr float kStep = 0.5f;
+    const float surfaceMotion = kStep * 32.0f / kWallDistance;
+    const auto stripe = [](int column) { return column % 4 == 0 ? 1.0f : 0.0f; };
+    // The shader's bilinear lookup along a row at pixel position x.
+    const auto lookup = [&](float x) {
+        const float base = std::floor(x - 0.5f);
+        const float t = x - 0.5f - base;
+        return (1.0f - t) * stripe(int(base)) + t * stripe(int(base) + 1);
+    };
+    for (const float roughness : {0.2f, 0.0f}) {
+        CAPTURE(roughness);
+        scene::Scene scene = wallScene(material(roughness, 1.0f));
+        std::vector<FrameInput> frames(2);
+        scene::Camera camera = testCamera();
+        frames[0].camera = camera;
+        camera.advance({{kStep, 0, 0}, {kStep, 0, -1}, {0, 1, 0}}, 1);
+        frames[1].camera = camera;
+        for (uint32_t y = 0; y < kSize; ++y) {
+            for (uint32_t x = 0; x < kSize; ++x) {
+                const float v = stripe(int(x));
+                frames[0].radiance[at(x, y)] = glm::vec4(v, v, v, 1.0f);
+                frames[1].radiance[at(x, y)] = glm::vec4(0.5f, 0.5f, 0.5f, 1.0f);
+                for (FrameInput& f : frames) f.hitDistance[at(x, y)] = shader::kMissHitDistance;
+            }
+        }
+        passes::TemporalSettings both;
+        both.neighbourhoodClamp = false;
+        both.spatialRadius = 0;
+        passes::TemporalSettings one = both;
+        one.oneHistoryCandidate = true;
+        const std::vector<FrameOutput> outBoth = runTemporal(scene, frames, both);
+        const std::vector<FrameOutput> outOne = runTemporal(scene, frames, one);
+        if (roughness == 0.0f) {
+            CHECK(outOne.back().resolved == outBoth.back().resolved);
+            continue;
+        }
+        uint32_t differing = 0;
+        for (uint32_t y = 0; y < kSize; ++y) {
+            for (uint32_t x = 0; x + 6 < kSize; ++x) {
+                INFO("pixel " << x << ", " << y);
+                const float centre = float(x) + 0.5f;
+                const float blendedHistories = 0.5f * lookup(centre) + 0.5f * lookup(centre + surfaceMotion);
+                const float blendedMotion = lookup(centre + 0.5f * surfaceMotion);
+                REQUIRE(outBoth.back().length[at(x, y)] == 2.0f);
+                REQUIRE(outOne.back().length[at(x, y)] == 2.0f);
+                REQUIRE(outBoth.back().resolved[at(x, y)].g ==
+                        doctest::Approx(0.5f * blendedHistories + 0.25f).epsilon(0.01));
+                REQUIRE(outOne.back().resolved[at(x, y)].g ==
+                        doctest::Approx(0.5f * blendedMotion + 0.25f).epsilon(0.01));
+                differing += std::abs(blendedHistories - blendedMotion) > 0.1f ? 1u : 0u;
+            }
+        }
+        CHECK(differing > kSize * kSize / 2);
+    }
+}
+
 TEST_CASE("a jittered camera keeps the history of a grazing floor") {
     // Rasterisation moves by a sub-pixel jitter every frame; positions are
     // reconstructed with the jittered matrices, so a floor seen at grazing

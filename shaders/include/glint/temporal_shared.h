@@ -73,12 +73,13 @@ struct TemporalFrame {
     uint debugOutputs;                   // 1: write the motion and history length images
     uint frame;                          // the frame's index (the history's rounding noise)
     uint spatialNoiseFreeRadius;         // the spatial filter's radius where this frame's radiance is noise-free
+    uint oneHistoryCandidate;            // 1: one history lookup at the blended motion (TemporalSettings)
 };
 
 GLINT_END
 
 #ifdef __cplusplus
-static_assert(sizeof(glint::shader::TemporalFrame) == 4 * 64 + 2 * 16 + 104);
+static_assert(sizeof(glint::shader::TemporalFrame) == 4 * 64 + 2 * 16 + 108);
 #endif
 
 #endif
