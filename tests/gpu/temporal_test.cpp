@@ -153,6 +153,16 @@ float rmsError(const std::vector<glm::vec4>& image) {
     return float(std::sqrt(sum / kPixels));
 }
 
+// Two frames whose camera steps `step` to the right, still facing the wall.
+std::vector<FrameInput> cameraStepFrames(float step) {
+    std::vector<FrameInput> frames(2);
+    scene::Camera camera = testCamera();
+    frames[0].camera = camera;
+    camera.advance({{step, 0, 0}, {step, 0, -1}, {0, 1, 0}}, 1);
+    frames[1].camera = camera;
+    return frames;
+}
+
 } // namespace
 
 // ---------------------------------------------------------------- temporal
@@ -503,11 +513,7 @@ TEST_CASE("reflection motion follows the reflected point for a mirror and the su
     for (const float roughness : {0.0f, 0.8f}) {
         CAPTURE(roughness);
         scene::Scene scene = wallScene(material(roughness, 1.0f));
-        std::vector<FrameInput> frames(2);
-        scene::Camera camera = testCamera();
-        frames[0].camera = camera;
-        camera.advance({{kStep, 0, 0}, {kStep, 0, -1}, {0, 1, 0}}, 1);
-        frames[1].camera = camera;
+        std::vector<FrameInput> frames = cameraStepFrames(kStep);
         for (FrameInput& f : frames) {
             for (uint32_t y = 0; y < kSize; ++y) {
                 for (uint32_t x = 0; x < kSize; ++x) {
@@ -564,11 +570,7 @@ TEST_CASE("one history candidate looks a glossy pixel's history up at the blende
     for (const float roughness : {0.2f, 0.0f}) {
         CAPTURE(roughness);
         scene::Scene scene = wallScene(material(roughness, 1.0f));
-        std::vector<FrameInput> frames(2);
-        scene::Camera camera = testCamera();
-        frames[0].camera = camera;
-        camera.advance({{kStep, 0, 0}, {kStep, 0, -1}, {0, 1, 0}}, 1);
-        frames[1].camera = camera;
+        std::vector<FrameInput> frames = cameraStepFrames(kStep);
         for (uint32_t y = 0; y < kSize; ++y) {
             for (uint32_t x = 0; x < kSize; ++x) {
                 const float v = stripe(int(x));
