@@ -75,18 +75,16 @@ struct RayGenerationSettings {
     // Perceptual roughness above which a pixel takes the environment map
     // and traces nothing. 0.3 from glint-bench --motion at 1080p
     // (docs/results/log/03-2026-12-03-04.md): against FidelityFX Hybrid
-    // Reflections' 0.22 it
-    // lowers FLIP in motion 2.4% on the plaza and 6% on DamagedHelmet for
-    // 0.02 ms; 0.5 lowers it further but, every rough pixel traced with one
-    // ray, flickers more than the target allows.
+    // Reflections' 0.22 it lowers FLIP in motion 2.4% on the plaza and 6%
+    // on DamagedHelmet for 0.02 ms; 0.5 lowers it further but, every rough
+    // pixel traced with one ray, flickers more than the target allows.
     float roughnessCutoff = 0.3f;
     // Perceptual roughness from which a 2x2 quad shares one ray. 0.15 from
     // glint-bench --motion at 1080p (docs/results/log/03-2026-12-03-04.md):
-    // against the starting
-    // value 0.1 (alpha 0.01, a lobe of a few degrees) it lowers FLIP in
-    // motion 2.5% on DamagedHelmet and 0.2% on the plaza and flicker 9-20%,
-    // for 0.007-0.035 ms; 1 (never shared) is a little more accurate again
-    // for twice that cost.
+    // against the starting value 0.1 (alpha 0.01, a lobe of a few degrees)
+    // it lowers FLIP in motion 2.5% on DamagedHelmet and 0.2% on the plaza
+    // and flicker 9-20%, for 0.007-0.035 ms; 1 (never shared) is a little
+    // more accurate again for twice that cost.
     float reuseRoughness = 0.15f;
     bool reuse = true;
     // Half-rate rays on the smooth hybrid and RT pixels: on a checkerboard
