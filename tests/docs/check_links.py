@@ -29,7 +29,11 @@ def anchor(heading):
     return text.replace(" ", "-")
 
 
-def anchors(path, cache={}):
+_anchors = {}  # Markdown file -> its headings' anchors
+
+
+def anchors(path):
+    cache = _anchors
     if path not in cache:
         found = set()
         in_code = False
