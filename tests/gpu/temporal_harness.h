@@ -1,5 +1,5 @@
 // What glint_temporal_gpu_tests' temporal and composite cases share
-// (temporal_test.cpp, composite_test.cpp): kSize x kSize textures uploaded
+// (temporal_rig.h, composite_test.cpp): kSize x kSize textures uploaded
 // into and read back from the graph through host buffers that outlive the
 // frames using them (Staging), and the scenes: materials, one instance per
 // geometry, a wall filling the image.

@@ -1,21 +1,17 @@
 // Temporal accumulation (passes/temporal.h) on a real device, validation
 // on, behind the real G-buffer, with the reflection radiance and hit
 // distance uploaded by the test (so nothing depends on the passes between;
-// the harness: temporal_harness.h). Frames run back to back with two in
-// flight; every frame has its own upload and readback buffers. Known
-// answers: noise around a known mean shrinks like an average; NaN, Inf and
-// 1e30 never reach a later frame; a disoccluded pixel shows the new surface
-// in its first frame; reflection motion equals the closed-form motion of
-// the virtual point (and of the surface when rough); a reset forgets. The
-// composite and the debug views have their own file (composite_test.cpp).
-#include "support/gpu_test.h"
-#include "temporal_harness.h"
+// the rig: temporal_rig.h). Frames run back to back with two in flight;
+// every frame has its own upload and readback buffers. Known answers:
+// noise around a known mean shrinks like an average; NaN, Inf and 1e30
+// never reach a later frame; a disoccluded pixel shows the new surface in
+// its first frame; reflection motion equals the closed-form motion of the
+// virtual point (and of the surface when rough); a reset forgets. The
+// spatial filter has its own file (spatial_filter_test.cpp), as do the
+// composite and the debug views (composite_test.cpp).
+#include "temporal_rig.h"
 
 #include "glint/gpu/error.h"
-#include "glint/graph/executor.h"
-#include "glint/graph/verify.h"
-#include "glint/passes/gbuffer.h"
-#include "glint/passes/temporal.h"
 
 #include "glint/integrate_shared.h"
 #include "glint/ray_generation_shared.h"
@@ -24,146 +20,11 @@
 #include <glm/gtc/matrix_transform.hpp>
 
 #include <algorithm>
-#include <array>
 #include <cmath>
-#include <functional>
 #include <limits>
-#include <random>
 
 using namespace glint;
 using namespace glint::temporal_test;
-
-namespace {
-
-bool finite(glm::vec4 v) {
-    return std::isfinite(v.x) && std::isfinite(v.y) && std::isfinite(v.z) && std::isfinite(v.w);
-}
-
-// ---------------------------------------------------------------- the temporal rig
-
-struct FrameInput {
-    std::vector<glm::vec4> radiance = std::vector<glm::vec4>(kPixels, glm::vec4(0.0f));  // uploaded as RGBA32F
-    std::vector<float> hitDistance = std::vector<float>(kPixels, 2.0f);
-    scene::Camera camera = testCamera();
-    bool reset = false;
-    // TemporalInputs::sharedRayRoughness (above 1: no pixel shares rays).
-    float sharedRayRoughness = 2.0f;
-    // TemporalInputs::environmentRoughness (above 1: no pixel takes the
-    // environment alone).
-    float environmentRoughness = 2.0f;
-    // TemporalInputs::debugOutputs: off, the motion and length are not read back.
-    bool debugOutputs = true;
-    // Called before the frame's G-buffer is declared (moves objects).
-    std::function<void(scene::Scene&)> update;
-};
-
-struct FrameOutput {
-    std::vector<glm::vec4> resolved;
-    std::vector<glm::vec2> motion;
-    std::vector<float> length;
-};
-
-// Each run has a device of its own: the 1.3.239 layer's synchronization
-// validation cannot see the host waits between independent executors, and
-// takes memory reused across them for a race.
-std::vector<FrameOutput> runTemporal(scene::Scene& scene, const std::vector<FrameInput>& frames,
-                                     const passes::TemporalSettings& settings = {}) {
-    test::GpuTest gpu;
-    auto& ctx = gpu.ctx();
-    rg::Executor executor(ctx, 2);
-    passes::GBufferRenderer renderer(ctx, scene);
-    passes::TemporalPipelines pipelines(ctx);
-    Staging staging(ctx);
-    std::vector<std::array<const gpu::Buffer*, 3>> readbacks;
-    for (size_t f = 0; f < frames.size(); ++f) {
-        const FrameInput& in = frames[f];
-        if (in.update) in.update(scene);
-        rg::Graph graph(executor.queueCaps());
-        rg::FrameResources resources;
-        const passes::GBufferOutputs gbuf = passes::addGBufferPass(graph, renderer, {in.camera});
-        const rg::Texture radiance = uploadTexture(graph, resources, staging, "test.radiance",
-                                                   VK_FORMAT_R32G32B32A32_SFLOAT, in.radiance.data());
-        const rg::Texture hit =
-            uploadTexture(graph, resources, staging, "test.hit", VK_FORMAT_R32_SFLOAT, in.hitDistance.data());
-        passes::TemporalInputs inputs{gbuf, radiance, hit, in.camera, uint64_t(f), in.reset};
-        inputs.sharedRayRoughness = in.sharedRayRoughness;
-        inputs.environmentRoughness = in.environmentRoughness;
-        inputs.debugOutputs = in.debugOutputs;
-        const passes::TemporalOutputs out = passes::addTemporalPass(graph, pipelines, inputs, settings);
-        REQUIRE(out.width == kSize);
-        REQUIRE(out.reflectionMotion.valid() == in.debugOutputs);
-        REQUIRE(out.historyLength.valid() == in.debugOutputs);
-        readbacks.push_back(
-            {&readTexture(graph, resources, staging, out.resolved, passes::kTemporalResolvedFormat, "resolved"),
-             in.debugOutputs ? &readTexture(graph, resources, staging, out.reflectionMotion,
-                                            passes::kTemporalMotionFormat, "motion")
-                             : nullptr,
-             in.debugOutputs ? &readTexture(graph, resources, staging, out.historyLength,
-                                            passes::kTemporalHistoryLengthFormat, "length")
-                             : nullptr});
-        const rg::Plan plan = graph.compile(executor.compileOptions());
-        const auto report = rg::verify(plan);
-        REQUIRE_MESSAGE(report.ok(), report.text());
-        executor.run(plan, resources);
-    }
-    executor.waitIdle();
-    std::vector<FrameOutput> outputs;
-    for (const auto& r : readbacks) {
-        FrameOutput o;
-        o.resolved = halves(*r[0], 4);
-        if (r[1]) {
-            for (const glm::vec4& m : halves(*r[1], 2)) o.motion.emplace_back(m.x, m.y);
-            for (const glm::vec4& l : halves(*r[2], 1)) o.length.push_back(l.x);
-        }
-        outputs.push_back(std::move(o));
-    }
-    return outputs;
-}
-
-// A smooth mean per pixel (so neighbourhoods are nearly flat) and uniform
-// noise of +-amplitude per channel, new every frame, from a fixed seed.
-glm::vec4 meanRadiance(uint32_t x, uint32_t y) {
-    return {0.4f + 0.4f * float(x) / kSize, 0.5f, 0.9f - 0.4f * float(y) / kSize, 1.0f};
-}
-
-std::vector<FrameInput> noisyFrames(uint32_t count, float amplitude, uint32_t seed = 7) {
-    std::mt19937 rng(seed);
-    std::uniform_real_distribution<float> noise(-amplitude, amplitude);
-    std::vector<FrameInput> frames(count);
-    for (FrameInput& f : frames) {
-        for (uint32_t y = 0; y < kSize; ++y) {
-            for (uint32_t x = 0; x < kSize; ++x) {
-                const glm::vec4 m = meanRadiance(x, y);
-                f.radiance[at(x, y)] = {m.x + noise(rng), m.y + noise(rng), m.z + noise(rng), 1.0f};
-            }
-        }
-    }
-    return frames;
-}
-
-// Root-mean-square error of rgb against the mean over the image.
-float rmsError(const std::vector<glm::vec4>& image) {
-    double sum = 0.0;
-    for (uint32_t y = 0; y < kSize; ++y) {
-        for (uint32_t x = 0; x < kSize; ++x) {
-            const glm::vec3 d = glm::vec3(image[at(x, y)]) - glm::vec3(meanRadiance(x, y));
-            sum += glm::dot(d, d) / 3.0;
-        }
-    }
-    return float(std::sqrt(sum / kPixels));
-}
-
-// Two frames whose camera steps `step` to the right, still facing the wall.
-std::vector<FrameInput> cameraStepFrames(float step) {
-    std::vector<FrameInput> frames(2);
-    scene::Camera camera = testCamera();
-    frames[0].camera = camera;
-    camera.advance({{step, 0, 0}, {step, 0, -1}, {0, 1, 0}}, 1);
-    frames[1].camera = camera;
-    return frames;
-}
-
-} // namespace
 
 // ---------------------------------------------------------------- temporal
 
@@ -231,161 +92,6 @@ TEST_CASE("a long history follows a small change of radiance instead of stalling
     mean /= double(kPixels);
     MESSAGE("mean " << mean << ", exact average " << expected);
     CHECK(std::abs(mean - expected) < 0.002);
-}
-
-TEST_CASE("the spatial filter smooths a rough reflection in its first frame and leaves a mirror alone") {
-    const std::vector<FrameInput> frames = noisyFrames(1, 0.3f);
-    const float single = rmsError(frames[0].radiance);
-    scene::Scene rough = wallScene(material(0.5f, 1.0f));
-    const std::vector<FrameOutput> blurred = runTemporal(rough, frames);
-    scene::Scene mirror = wallScene(material(0.0f, 1.0f));
-    const std::vector<FrameOutput> sharp = runTemporal(mirror, frames);
-    MESSAGE("rms: input " << single << ", rough " << rmsError(blurred[0].resolved) << ", mirror "
-                          << rmsError(sharp[0].resolved));
-    // A 5x5 Gaussian of sigma 1.5 averages ~20 pixels' worth of noise.
-    CHECK(rmsError(blurred[0].resolved) < 0.4f * single);
-    for (size_t i = 0; i < kPixels; ++i) {
-        const glm::vec3 d = glm::vec3(sharp[0].resolved[i]) - glm::vec3(frames[0].radiance[i]);
-        REQUIRE(glm::length(d) < 2e-3f);  // half-float rounding
-    }
-}
-
-// The left half of a rough wall marked noise-free (a cone trace's hits,
-// glint/integrate_shared.h's kReflectsNoiseFree): with
-// spatialNoiseFreeRadius 0 (the default) those pixels resolve to their own
-// radiance, the right half is filtered as before; at the filter's own
-// radius both halves are.
-TEST_CASE("the spatial filter leaves noise-free pixels alone where told to, and filters the rest") {
-    std::vector<FrameInput> frames = noisyFrames(1, 0.3f, 5);
-    const auto marked = [](uint32_t x) { return x < kSize / 2; };
-    for (uint32_t y = 0; y < kSize; ++y) {
-        for (uint32_t x = 0; x < kSize; ++x) {
-            frames[0].radiance[at(x, y)].a = marked(x) ? shader::kReflectsNoiseFree : shader::kReflects;
-        }
-    }
-    scene::Scene rough = wallScene(material(0.5f, 1.0f));
-    passes::TemporalSettings skipping;
-    skipping.spatialNoiseFreeRadius = 0;
-    passes::TemporalSettings filtering;
-    filtering.spatialNoiseFreeRadius = filtering.spatialRadius;
-    const std::vector<FrameOutput> skipped = runTemporal(rough, frames, skipping);
-    const std::vector<FrameOutput> filtered = runTemporal(rough, frames, filtering);
-    // Each half's rms against the mean, and the largest change from the input.
-    const auto halfStats = [&](const std::vector<glm::vec4>& image, bool left) {
-        double sum = 0.0, count = 0.0;
-        float largest = 0.0f;
-        for (uint32_t y = 0; y < kSize; ++y) {
-            for (uint32_t x = 0; x < kSize; ++x) {
-                if (marked(x) != left) continue;
-                const glm::vec3 d = glm::vec3(image[at(x, y)]) - glm::vec3(meanRadiance(x, y));
-                sum += glm::dot(d, d) / 3.0;
-                count += 1.0;
-                largest = std::max(largest, glm::length(glm::vec3(image[at(x, y)]) -
-                                                        glm::vec3(frames[0].radiance[at(x, y)])));
-            }
-        }
-        return std::pair{float(std::sqrt(sum / count)), largest};
-    };
-    const float inputRms = halfStats(frames[0].radiance, true).first;
-    const auto [skippedLeft, skippedLeftChange] = halfStats(skipped[0].resolved, true);
-    const auto [skippedRight, skippedRightChange] = halfStats(skipped[0].resolved, false);
-    const auto [filteredLeft, filteredLeftChange] = halfStats(filtered[0].resolved, true);
-    MESSAGE("rms: input " << inputRms << ", skipping: left " << skippedLeft << " right " << skippedRight
-                          << ", filtering all: left " << filteredLeft);
-    CHECK(skippedLeftChange < 2e-3f);  // half-float rounding
-    CHECK(skippedRight < 0.4f * inputRms);
-    CHECK(filteredLeft < 0.4f * inputRms);
-    CHECK(filteredLeftChange > 0.1f);
-    // The right half's filter still takes the marked pixels as taps: the
-    // same image there either way.
-    for (uint32_t y = 0; y < kSize; ++y) {
-        for (uint32_t x = kSize / 2; x < kSize; ++x) {
-            REQUIRE(skipped[0].resolved[at(x, y)] == filtered[0].resolved[at(x, y)]);
-        }
-    }
-}
-
-// On a flat wall of one roughness every tap's plane, normal and roughness
-// weights are 1, so the filter is the Gaussian of its radius (sigma
-// 0.5 radius + 0.5) over the window's taps inside the image, the centre
-// weighing 1, and taps beyond the image's edge weigh nothing.
-TEST_CASE("on a flat rough wall the spatial filter is its radius's Gaussian at every radius, up to the image's edge") {
-    const std::vector<FrameInput> frames = noisyFrames(1, 0.3f, 11);
-    scene::Scene rough = wallScene(material(0.5f, 1.0f));
-    for (uint32_t radius = 1; radius <= shader::kTemporalMaxSpatialRadius; ++radius) {
-        passes::TemporalSettings settings;
-        settings.spatialRadius = radius;
-        const std::vector<FrameOutput> out = runTemporal(rough, frames, settings);
-        const int r = int(radius);
-        const double sigma = 0.5 * radius + 0.5;
-        float worst = 0.0f;
-        for (int y = 0; y < int(kSize); ++y) {
-            for (int x = 0; x < int(kSize); ++x) {
-                glm::dvec3 sum(frames[0].radiance[at(x, y)]);
-                double weightSum = 1.0;
-                for (int dy = -r; dy <= r; ++dy) {
-                    for (int dx = -r; dx <= r; ++dx) {
-                        const int qx = x + dx, qy = y + dy;
-                        if ((dx == 0 && dy == 0) || qx < 0 || qy < 0 || qx >= int(kSize) || qy >= int(kSize)) {
-                            continue;
-                        }
-                        const double w = std::exp(-double(dx * dx + dy * dy) / (2.0 * sigma * sigma));
-                        sum += w * glm::dvec3(frames[0].radiance[at(qx, qy)]);
-                        weightSum += w;
-                    }
-                }
-                const glm::vec3 expected(sum / weightSum);
-                const float e = glm::length(glm::vec3(out[0].resolved[at(x, y)]) - expected);
-                worst = std::max(worst, e);
-            }
-        }
-        MESSAGE("radius " << radius << ": largest difference from the Gaussian " << worst);
-        // Half floats, normals and the plane distance put the weights a hair
-        // below 1: 0.003-0.01 on lavapipe. Against the Gaussian of another
-        // radius the same images are 0.09-0.16 off; a shader that counted
-        // the clamped taps beyond the edge was 0.07-0.11 off, one that
-        // filtered the default radius with a window of 1, 0.14.
-        CHECK(worst < 0.02f);
-    }
-}
-
-// The filter's plane weight on surfaces that are not square to the view: a
-// wall turned 30 degrees away (its depth changes across every pixel) is
-// one plane and blurs as the facing wall does; across a step between two
-// parallel walls a unit apart, no tap weighs anything.
-TEST_CASE("the spatial filter blurs along a slanted wall and not across a depth step") {
-    const std::vector<FrameInput> noisy = noisyFrames(1, 0.3f);
-    const float single = rmsError(noisy[0].radiance);
-    const glm::vec3 along = glm::normalize(glm::vec3(0.866f, 0.0f, -0.5f));
-    scene::Scene slanted = makeScene({square({0, 0, -kWallDistance}, along, {0, 1, 0}, 50.0f, 0)},
-                                     {material(0.5f, 1.0f)});
-    const std::vector<FrameOutput> blurred = runTemporal(slanted, noisy);
-    MESSAGE("rms: input " << single << ", slanted " << rmsError(blurred[0].resolved));
-    // As the facing wall (0.23 of the input's): a plane distance off by a
-    // pixel's depth step weighs the taps across the slope down (0.36).
-    CHECK(rmsError(blurred[0].resolved) < 0.3f * single);
-
-    // Left of the image's centre column the wall at kWallDistance, right of
-    // it one a unit behind; each reflects a flat radiance of its own.
-    scene::Scene step = makeScene({square({-25, 0, -kWallDistance}, {1, 0, 0}, {0, 1, 0}, 25.0f, 0),
-                                   square({25, 0, -kWallDistance - 1.0f}, {1, 0, 0}, {0, 1, 0}, 25.0f, 0)},
-                                  {material(0.5f, 1.0f)});
-    const glm::vec4 nearRadiance(0.2f, 0.3f, 0.4f, 1.0f), farRadiance(0.9f, 0.7f, 0.5f, 1.0f);
-    std::vector<FrameInput> halves(1);
-    for (uint32_t y = 0; y < kSize; ++y) {
-        for (uint32_t x = 0; x < kSize; ++x) {
-            halves[0].radiance[at(x, y)] = x < kSize / 2 ? nearRadiance : farRadiance;
-        }
-    }
-    const std::vector<FrameOutput> edge = runTemporal(step, halves);
-    for (uint32_t y = 2; y + 2 < kSize; ++y) {
-        for (uint32_t x = kSize / 2 - 2; x < kSize / 2 + 2; ++x) {
-            const glm::vec3 expected(x < kSize / 2 ? nearRadiance : farRadiance);
-            const glm::vec3 d = glm::vec3(edge[0].resolved[at(x, y)]) - expected;
-            INFO("pixel " << x << "," << y);
-            REQUIRE(glm::length(d) < 2e-3f);  // half-float rounding
-        }
-    }
 }
 
 TEST_CASE("NaN, Inf and 1e30 injected in one frame leave every later frame finite and bounded") {
