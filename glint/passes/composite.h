@@ -109,7 +109,9 @@ CompositeOutputs addCompositePass(rg::Graph& graph, CompositePipelines& pipeline
                                   const CompositeSettings& settings = {});
 
 // Declares a debug view of `source` (a 2D texture of one layer; mip 0 of one with mips;
-// its first width x height texels are shown) on the graphics queue.
+// its first width x height texels are shown, or, of a source half that size (each side
+// halved and rounded down, as mip 1 of it would be: the SSLR pyramid), every texel as
+// 2x2 pixels) on the graphics queue.
 // Signed-integer and stencil sources are refused.
 CompositeOutputs addDebugViewPass(rg::Graph& graph, CompositePipelines& pipelines, rg::Texture source, uint32_t width,
                                   uint32_t height, const DebugViewSettings& settings = {});

@@ -84,30 +84,34 @@ SslrOutputs addSslrPass(rg::Graph& graph, SslrPipelines& pipelines, const SslrIn
     }
     const auto [radiance, confidence, hit] = outputs;
 
-    // The cone trace's colour pyramid (glint/sslr_shared.h): two passes,
-    // each five levels, dispatched from the SSLR list's args, which give
-    // them no groups unless ray generation listed a ray that cone-traces.
-    uint32_t pyramidMips = 0;
+    // The cone trace's colour pyramid (glint/sslr_shared.h): the lit
+    // colour's mip chain from level 1 on, its mip m - 1 the chain's level m;
+    // two passes, each five levels, dispatched from the SSLR list's args,
+    // which give them no groups unless ray generation listed a ray that
+    // cone-traces.
+    uint32_t pyramidMips = 0;  // the chain's levels, the lit colour (level 0) included
     rg::Texture pyramid;
     if (settings.coneTrace) {
         pyramidMips = std::min(shader::kSslrPyramidMaxMips, uint32_t(std::bit_width(std::max(gbuf.width, gbuf.height))));
-        pyramid = graph.createTexture("sslr.lit_pyramid", {.width = gbuf.width,
-                                                            .height = gbuf.height,
-                                                            .mips = pyramidMips,
-                                                            .format = kSslrRadianceFormat});
+    }
+    if (pyramidMips > 1) {
         const glm::uvec2 size{gbuf.width, gbuf.height};
+        const glm::uvec2 base = shader::sslrMipSize(size, 1);
+        pyramid = graph.createTexture("sslr.lit_pyramid", {.width = base.x,
+                                                            .height = base.y,
+                                                            .mips = pyramidMips - 1,
+                                                            .format = kSslrRadianceFormat});
         for (uint32_t pass = 0; pass < 2; ++pass) {
-            // Pass 0 writes levels 0-5 (the copy and five means), pass 1 the
-            // levels from 6 on, from level 5.
-            const uint32_t first = pass == 0 ? 0 : shader::kSslrPyramidLevelsPerPass + 1;
-            const uint32_t end = std::min(pyramidMips, pass == 0 ? shader::kSslrPyramidOutputs
-                                                                 : first + shader::kSslrPyramidLevelsPerPass);
+            // Pass 0 writes levels 1-5 from the lit colour, pass 1 the levels
+            // from 6 on from level 5; `first` and `end` are the image's mips.
+            const uint32_t first = pass * shader::kSslrPyramidLevelsPerPass;
+            const uint32_t end = std::min(pyramidMips - 1, first + shader::kSslrPyramidLevelsPerPass);
             if (first >= end) break;
             shader::SslrPyramidConstants constants{};
-            constants.sourceSize = shader::sslrMipSize(size, pass * shader::kSslrPyramidLevelsPerPass);
+            constants.sourceSize = shader::sslrMipSize(size, first);
             constants.outputs = end - first;
             for (uint32_t o = 0; o < constants.outputs; ++o) {
-                constants.outputSize[o] = shader::sslrMipSize(size, first + o);
+                constants.outputSize[o] = shader::sslrMipSize(size, first + 1 + o);
             }
             struct PyramidData {
                 rg::Texture source, pyramid;
@@ -120,15 +124,15 @@ SslrOutputs addSslrPass(rg::Graph& graph, SslrPipelines& pipelines, const SslrIn
                 [&](rg::Builder& b, PyramidData& d) {
                     d.args = b.read(rays.sslrArgs, rg::Access::IndirectArgs);
                     d.fromLit = pass == 0;
-                    // Level 5 is read and the levels below it written through
-                    // the handle the read returns (the graph orders both by
-                    // subresource).
+                    // Level 5 (the image's mip 4) is read and the levels below
+                    // it written through the handle the read returns (the
+                    // graph orders both by subresource).
                     rg::Texture target = pyramid;
                     if (d.fromLit) {
                         d.source = b.read(gbuf.lit, rg::Access::SampledRead);
                     } else {
                         d.source = target = b.read(pyramid, rg::Access::StorageRead,
-                                                   rg::Subresource::mip(shader::kSslrPyramidLevelsPerPass));
+                                                   rg::Subresource::mip(shader::kSslrPyramidLevelsPerPass - 1));
                     }
                     d.pyramid = b.write(target, rg::Access::StorageWrite,
                                         rg::Subresource{first, end - first, 0, rg::Subresource::kAll});
@@ -146,10 +150,10 @@ SslrOutputs addSslrPass(rg::Graph& graph, SslrPipelines& pipelines, const SslrIn
                         push.sampledImage("source", pc.view(d.source), pipelines.nearest_.handle(),
                                           pc.layout(d.source));
                     } else {
-                        push.storageImage("source", image.mipView(shader::kSslrPyramidLevelsPerPass));
+                        push.storageImage("source", image.mipView(shader::kSslrPyramidLevelsPerPass - 1));
                     }
                     // Outputs past the levels written repeat the last one (never stored to).
-                    for (uint32_t o = 0; o < shader::kSslrPyramidOutputs; ++o) {
+                    for (uint32_t o = 0; o < shader::kSslrPyramidLevelsPerPass; ++o) {
                         push.storageImage("output" + std::to_string(o),
                                           image.mipView(d.first + std::min(o, d.outputs - 1)));
                     }

@@ -1,6 +1,7 @@
 // The debug view (passes/composite.h): any texture to the composite's
 // RGBA8 sRGB-encoded output. The stage files declare the source binding
-// (float or unsigned integer sampler) and fetchSource(), then include this.
+// (sourceTexture, a float or unsigned integer sampler) and fetchSource(),
+// then include this.
 #ifndef GLINT_DEBUG_VIEW_GLSL
 #define GLINT_DEBUG_VIEW_GLSL
 
@@ -36,7 +37,9 @@ void main() {
     if (p.x >= int(pc.size.x) || p.y >= int(pc.size.y)) {
         return;
     }
-    const vec4 v = fetchSource(p);
+    // A half-size source of an odd-sized output: its last column or row
+    // shows the texel before.
+    const vec4 v = fetchSource(min(p >> int(pc.sourceShift), textureSize(sourceTexture, 0) - 1));
     vec4 encoded;
     if (pc.kind == kDebugViewScalar) {
         const float x = v.r;

@@ -7,9 +7,10 @@
 // (a one-texel-wide level halves to itself); of an odd level the last row
 // or column is left out of the level below, whose size Vulkan rounds down.
 //
-// The variant defines GLINT_PYRAMID_BASE: 1 reads the lit colour (a
-// sampler) and also copies it to output 0 (level 0); 0 reads level 5 (a
-// storage image), and outputs 0-4 are levels 6-10.
+// The variant defines GLINT_PYRAMID_BASE: 1 reads the lit colour (level 0,
+// a sampler), and outputs 0-4 are levels 1-5; 0 reads level 5 (a storage
+// image), and outputs 0-4 are levels 6-10. (The pyramid image holds level
+// m as its mip m - 1: level 0 is the lit colour itself.)
 #extension GL_EXT_scalar_block_layout : require
 
 #include "glint/sslr_shared.h"
@@ -19,18 +20,15 @@ layout(local_size_x = 16, local_size_y = 16) in;
 #if GLINT_PYRAMID_BASE
 layout(set = 0, binding = 0) uniform sampler2D source;
 vec3 load(ivec2 p) { return texelFetch(source, p, 0).rgb; }
-const uint kFirstReduced = 1u;  // output 0 is the copy of the source
 #else
 layout(set = 0, binding = 0, rgba16f) uniform readonly image2D source;
 vec3 load(ivec2 p) { return imageLoad(source, p).rgb; }
-const uint kFirstReduced = 0u;
 #endif
 layout(set = 0, binding = 1, rgba16f) uniform writeonly image2D output0;
 layout(set = 0, binding = 2, rgba16f) uniform writeonly image2D output1;
 layout(set = 0, binding = 3, rgba16f) uniform writeonly image2D output2;
 layout(set = 0, binding = 4, rgba16f) uniform writeonly image2D output3;
 layout(set = 0, binding = 5, rgba16f) uniform writeonly image2D output4;
-layout(set = 0, binding = 6, rgba16f) uniform writeonly image2D output5;
 
 layout(push_constant, scalar) uniform Constants { SslrPyramidConstants pc; };
 
@@ -47,8 +45,7 @@ void store(uint index, uvec2 texel, vec3 colour) {
         case 1u: imageStore(output1, p, value); break;
         case 2u: imageStore(output2, p, value); break;
         case 3u: imageStore(output3, p, value); break;
-        case 4u: imageStore(output4, p, value); break;
-        default: imageStore(output5, p, value); break;
+        default: imageStore(output4, p, value); break;
     }
 }
 
@@ -62,15 +59,11 @@ void main() {
     vec3 sum = vec3(0.0);
     for (int dy = 0; dy < 2; ++dy) {
         for (int dx = 0; dx < 2; ++dx) {
-            const vec3 c = load(min(corner + ivec2(dx, dy), last));
-#if GLINT_PYRAMID_BASE
-            store(0u, uvec2(corner + ivec2(dx, dy)), c);
-#endif
-            sum += c;
+            sum += load(min(corner + ivec2(dx, dy), last));
         }
     }
     vec3 colour = 0.25 * sum;
-    store(kFirstReduced, group * 16u + local, colour);
+    store(0u, group * 16u + local, colour);
     tile[local.y][local.x] = colour;
 
     // Four more in shared memory: 8, 4, 2, 1 texels a side. Children are
@@ -97,7 +90,7 @@ void main() {
         barrier();
         if (reduces) {
             tile[local.y][local.x] = colour;
-            store(kFirstReduced + step - 1u, group * side + local, colour);
+            store(step - 1u, group * side + local, colour);
         }
         parentSize = sslrMipSize(pc.sourceSize, step);
     }

@@ -30,8 +30,8 @@ layout(set = 0, binding = 7) uniform writeonly image2D hitImage;
 layout(set = 0, binding = 8, scalar) writeonly buffer RtRays { PackedRay rtRays[]; };
 layout(set = 0, binding = 9, scalar) buffer RtArgs { uint rtArgs[]; };
 layout(set = 0, binding = 10) uniform sampler2D roughnessMetalTexture;
-// The lit colour's box-filtered mip chain (pyramid_*.comp), sampled
-// trilinearly by the cone trace.
+// The lit colour's box-filtered mip chain from level 1 on (pyramid_*.comp;
+// level m is its mip m - 1), sampled trilinearly by the cone trace.
 layout(set = 0, binding = 11) uniform sampler2D pyramidTexture;
 // The SSLR list's args: its length at kRayListCountOffset.
 layout(set = 0, binding = 12, scalar) readonly buffer SslrArgs { uint sslrArgs[]; };
@@ -267,7 +267,14 @@ void main() {
             const float pixelsPerUnit = 0.5 * abs(pc.projection.y) * float(pc.size.y) / max(-hitPosition.z, 1e-6);
             const float footprint = 2.0 * 1.287 * alpha * distance * pixelsPerUnit;
             const float mip = clamp(log2(max(footprint, 1.0)), 0.0, float(pc.pyramidMips - 1u));
-            radiance = textureLod(pyramidTexture, hitUv, mip).rgb;
+            // Trilinear over the chain: the pyramid holds level m as its
+            // mip m - 1; between levels 0 and 1 the lit texel (the hit's
+            // centre: level 0's bilinear there) blends with level 1.
+            if (mip >= 1.0) {
+                radiance = textureLod(pyramidTexture, hitUv, mip - 1.0).rgb;
+            } else if (mip > 0.0) {
+                radiance = mix(radiance, textureLod(pyramidTexture, hitUv, 0.0).rgb, mip);
+            }
         }
         // Back faces: the hit surface must face the ray (world normals; the
         // view matrix is a rotation and translation, so its inverse

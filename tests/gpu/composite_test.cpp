@@ -214,6 +214,7 @@ struct DebugViewJob {
     VkFormat format;
     const void* texels;
     passes::DebugViewSettings settings;
+    uint32_t side = kSize;  // the source's; the view is kSize x kSize
 };
 
 // Every job's source uploaded and shown, all in one graph.
@@ -228,7 +229,8 @@ std::vector<std::vector<glm::u8vec4>> runDebugViews(const std::vector<DebugViewJ
     std::vector<const gpu::Buffer*> colors;
     for (size_t i = 0; i < jobs.size(); ++i) {
         const std::string name = "test.source" + std::to_string(i);
-        const rg::Texture source = uploadTexture(graph, resources, staging, name, jobs[i].format, jobs[i].texels);
+        const rg::Texture source =
+            uploadTexture(graph, resources, staging, name, jobs[i].format, jobs[i].texels, jobs[i].side);
         const passes::CompositeOutputs out =
             passes::addDebugViewPass(graph, pipelines, source, kSize, kSize, jobs[i].settings);
         colors.push_back(&readTexture(graph, resources, staging, out.color, passes::kCompositeFormat,
@@ -341,6 +343,25 @@ TEST_CASE("a colour debug view tonemaps HDR values; a raw view passes display co
     }
 }
 
+TEST_CASE("a source of half the view's size shows each texel as 2x2 pixels") {
+    // As the SSLR pyramid's first level (half the lit colour's size) shows.
+    constexpr uint32_t kHalf = kSize / 2;
+    std::vector<glm::u8vec4> texels(size_t(kHalf) * kHalf);
+    for (size_t i = 0; i < texels.size(); ++i) {
+        texels[i] = glm::u8vec4(uint8_t(i * 7), uint8_t(255 - i), uint8_t(i / 16), 255);
+    }
+    passes::DebugViewSettings raw;
+    raw.kind = passes::DebugViewKind::Raw;
+    const std::vector<glm::u8vec4> out = runDebugViews({{VK_FORMAT_R8G8B8A8_UNORM, texels.data(), raw, kHalf}}).front();
+    for (uint32_t y = 0; y < kSize; ++y) {
+        for (uint32_t x = 0; x < kSize; ++x) {
+            INFO("pixel " << x << ", " << y);
+            const glm::u8vec4 t = texels[size_t(y / 2) * kHalf + x / 2];
+            REQUIRE(near(out[at(x, y)], glm::ivec3(t.r, t.g, t.b), 0));
+        }
+    }
+}
+
 TEST_CASE("the G-buffer's depth shows through the scalar view") {
     test::GpuTest gpu;
     auto& ctx = gpu.ctx();
@@ -381,6 +402,11 @@ TEST_CASE("a debug view refuses sources it cannot show, naming them") {
                                                             .format = VK_FORMAT_R32_SFLOAT});
     CHECK_THROWS_WITH_AS(passes::addDebugViewPass(graph, pipelines, small, kSize, kSize),
                          doctest::Contains("small"), gpu::GpuError);
+    // Half the view's size on one side only is neither.
+    const rg::Texture narrow = graph.createTexture("narrow", {.width = kSize / 2, .height = kSize,
+                                                              .format = VK_FORMAT_R32_SFLOAT});
+    CHECK_THROWS_WITH_AS(passes::addDebugViewPass(graph, pipelines, narrow, kSize, kSize),
+                         doctest::Contains("narrow"), gpu::GpuError);
     rg::Graph other;
     CHECK_THROWS_AS(passes::addDebugViewPass(other, pipelines, small, 4, 4), gpu::GpuError);
 }

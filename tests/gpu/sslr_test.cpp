@@ -491,8 +491,9 @@ TEST_CASE("rough pixels cone-trace: their reflection of thin stripes is the stri
 
 namespace {
 
-// The colour pyramid of one frame, every level read back, with the lit
-// colour it was built from and the SSLR list's args.
+// The colour pyramid of one frame, every level read back (levels[m] the
+// chain's level m + 1: the image's mip m), with the lit colour it was
+// built from and the SSLR list's args.
 struct PyramidFrame {
     glm::uvec2 size{0};
     std::vector<glm::vec4> lit;
@@ -524,10 +525,12 @@ PyramidFrame buildPyramid(test::GpuTest& gpu, const scene::Scene& scene, glm::uv
 
     PyramidFrame out;
     out.size = size;
-    const uint32_t mips = std::min(shader::kSslrPyramidMaxMips, uint32_t(std::bit_width(std::max(size.x, size.y))));
+    // The image's mips: the chain's levels but level 0, the lit colour.
+    const uint32_t mips =
+        std::min(shader::kSslrPyramidMaxMips, uint32_t(std::bit_width(std::max(size.x, size.y)))) - 1;
     uint64_t texels = 0;
     for (uint32_t m = 0; m < mips; ++m) {
-        const glm::uvec2 s = shader::sslrMipSize(size, m);
+        const glm::uvec2 s = shader::sslrMipSize(size, m + 1);
         texels += uint64_t(s.x) * s.y;
     }
     const uint64_t pixels = uint64_t(size.x) * size.y;
@@ -559,7 +562,7 @@ PyramidFrame buildPyramid(test::GpuTest& gpu, const scene::Scene& scene, glm::uv
             std::vector<VkBufferImageCopy> regions;
             VkDeviceSize offset = 0;
             for (uint32_t m = 0; m < mips; ++m) {
-                const glm::uvec2 s = shader::sslrMipSize(size, m);
+                const glm::uvec2 s = shader::sslrMipSize(size, m + 1);
                 VkBufferImageCopy region{};
                 region.bufferOffset = offset;
                 region.imageSubresource = {VK_IMAGE_ASPECT_COLOR_BIT, m, 0, 1};
@@ -595,7 +598,7 @@ PyramidFrame buildPyramid(test::GpuTest& gpu, const scene::Scene& scene, glm::uv
     out.lit = unpack(lit, 0, pixels);
     uint64_t first = 0;
     for (uint32_t m = 0; m < mips; ++m) {
-        const glm::uvec2 s = shader::sslrMipSize(size, m);
+        const glm::uvec2 s = shader::sslrMipSize(size, m + 1);
         out.levels.push_back(unpack(pyramid, first, uint64_t(s.x) * s.y));
         first += uint64_t(s.x) * s.y;
     }
@@ -619,22 +622,21 @@ TEST_CASE("the cone pyramid is the lit colour's 2x2 means level by level, built 
             CHECK(command[1] == groups.y);
             CHECK(command[2] == 1u);  // open: the floor's rays cone-trace
         }
-        // The expectation on the CPU: level 0 is the lit colour; each next
-        // level's texel the mean of its 2x2 children in the level above,
-        // clamped to that level (a level one texel across halves to itself).
+        // The expectation on the CPU: level 0 is the lit colour (not in the
+        // pyramid, which starts at level 1 at half size); each next level's
+        // texel the mean of its 2x2 children in the level above, clamped to
+        // that level (a level one texel across halves to itself).
+        const uint32_t chain = std::min(shader::kSslrPyramidMaxMips, uint32_t(std::bit_width(std::max(size.x, size.y))));
+        REQUIRE(f.levels.size() == chain - 1);
         std::vector<glm::vec3> above(f.lit.size());
         for (size_t i = 0; i < above.size(); ++i) above[i] = glm::vec3(f.lit[i]);
         glm::uvec2 aboveSize = size;
-        for (uint32_t m = 0; m < f.levels.size(); ++m) {
+        for (uint32_t m = 1; m <= f.levels.size(); ++m) {
             CAPTURE(m);
             const glm::uvec2 s = shader::sslrMipSize(size, m);
             std::vector<glm::vec3> expected(size_t(s.x) * s.y);
             for (uint32_t y = 0; y < s.y; ++y) {
                 for (uint32_t x = 0; x < s.x; ++x) {
-                    if (m == 0) {
-                        expected[size_t(y) * s.x + x] = above[size_t(y) * s.x + x];
-                        continue;
-                    }
                     glm::vec3 sum(0.0f);
                     for (uint32_t dy = 0; dy < 2; ++dy) {
                         for (uint32_t dx = 0; dx < 2; ++dx) {
@@ -648,11 +650,11 @@ TEST_CASE("the cone pyramid is the lit colour's 2x2 means level by level, built 
             }
             uint32_t wrong = 0;
             for (size_t i = 0; i < expected.size(); ++i) {
-                const glm::vec3 got(f.levels[m][i]);
-                // Half floats per stored level (levels 0-5 are reduced in
+                const glm::vec3 got(f.levels[m - 1][i]);
+                // Half floats per stored level (levels 1-5 are reduced in
                 // fp32 by one pass, 6 on from the stored level 5).
                 const float tolerance = 2e-3f * glm::length(expected[i]) + 1e-4f;
-                if (glm::length(got - expected[i]) > tolerance || f.levels[m][i].a != 1.0f) ++wrong;
+                if (glm::length(got - expected[i]) > tolerance || f.levels[m - 1][i].a != 1.0f) ++wrong;
             }
             CHECK(wrong == 0u);
             above = expected;

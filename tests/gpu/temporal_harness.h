@@ -52,11 +52,12 @@ private:
     std::deque<rg::HostReadback> readbacks_;
 };
 
-// A kSize x kSize texture of `format` filled from `data` by a copy inside
-// the graph.
+// A side x side texture (kSize x kSize unless told) of `format` filled from
+// `texels` by a copy inside the graph.
 inline rg::Texture uploadTexture(rg::Graph& graph, rg::FrameResources& resources, Staging& staging,
-                                 const std::string& name, VkFormat format, const void* texels) {
-    const gpu::Buffer& source = staging.upload(texels, kPixels * gpu::bytesPerTexel(format));
+                                 const std::string& name, VkFormat format, const void* texels,
+                                 uint32_t side = kSize) {
+    const gpu::Buffer& source = staging.upload(texels, size_t(side) * side * gpu::bytesPerTexel(format));
     const rg::Buffer imported = graph.importBuffer(
         name + ".staging", {{source.size()}, kHostWrite, rg::BoundaryState::of(rg::Access::TransferSrc)});
     resources.bind(imported, source);
@@ -68,13 +69,13 @@ inline rg::Texture uploadTexture(rg::Graph& graph, rg::FrameResources& resources
         "upload." + name, rg::Queue::Graphics,
         [&](rg::Builder& b, Data& data) {
             data.source = b.read(imported, rg::Access::TransferSrc);
-            data.texture = b.write(b.createTexture(name, {.width = kSize, .height = kSize, .format = format}),
+            data.texture = b.write(b.createTexture(name, {.width = side, .height = side, .format = format}),
                                    rg::Access::TransferDst);
         },
-        [](const Data& data, rg::PassContext& pc) {
+        [side](const Data& data, rg::PassContext& pc) {
             VkBufferImageCopy region{};
             region.imageSubresource = {VK_IMAGE_ASPECT_COLOR_BIT, 0, 0, 1};
-            region.imageExtent = {kSize, kSize, 1};
+            region.imageExtent = {side, side, 1};
             vkCmdCopyBufferToImage(pc.cmd(), pc.buffer(data.source).handle(), pc.image(data.texture).handle(),
                                    VK_IMAGE_LAYOUT_TRANSFER_DST_OPTIMAL, 1, &region);
         });

@@ -44,7 +44,7 @@ struct DebugViewConstants {
     float minValue;
     float maxValue;
     float exposure;
-    uint pad0;
+    uint sourceShift;  // output pixel p shows source texel p >> sourceShift (1: a half-size source)
 };
 
 GLINT_END

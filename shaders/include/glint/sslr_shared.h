@@ -9,7 +9,7 @@
 // SSLR and hybrid pixels:
 //   radiance    lit colour at the hit, rgb; a: 0 no hit, kSslrHitRay (1) a
 //               hit of the pixel's own (stochastic) ray, kSslrHitCone (2) a
-//               cone trace's hit: the lobe's mean from the colour pyramid,
+//               cone trace's hit: the lobe's mean from the lit colour's mip chain,
 //               without the ray's noise
 //   confidence  [0, 1]: 0 for misses (off screen, sky, too thick, back face)
 //   hit         xy = uv of the hit texel's centre (float32: exact at any size)
@@ -43,7 +43,7 @@ struct SslrConstants {
     float maxDistance;
     float edgeFade;
     float confidenceThreshold;  // as stored (passes::sslrStoredThreshold); hybrid rays below it go on to RT
-    uint pyramidMips;           // levels of the colour pyramid; 0: no cone trace
+    uint pyramidMips;           // levels of the lit colour's mip chain (below); 0: no cone trace
     float minStepPixels;        // SslrSettings::minStepPixels
     uint blueNoise;             // 1: start offsets from the blue noise (ray generation's choice)
 };
@@ -59,22 +59,25 @@ GLINT_FUNC bool sslrHitIsCone(float a) { return a > 0.5f * (kSslrHitRay + kSslrH
 // footprints belong to pixels rougher than the cutoff, which trace nothing.
 GLINT_CONST uint kSslrPyramidMaxMips = 8u;
 
-// The colour pyramid is built by two passes of pyramid.glsl, each a 16 x 16
-// workgroup per 32 x 32 texels of its source level that writes the five
-// levels below it (2x2 means, reduced in shared memory): the first reads
-// the lit colour and also writes it as level 0 (levels 0-5), the second
-// reads level 5 (levels 6 and 7). Both are dispatched indirectly from the
-// SSLR list's args (glint/ray_generation_shared.h, kSslrArgsPyramidOffset),
-// whose z is 0, so no group runs, unless ray generation listed a ray that
+// The colour pyramid is the lit colour's mip chain without its level 0
+// (the lit colour itself, which the cone trace reads from the G-buffer):
+// an image of half the lit colour's size whose mip k is the chain's level
+// k + 1, a 2^(k+1) box filter. SslrConstants::pyramidMips counts the
+// chain's levels, level 0 included. It is built by two passes of
+// pyramid.glsl, each a 16 x 16 workgroup per 32 x 32 texels of its source
+// level that writes the five levels below it (2x2 means, reduced in shared
+// memory): the first reads the lit colour (levels 1-5), the second level 5
+// (levels 6 and 7). Both are dispatched indirectly from the SSLR list's
+// args (glint/ray_generation_shared.h, kSslrArgsPyramidOffset), whose z is
+// 0, so no group runs, unless ray generation listed a ray that
 // cone-traces.
 GLINT_CONST uint kSslrPyramidGroupTexels = 32u;
 GLINT_CONST uint kSslrPyramidLevelsPerPass = 5u;
-GLINT_CONST uint kSslrPyramidOutputs = 6u;  // the first pass's level 0 and five reductions
 
-// Push constants of pyramid_base.comp and pyramid_down.comp (64 bytes).
+// Push constants of pyramid_base.comp and pyramid_down.comp.
 struct SslrPyramidConstants {
-    uvec2 sourceSize;    // texels of the level read
-    uvec2 outputSize[6];  // texels of each written level, in binding order
+    uvec2 sourceSize;     // texels of the level read
+    uvec2 outputSize[5];  // texels of each written level (kSslrPyramidLevelsPerPass), in binding order
     uint outputs;         // levels written (the rest of the bindings are stand-ins)
     uint pad0;
 };
@@ -107,7 +110,7 @@ GLINT_END
 
 #ifdef __cplusplus
 static_assert(sizeof(glint::shader::SslrConstants) == 128);
-static_assert(sizeof(glint::shader::SslrPyramidConstants) == 64);
+static_assert(sizeof(glint::shader::SslrPyramidConstants) == 56);
 #endif
 
 #endif
