@@ -139,15 +139,19 @@ struct TemporalSettings {
     // roughness (0.1).
     float surfaceMotionRoughnessStart = 0.1f;
     float surfaceMotionRoughnessEnd = 0.3f;
-    // Between those roughnesses the history is looked up at both motions
-    // and the two histories blended (each a bilinear lookup of four taps,
-    // two texels a tap). On: one lookup, at the blended motion, and the
-    // surface's motion alone where that finds nothing (a disocclusion):
-    // half the history's reads there. Off by default: on lavapipe
-    // (city:64, 192x108, glint-bench --motion) it is as accurate (FLIP in
-    // motion 0.42015 -> 0.42005, still 0.41410 -> 0.41411, flicker +0.1%),
-    // but it has not been timed on NVIDIA, where its reads are the point.
-    bool oneHistoryCandidate = false;
+    // On: every pixel looks its history up once, at the blended motion (the
+    // reflected point's for a mirror, the surface's from the end roughness
+    // on), and at the surface's motion alone where that finds nothing (a
+    // disocclusion). Off: between those roughnesses the history is looked
+    // up at both motions and the two histories blended (each a bilinear
+    // lookup of four taps, two texels a tap): twice the reads there, and
+    // warps that hold glossy pixels beside others run both ways. On an H100
+    // at 1080p the accumulation 0.1141 -> 0.1002 ms in the city, 0.0916 ->
+    // 0.0865 on the plaza, for FLIP +0.09% on the plaza (hybrid 0.060277 ->
+    // 0.060331), +0.003% in the city's hybrid, +0.9% in its rt; in motion
+    // +0.02-0.03%, flicker unchanged
+    // (docs/results/log/08-2026-12-07-thirteenth.md).
+    bool oneHistoryCandidate = true;
     // Radiance is clamped to [0, maxRadiance] before it is accumulated: the
     // largest half float, so neither the RGBA16F history nor the resolved
     // image overflows to Inf.

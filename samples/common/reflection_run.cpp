@@ -101,9 +101,9 @@ const std::array<ParameterSlot, 33> kParameters = {{
     {{"spatial_noise_free_radius", "TemporalSettings::spatialNoiseFreeRadius", 0.0f, 4.0f, true, {1, 2}, {},
       kScreenSpace},
      nullptr, [](ReflectionRunOptions& o) { return &o.frame.temporal.spatialNoiseFreeRadius; }},
-    // Glossy pixels look their history up once, at the blended motion,
-    // instead of at the reflected point's and the surface's (default off).
-    {{"one_history_candidate", "TemporalSettings::oneHistoryCandidate (0 or 1)", 0.0f, 1.0f, true, {1}, {},
+    // Glossy pixels look their history up once, at the blended motion (on
+    // by default); 0 at the reflected point's and the surface's, blended.
+    {{"one_history_candidate", "TemporalSettings::oneHistoryCandidate (0 or 1)", 0.0f, 1.0f, true, {0}, {},
       kEveryMode},
      nullptr, nullptr, [](ReflectionRunOptions& o) { return &o.frame.temporal.oneHistoryCandidate; }},
     // Pixels nearer than this go straight to RT (default 3 world units): 0

@@ -323,17 +323,22 @@ void main() {
         virtualValid ? ramp(px.roughness, frame.surfaceMotionRoughnessStart, frame.surfaceMotionRoughnessEnd) : 1.0;
     const vec2 reflectionMotion = mix(virtualMotion, surfaceMotion, surfaceWeight);
 
-    // 2. History at both candidates, blended by roughness; either one alone
-    // where the other is rejected. With frame.oneHistoryCandidate, where
-    // both would be read: one lookup at the blended motion, the surface's
-    // where that finds nothing.
+    // 2. History at the blended motion, the surface's where that finds
+    // nothing (frame.oneHistoryCandidate, the default); without it, at both
+    // candidates blended by roughness, either one alone where the other is
+    // rejected.
     vec3 history = vec3(0.0);
     float historyLength = 0.0;
     bool hasHistory = false;
-    if (frame.resetHistory == 0u && frame.oneHistoryCandidate != 0u && surfaceWeight > 0.0 && surfaceWeight < 1.0) {
+    if (frame.resetHistory == 0u && frame.oneHistoryCandidate != 0u) {
+        // Every pixel the same way (no warp runs both branches): the
+        // blended motion is the virtual point's for a mirror and the
+        // surface's for a rough pixel, so only glossy pixels read less.
         float blendedLength = 0.0;
-        hasHistory = sampleHistory(centre + reflectionMotion, px, history, blendedLength) ||
-                     sampleHistory(centre + surfaceMotion, px, history, blendedLength);
+        hasHistory = sampleHistory(centre + reflectionMotion, px, history, blendedLength);
+        if (!hasHistory && distance(reflectionMotion, surfaceMotion) >= 1e-3) {
+            hasHistory = sampleHistory(centre + surfaceMotion, px, history, blendedLength);
+        }
         historyLength = hasHistory ? max(floor(blendedLength + 0.5), 1.0) : 0.0;
     } else if (frame.resetHistory == 0u) {
         vec3 virtualHistory = vec3(0.0), surfaceHistoryRadiance = vec3(0.0);
