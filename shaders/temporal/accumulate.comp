@@ -9,11 +9,14 @@
 //      virtual point is the mirror image of where it was. Rough
 //      reflections are blurry and follow the surface instead: the two
 //      motions blend by roughness;
-//   2. history at each candidate, bilinear over four taps, each tap kept
-//      only if last frame's surface there lies on this pixel's plane with a
-//      similar normal and roughness (disocclusion and history rejection;
-//      not where the pixel reflects the environment alone, whose radiance
-//      has no noise and follows the normal: the clip box bounds its ghost);
+//   2. history at the blended motion (at the surface's where that finds
+//      nothing; with TemporalSettings::oneHistoryCandidate off, at both
+//      motions, the two histories blended), bilinear over four taps, each
+//      tap kept only if last frame's surface there lies on this pixel's
+//      plane with a similar normal and roughness (disocclusion and history
+//      rejection; not where the pixel reflects the environment alone, whose
+//      radiance has no noise and follows the normal: the clip box bounds
+//      its ghost);
 //   3. sanitise this frame's radiance: NaN and Inf are dropped (the pixel
 //      takes its neighbours' mean), the rest is clamped to [0, maxRadiance]
 //      so nothing a half float cannot hold reaches the history;

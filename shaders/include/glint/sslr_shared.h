@@ -9,8 +9,8 @@
 // SSLR and hybrid pixels:
 //   radiance    lit colour at the hit, rgb; a: 0 no hit, kSslrHitRay (1) a
 //               hit of the pixel's own (stochastic) ray, kSslrHitCone (2) a
-//               cone trace's hit: the lobe's mean from the lit colour's mip chain,
-//               without the ray's noise
+//               cone trace's hit: the lobe's mean from the lit colour's mip
+//               chain, without the ray's noise
 //   confidence  [0, 1]: 0 for misses (off screen, sky, too thick, back face)
 //   hit         xy = uv of the hit texel's centre (float32: exact at any size)
 // RT hand-off: each hybrid ray whose confidence is not at least the
