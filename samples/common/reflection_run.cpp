@@ -21,6 +21,7 @@
 #include <array>
 #include <cmath>
 #include <chrono>
+#include <cstdio>
 #include <cstring>
 #include <limits>
 #include <map>
@@ -283,6 +284,32 @@ double getParameter(const ReflectionRunOptions& options, std::string_view name) 
     auto& o = const_cast<ReflectionRunOptions&>(options);  // the accessors are shared with setParameter
     if (slot.boolField) return *slot.boolField(o) ? 1.0 : 0.0;
     return slot.uintField ? double(*slot.uintField(o)) : double(*slot.floatField(o));
+}
+
+std::string parameterListing() {
+    const ReflectionRunOptions defaults;
+    const auto number = [](double v) {
+        char text[32];
+        std::snprintf(text, sizeof(text), "%g", v);
+        return std::string(text);
+    };
+    std::string out;
+    char line[256];
+    std::snprintf(line, sizeof(line), "%-33s %-8s %-10s %-16s %s\n", "name", "default", "range", "bench sweeps in",
+                  "field");
+    out += line;
+    for (const ParameterSlot& slot : kParameters) {
+        const Parameter& p = slot.parameter;
+        const std::string range = number(p.min) + ".." + number(p.max);
+        std::string modes = std::string(p.sweepModes[0] ? "hybrid " : "") + (p.sweepModes[1] ? "ssr " : "") +
+                            (p.sweepModes[2] ? "rt" : "");
+        if (p.sweep.empty() || modes.empty()) modes = "-";
+        std::snprintf(line, sizeof(line), "%-33.*s %-8s %-10s %-16s %.*s\n", int(p.name.size()), p.name.data(),
+                      number(getParameter(defaults, p.name)).c_str(), range.c_str(), modes.c_str(),
+                      int(p.field.size()), p.field.data());
+        out += line;
+    }
+    return out;
 }
 
 scene::CameraPose cameraPoseAt(const scene::Scene& scene, const ReflectionRunOptions& options, uint32_t frame) {

@@ -191,6 +191,10 @@ void setParameter(ReflectionRunOptions& options, std::string_view name, std::str
 void setParameters(ReflectionRunOptions& options, std::string_view list);
 // The parameter's current value.
 double getParameter(const ReflectionRunOptions& options, std::string_view name);
+// What glint-render --list-parameters prints: a header line, then one line
+// a parameter: name, default, range, the modes the bench sweeps it in ("-":
+// not swept) and the settings field it sets.
+std::string parameterListing();
 
 // Renders options.frames frames of `scene` (which it animates).
 ReflectionRunResult runReflections(gpu::Context& ctx, scene::Scene& scene, const ReflectionRunOptions& options);

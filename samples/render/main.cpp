@@ -82,9 +82,7 @@ int main(int argc, char** argv) {
                        {{"list-debug-views", "print the debug views (name, modes, what each shows) and exit"},
                         {"list-parameters", "print the tunable parameters (--set) and exit"}});
         if (args.has("list-parameters")) {
-            for (const app::Parameter& p : app::parameters()) {
-                std::printf("%-18.*s %.*s\n", int(p.name.size()), p.name.data(), int(p.field.size()), p.field.data());
-            }
+            std::fputs(app::parameterListing().c_str(), stdout);
             return 0;
         }
         if (args.has("list-debug-views")) {
