@@ -166,8 +166,9 @@ CompositeOutputs addDebugViewPass(rg::Graph& graph, CompositePipelines& pipeline
     // Of a texture with mips (the SSLR pyramid), mip 0 is shown.
     const bool mipped = desc.mips > 1;
     // A source of half the output's size (its mip 1's) is shown at twice its size.
+    const bool magnified = width > desc.width || height > desc.height;
     const bool half = width > 1 && height > 1 && desc.width == width / 2 && desc.height == height / 2;
-    if (width == 0 || height == 0 || ((width > desc.width || height > desc.height) && !half)) {
+    if (width == 0 || height == 0 || (magnified && !half)) {
         throw gpu::GpuError("addDebugViewPass: " + std::to_string(width) + "x" + std::to_string(height) +
                             " does not fit in '" + name + "' (" + std::to_string(desc.width) + "x" +
                             std::to_string(desc.height) + ", nor is it half of it)");
@@ -186,7 +187,7 @@ CompositeOutputs addDebugViewPass(rg::Graph& graph, CompositePipelines& pipeline
     constants.minValue = settings.minValue;
     constants.maxValue = settings.maxValue;
     constants.exposure = settings.exposure;
-    constants.sourceShift = (width > desc.width || height > desc.height) ? 1u : 0u;
+    constants.sourceShift = magnified ? 1u : 0u;
 
     struct Data {
         rg::Texture source;

@@ -33,8 +33,7 @@ _anchors = {}  # Markdown file -> its headings' anchors
 
 
 def anchors(path):
-    cache = _anchors
-    if path not in cache:
+    if path not in _anchors:
         found = set()
         in_code = False
         with open(path, encoding="utf-8") as f:
@@ -43,8 +42,8 @@ def anchors(path):
                     in_code = not in_code
                 elif not in_code and line.startswith("#"):
                     found.add(anchor(line.lstrip("#")))
-        cache[path] = found
-    return cache[path]
+        _anchors[path] = found
+    return _anchors[path]
 
 
 def markdown_files(root):

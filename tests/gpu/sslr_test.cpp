@@ -525,9 +525,12 @@ PyramidFrame buildPyramid(test::GpuTest& gpu, const scene::Scene& scene, glm::uv
 
     PyramidFrame out;
     out.size = size;
-    // The image's mips: the chain's levels but level 0, the lit colour.
-    const uint32_t mips =
-        std::min(shader::kSslrPyramidMaxMips, uint32_t(std::bit_width(std::max(size.x, size.y)))) - 1;
+    // The mips the pass declared its image with (the test case checks
+    // their number); each the chain's level m + 1 (level 0, the lit
+    // colour, is not in the image).
+    const rg::TextureDesc& desc = graph.declaration().resources[sslr.litPyramid.index].texture;
+    REQUIRE(glm::uvec2(desc.width, desc.height) == shader::sslrMipSize(size, 1));
+    const uint32_t mips = desc.mips;
     uint64_t texels = 0;
     for (uint32_t m = 0; m < mips; ++m) {
         const glm::uvec2 s = shader::sslrMipSize(size, m + 1);
