@@ -85,9 +85,15 @@ struct SslrSettings {
     float minStepPixels = 1.0f;
     // A hit counts when the refined point lies at most this fraction of
     // the surface's view distance behind the depth buffer (which has no
-    // thickness of its own); a relative test holds at every distance.
-    // Glint's starting value, not a published one: the bench tunes it.
-    float thickness = 0.02f;
+    // thickness of its own; a relative test holds at every distance), or,
+    // where more, what the surface's depth changes over half a pixel (seen
+    // at a slant, a surface spans that much behind its texel's one depth:
+    // shaders/sslr/trace.comp, hitTolerance). Hits fade out from half of
+    // it (confidence). Tuned on the bench's plot: 0.02 until 2026-12-07
+    // took rays passing just behind thin objects for hits on them, which
+    // the plaza's mirrors and glossy street showed in motion
+    // (docs/results/log/09-2026-12-07-fourteenth.md).
+    float thickness = 0.005f;
     // Length of a ray in view units; a ray that meets nothing within it misses.
     float maxDistance = 1000.0f;
     // Confidence fades to zero over this fraction of the image at each

@@ -75,8 +75,12 @@ const std::array<ParameterSlot, 33> kParameters = {{
     // ray's screen length.
     {{"sslr_min_step_pixels", "SslrSettings::minStepPixels", 0.0f, 8.0f, false, {0, 2, 4}, {0, 2}, kScreenSpace},
      [](ReflectionRunOptions& o) { return &o.frame.sslr.minStepPixels; }, nullptr},
-    // Default 0.02 view-space units.
-    {{"sslr_thickness", "SslrSettings::thickness", 0.001f, 0.5f, false, {}, {}, {}},
+    // A hit lies at most this share of its view distance behind the depth
+    // buffer's surface (default 0.005; 0.02 until 2026-12-07), or what a
+    // slanted surface's depth changes over half a pixel: thinner misses
+    // more hits and hands them on, thicker takes rays passing behind an
+    // object for hits.
+    {{"sslr_thickness", "SslrSettings::thickness", 0.001f, 0.5f, false, {0.002, 0.01, 0.02}, {}, kScreenSpace},
      [](ReflectionRunOptions& o) { return &o.frame.sslr.thickness; }, nullptr},
     // A roughness; 0.3 (default) against FidelityFX's 0.22: lower sends
     // more pixels to the environment, higher traces more.

@@ -91,6 +91,26 @@ float screenExit(float start, float delta, float size) {
     return ((delta > 0.0 ? size : 0.0) - start) / delta;
 }
 
+// How far behind the depth buffer at `texel` a ray's refined crossing may
+// lie and still be a hit: the thickness (a share of the view distance), or
+// where the surface is seen at a slant, what its depth changes over half a
+// pixel. The depth buffer holds one depth per texel, its centre's; a ray
+// that meets the surface where it enters the texel, half a pixel from the
+// centre, lies behind that depth by up to that much: many times the
+// thickness on a street far ahead or at a low resolution, where the
+// thickness alone rejected real hits. (A thin object seen face on gets the
+// thickness alone: a ray passing behind it is no hit.)
+float hitTolerance(ivec2 texel, float depth, float surface) {
+    const vec3 normal = mat3(pc.view) * texelFetch(normalTexture, texel, 0).xyz;
+    const vec3 toSurface = normalize(viewPosition(vec2(texel) + 0.5, depth));
+    const float facing = abs(dot(normal, toSurface));
+    // tan of the angle between the view ray and the normal, at most 10.
+    const float slope = sqrt(max(1.0 - facing * facing, 0.0)) / max(facing, 0.1);
+    // Half a pixel's width at the surface's distance, in view units.
+    const float halfPixel = surface / (abs(pc.projection.y) * float(pc.size.y));
+    return max(pc.thickness * surface, halfPixel * slope);
+}
+
 void writeResult(ivec2 pixel, vec3 radiance, float confidence, vec2 hitUv, bool hit, bool cone) {
     imageStore(radianceImage, pixel, vec4(radiance, hit ? (cone ? kSslrHitCone : kSslrHitRay) : 0.0));
     imageStore(confidenceImage, pixel, vec4(confidence));
@@ -226,7 +246,12 @@ void main() {
             const float mid = 0.5 * (lo + hi);
             ivec2 midTexel;
             const float midDepth = depthUnder(m, mid, midTexel);
-            if (inFront(m, mid, midDepth)) {
+            // Within a pixel of the origin counts as in front, as in the
+            // march: there the ray leaves its own texel, whose one depth
+            // (its centre's) a ray rising over a flat surface lies behind.
+            // Searched into, it made the ray hit itself (confidence 0: a
+            // back face) and stop.
+            if (mid * pixelsPerT < 1.0 || inFront(m, mid, midDepth)) {
                 lo = mid;
             } else {
                 hi = mid;
@@ -238,11 +263,12 @@ void main() {
         const float hiGap = rayDistance(m, hi) - hiSurface;
         // Thickness test: the depth buffer holds only front surfaces, so a
         // ray found far behind one passed behind it; keep marching.
-        if (hiGap <= pc.thickness * hiSurface) {
+        const float tolerance = hitTolerance(hiTexel, hiDepth, hiSurface);
+        if (hiGap <= tolerance) {
             tHit = hi;
             hitTexel = hiTexel;
             hitDepth = hiDepth;
-            gap = hiGap / (pc.thickness * hiSurface);
+            gap = hiGap / tolerance;
             break;
         }
         tFront = t;

@@ -453,6 +453,86 @@ TEST_CASE("rays from a mirror wall back toward the camera leave the screen with 
     CHECK(checked >= 3 * kSize);
 }
 
+// A rough green bar across the view in front of mirrorScene's wall, its
+// edges on texel edges: image rows kBarFirstRow to kBarLastRow. Its distance
+// is chosen so that the mirror reflection of the floor row just below it
+// enters the bar's rows 1.5% of the bar's distance behind it (the ray rises
+// up the image and away from the camera), then climbs on to the wall.
+constexpr uint32_t kBarFirstRow = 38;
+constexpr uint32_t kBarLastRow = 41;
+constexpr uint32_t kBelowBarRow = kBarLastRow + 3;
+constexpr float kBarGap = 0.015f;
+
+// The image's ndc y at a texel edge (row r's top edge).
+float rowEdgeNdc(uint32_t r) { return float(r) / float(kSize) * 2.0f - 1.0f; }
+
+// The view distance at which the reflection of floor row `row` (ndc y n,
+// the floor at depth 1 / n) is seen at ndc y `s`: at distance d it is at
+// height y = -1 + (d - 1 / n) n, seen at s = -y / d, so d = 2 / (s + n).
+float reflectionDistanceAt(uint32_t row, float s) { return 2.0f / (s + test::pixelNdc(0, row).y); }
+
+float barDistance() { return reflectionDistanceAt(kBelowBarRow, rowEdgeNdc(kBarLastRow + 1)) / (1.0f + kBarGap); }
+
+scene::Scene barScene() {
+    scene::Scene s = mirrorScene();
+    scene::Material bar;
+    bar.baseColorFactor = {0.1f, 0.8f, 0.1f, 1.0f};
+    bar.roughnessFactor = 1.0f;
+    bar.metallicFactor = 0.0f;
+    s.materials.push_back(bar);
+    const float d = barDistance();
+    const float top = -rowEdgeNdc(kBarFirstRow) * d, bottom = -rowEdgeNdc(kBarLastRow + 1) * d;
+    scene::Geometry g = square({0.0f, 0.5f * (top + bottom), -d}, {1, 0, 0}, {0, 1, 0}, 0.5f * (top - bottom), 2);
+    for (glm::vec3& p : g.positions) p.x *= 40.0f / (0.5f * (top - bottom));  // as wide as the wall
+    s.meshes[0].lods[0].geometries.push_back(std::move(g));
+    scene::prepareScene(s);
+    return s;
+}
+
+// A ray that passes behind a thin object is no hit on it. With the default
+// thickness, the reflections of the floor rows just below the bar that
+// slip behind it (kBelowBarRow's by 1.5% of its distance, the rows above
+// by more) march on past it and find the wall: 0.02, the default until
+// 2026-12-07, took the bar for kBelowBarRow's hit (at half confidence).
+// The rows below, whose reflections meet the bar's face, still find it.
+// (The row just below the bar enters the bar's rows within a pixel of its
+// origin: the binary search used to follow the ray into its own texel
+// there and stop at a hit on itself.)
+TEST_CASE("a reflection passing just behind a thin bar is no hit on it: it marches on to the wall") {
+    test::GpuTest gpu;
+    const passes::SslrSettings settings;
+    REQUIRE(settings.thickness < kBarGap);
+    const SslrFrame f = traceScene(gpu, barScene(), 4, settings);
+    const glm::vec4 wallLit = f.lit[f.at(kSize / 2, kSize / 2 - 4)];
+    const glm::vec4 barLit = f.lit[f.at(kSize / 2, (kBarFirstRow + kBarLastRow) / 2)];
+    REQUIRE(wallLit.r > 2.0f * wallLit.g);  // red: the wall
+    REQUIRE(barLit.g > 2.0f * barLit.r);    // green: the bar
+    const float fadePixels = settings.edgeFade * float(kSize);
+    uint32_t behind = 0, onBar = 0;
+    for (uint32_t y = kBarLastRow + 1; y <= kBelowBarRow + 2; ++y) {
+        // Where the reflection first appears in the bar's rows (their
+        // bottom edge), it lies behind the bar or in front of it.
+        const bool passesBehind = reflectionDistanceAt(y, rowEdgeNdc(kBarLastRow + 1)) > barDistance();
+        REQUIRE(passesBehind == (y <= kBelowBarRow));
+        const glm::vec4 expected = passesBehind ? wallLit : barLit;
+        for (uint32_t x = 0; x < kSize; ++x) {
+            if (!(float(x) > fadePixels + 1.0f && float(x) + 1.0f < float(kSize) - fadePixels)) continue;
+            const size_t i = f.at(x, y);
+            const float hitRow = f.hit[i].y * float(kSize);
+            INFO("pixel " << x << ", " << y << ": hit row " << hitRow << ", radiance " << f.radiance[i].r << " "
+                          << f.radiance[i].g << " " << f.radiance[i].b);
+            REQUIRE(f.classes[i] == shader::kPixelHybrid);
+            CHECK(f.radiance[i].a == 1.0f);
+            CHECK(f.confidence[i] >= passes::kDefaultConfidenceThreshold);
+            CHECK((hitRow >= float(kBarFirstRow) && hitRow < float(kBarLastRow + 1)) == !passesBehind);
+            CHECK(glm::length(glm::vec3(f.radiance[i] - expected)) <= 0.01f * glm::length(glm::vec3(expected)));
+            ++(passesBehind ? behind : onBar);
+        }
+    }
+    CHECK(behind > 3 * kSize / 2);
+    CHECK(onBar > kSize);
+}
+
 TEST_CASE("rough pixels cone-trace: their reflection of thin stripes is the stripes' mean, a mirror's is one stripe") {
     test::GpuTest gpu;
     // The share of confident floor hits whose colour mixes both stripes
