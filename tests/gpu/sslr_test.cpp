@@ -455,9 +455,10 @@ TEST_CASE("rays from a mirror wall back toward the camera leave the screen with 
 
 // A rough green bar across the view in front of mirrorScene's wall, its
 // edges on texel edges: image rows kBarFirstRow to kBarLastRow. Its distance
-// is chosen so that the mirror reflection of the floor row just below it
-// enters the bar's rows 1.5% of the bar's distance behind it (the ray rises
-// up the image and away from the camera), then climbs on to the wall.
+// is chosen so that the mirror reflection of floor row kBelowBarRow, three
+// rows below it, enters the bar's rows 1.5% of the bar's distance behind it
+// (the ray rises up the image and away from the camera), then climbs on to
+// the wall.
 constexpr uint32_t kBarFirstRow = 38;
 constexpr uint32_t kBarLastRow = 41;
 constexpr uint32_t kBelowBarRow = kBarLastRow + 3;
