@@ -100,8 +100,9 @@ float screenExit(float start, float delta, float size) {
 // thickness on a street far ahead or at a low resolution, where the
 // thickness alone rejected real hits. (A thin object seen face on gets the
 // thickness alone: a ray passing behind it is no hit.)
-float hitTolerance(ivec2 texel, float depth, float surface) {
-    const vec3 normal = mat3(pc.view) * texelFetch(normalTexture, texel, 0).xyz;
+// `worldNormal` is the G-buffer's at the texel.
+float hitTolerance(vec3 worldNormal, ivec2 texel, float depth, float surface) {
+    const vec3 normal = mat3(pc.view) * worldNormal;
     const vec3 toSurface = normalize(viewPosition(vec2(texel) + 0.5, depth));
     const float facing = abs(dot(normal, toSurface));
     // tan of the angle between the view ray and the normal, at most 10.
@@ -194,6 +195,7 @@ void main() {
     float tHit = -1.0;
     ivec2 hitTexel = ivec2(0);
     float hitDepth = 0.0;
+    vec3 hitNormal = vec3(0.0);  // world, the G-buffer's at hitTexel
     float gap = 0.0;
     // A ray passing behind a thick occluder lies behind the depth buffer at
     // every step, and a search between two such steps finds that occluder
@@ -263,11 +265,13 @@ void main() {
         const float hiGap = rayDistance(m, hi) - hiSurface;
         // Thickness test: the depth buffer holds only front surfaces, so a
         // ray found far behind one passed behind it; keep marching.
-        const float tolerance = hitTolerance(hiTexel, hiDepth, hiSurface);
+        const vec3 hiNormal = texelFetch(normalTexture, hiTexel, 0).xyz;
+        const float tolerance = hitTolerance(hiNormal, hiTexel, hiDepth, hiSurface);
         if (hiGap <= tolerance) {
             tHit = hi;
             hitTexel = hiTexel;
             hitDepth = hiDepth;
+            hitNormal = hiNormal;
             gap = hiGap / tolerance;
             break;
         }
@@ -306,7 +310,6 @@ void main() {
         // view matrix is a rotation and translation, so its inverse
         // rotation is the transpose).
         const vec3 worldDirection = cone ? transpose(mat3(pc.view)) * direction : unpackRayDirection(ray.direction);
-        const vec3 hitNormal = texelFetch(normalTexture, hitTexel, 0).xyz;
         const float facing = dot(hitNormal, worldDirection) < 0.0 ? 1.0 : 0.0;
         // Fade near the border, where neighbouring rays start to leave the
         // screen, and as the hit's depth gap approaches the thickness (as
