@@ -617,6 +617,7 @@ GBufferOutputs addGBufferPass(rg::Graph& graph, GBufferRenderer& renderer, const
                 o.height = height;
                 o.shadowResolution = shadowSize;
                 o.shadow = work->frame.shadow;
+                o.lighting = work->frame.lighting;
             },
             [&renderer, work, phase, environment = inputs.environment](const SurfaceData& d, rg::PassContext& pc) {
                 renderer.record(*work, pc, d.out, environment, phase, d.args);

@@ -173,6 +173,9 @@ struct GBufferOutputs {
     // This frame's shadow map fit (enabled = 0 with shadows off): what a
     // later pass that reads shadowMap needs to look it up.
     shader::GBufferShadow shadow{};
+    // The sun and the environment the lit colour was lit with (SSLR
+    // re-lights its hits with them).
+    shader::SceneLighting lighting{};
     // With occlusion culling, the frame's counts (shader::kOcclusionStat*,
     // u32 words, glint/occlusion_shared.h), final after "gbuffer.cull_late";
     // else invalid.

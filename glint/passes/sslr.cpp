@@ -3,6 +3,7 @@
 #include "glint/gpu/descriptors.h"
 #include "glint/gpu/error.h"
 #include "glint/graph/executor.h"
+#include "glint/graph/transfer.h"
 
 #include "glint/ray_generation_shared.h"
 #include "glint/sslr_shared.h"
@@ -183,11 +184,15 @@ SslrOutputs addSslrPass(rg::Graph& graph, SslrPipelines& pipelines, const SslrIn
     // confidence (at most 1) it hands every one on.
     constants.confidenceThreshold = inputs.handEveryRay ? 2.0f : sslrStoredThreshold(inputs.confidenceThreshold);
     constants.pyramidMips = pyramidMips;
-    constants.blueNoise = rays.blueNoise ? 1u : 0u;
+    constants.flags = (rays.blueNoise ? shader::kSslrFlagBlueNoise : 0u) |
+                      (settings.relightHits ? shader::kSslrFlagRelight : 0u);
+    // The lighting the re-lighting swaps the sun's specular term with: the
+    // G-buffer's own (larger than push constants leave room for).
+    const rg::Buffer lighting = rg::addUpload(graph, "sslr.lighting", gbuf.lighting);
 
     struct TraceData {
-        rg::Texture depth, normal, lit, roughnessMetal, pyramid;
-        rg::Buffer classes, sslrRays, sslrArgs;
+        rg::Texture depth, normal, albedo, lit, roughnessMetal, pyramid;
+        rg::Buffer classes, sslrRays, sslrArgs, lighting;
         SslrOutputs out;
     };
     const TraceData& trace = graph.addPass<TraceData>(
@@ -195,7 +200,9 @@ SslrOutputs addSslrPass(rg::Graph& graph, SslrPipelines& pipelines, const SslrIn
         [&](rg::Builder& b, TraceData& d) {
             d.depth = b.read(gbuf.depth, rg::Access::SampledRead);
             d.normal = b.read(gbuf.normal, rg::Access::SampledRead);
+            d.albedo = b.read(gbuf.albedo, rg::Access::SampledRead);
             d.lit = b.read(gbuf.lit, rg::Access::SampledRead);
+            d.lighting = b.read(lighting, rg::Access::StorageRead);
             d.roughnessMetal = b.read(gbuf.roughnessMetal, rg::Access::SampledRead);
             if (pyramid.valid()) d.pyramid = b.read(pyramid, rg::Access::SampledRead);
             d.classes = b.read(rays.classes, rg::Access::StorageRead);
@@ -236,6 +243,8 @@ SslrOutputs addSslrPass(rg::Graph& graph, SslrPipelines& pipelines, const SslrIn
                               pipelines.trilinear_.handle(), pc.layout(d.pyramid.valid() ? d.pyramid : d.lit))
                 .storageBuffer("SslrArgs", pc.buffer(d.sslrArgs))
                 .storageBuffer("BlueNoise", *blueNoise)
+                .sampledImage("albedoTexture", pc.view(d.albedo), sampler, pc.layout(d.albedo))
+                .storageBuffer("Lighting", pc.buffer(d.lighting))
                 .push(pipelines.ctx_, pc.cmd());
             pipeline.pushConstants(pc.cmd(), constants);
             pc.dispatchIndirect(pipeline, d.sslrArgs, kRayListDispatchArgsBytes);

@@ -5,8 +5,8 @@
 // leader of the SSLR and hybrid pixels across the depth buffer: a linear march of large steps with a per-pixel
 // random start offset, then binary refinement where the ray may have met a
 // surface (Far Cry 6 talk section 3; not at every step of a ray passing
-// behind an occluder, shaders/sslr/trace.comp says when). It writes the lit colour at the hit and a confidence in
-// [0, 1], and lists the hybrid rays below the confidence threshold, with
+// behind an occluder, shaders/sslr/trace.comp says when). It writes the lit colour at the hit, re-lit for
+// the ray's direction (relightHits), and a confidence in [0, 1], and lists the hybrid rays below the confidence threshold, with
 // indirect args, for the ray-traced pass: it appends them to ray
 // generation's RT ray list. The rays ray generation marks for the cone
 // trace sample a box-filtered pyramid of the lit colour, built by two
@@ -100,6 +100,13 @@ struct SslrSettings {
     // border, where neighbouring rays start to leave the screen (FidelityFX
     // SSSR's hit validation fades the same way). Glint's starting value.
     float edgeFade = 0.05f;
+    // A hit's lit colour is the surface as the camera sees it; the ray
+    // sees it from another side. On, the hit is re-lit for the ray's
+    // direction (the sun's specular reflection, the lighting's one term
+    // that depends on it, swapped: shaders/sslr/trace.comp, relit), as the
+    // ray-traced hits are lit; the cone trace re-lights its hit texel, not
+    // the pyramid's wider levels. Off: the lit colour as it is.
+    bool relightHits = true;
     // The rays ray generation marks (RayGenerationSettings::coneRoughness)
     // cone-trace over a pyramid of the lit colour; off, every ray marches
     // its own GGX direction and no pyramid is declared.

@@ -62,7 +62,7 @@ constexpr std::array<bool, 3> kEveryMode{true, true, true};
 
 // The one table of parameters: name, field, the viewer's range, the
 // bench's sweep, and where the value lives.
-const std::array<ParameterSlot, 33> kParameters = {{
+const std::array<ParameterSlot, 34> kParameters = {{
     // A confidence; the talk's 0.9 (default) bracketed from "trust SSLR
     // often" to "almost never".
     {{"sslr_threshold", "ReflectionFrameSettings::confidenceThreshold", 0.0f, 1.0f, false, {0.5, 0.7, 0.8, 0.95, 0.99},
@@ -82,6 +82,10 @@ const std::array<ParameterSlot, 33> kParameters = {{
     // object for hits.
     {{"sslr_thickness", "SslrSettings::thickness", 0.001f, 0.5f, false, {0.002, 0.01, 0.02}, {}, kScreenSpace},
      [](ReflectionRunOptions& o) { return &o.frame.sslr.thickness; }, nullptr},
+    // SSLR's hits re-lit for the ray's direction (default on); 0: the lit
+    // colour as the camera sees it.
+    {{"sslr_relight", "SslrSettings::relightHits (0 or 1)", 0.0f, 1.0f, true, {0}, {}, kScreenSpace}, nullptr,
+     nullptr, [](ReflectionRunOptions& o) { return &o.frame.sslr.relightHits; }},
     // A roughness; 0.3 (default) against FidelityFX's 0.22: lower sends
     // more pixels to the environment, higher traces more.
     {{"roughness_cutoff", "RayGenerationSettings::roughnessCutoff", 0.0f, 1.0f, false, {0.1, 0.15, 0.22, 0.5}, {0.5},

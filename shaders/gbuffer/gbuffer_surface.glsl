@@ -155,6 +155,8 @@ void main() {
     const float coverage = clamp(alpha, 0.0, 1.0);
     outColor = vec4(radiance * coverage, coverage);
 #else
-    outLit = vec4(shadeSurface(frame.lighting, s, toViewer, sunVisibility) + emission, 1.0);
+    // a: the sun's visibility, with which SSLR re-lights the surface for
+    // the direction a reflection ray sees it from (shaders/sslr/trace.comp).
+    outLit = vec4(shadeSurface(frame.lighting, s, toViewer, sunVisibility) + emission, sunVisibility);
 #endif
 }

@@ -5,12 +5,15 @@
 // buffer in screen space: kLinearSteps large steps with a per-pixel random
 // start offset, then a binary search between the last step in front of the
 // surface and the first behind it (the Far Cry 6 talk's linear-then-refine
-// trace; 64 + 8 steps by default). Hits sample the lit colour; the
-// confidence falls to zero for misses, thick or back-facing hits and near
-// the screen border, and hybrid rays below the threshold are listed for RT.
+// trace; 64 + 8 steps by default). Hits sample the lit colour, re-lit for
+// the direction the ray sees the surface from; the confidence falls to
+// zero for misses, thick or back-facing hits and near the screen border,
+// and hybrid rays below the threshold are listed for RT.
 #extension GL_GOOGLE_include_directive : require
 #extension GL_EXT_scalar_block_layout : require
 
+#include "glint/gbuffer_shared.h"
+#include "glint/brdf.glsl"
 #include "glint/ray_generation_shared.h"
 #include "glint/sampling.glsl"
 #include "glint/sslr_shared.h"
@@ -35,8 +38,12 @@ layout(set = 0, binding = 10) uniform sampler2D roughnessMetalTexture;
 layout(set = 0, binding = 11) uniform sampler2D pyramidTexture;
 // The SSLR list's args: its length at kRayListCountOffset.
 layout(set = 0, binding = 12, scalar) readonly buffer SslrArgs { uint sslrArgs[]; };
-// Ray generation's spatiotemporal blue noise (glint/sampling.glsl); read only when pc.blueNoise is 1.
+// Ray generation's spatiotemporal blue noise (glint/sampling.glsl); read
+// only with kSslrFlagBlueNoise.
 layout(set = 0, binding = 13, scalar) readonly buffer BlueNoise { uvec2 blueNoise[]; };
+// The G-buffer's albedo and its lighting: the re-lighting's (kSslrFlagRelight).
+layout(set = 0, binding = 14) uniform sampler2D albedoTexture;
+layout(set = 0, binding = 15, scalar) readonly buffer Lighting { SceneLighting lighting; };
 
 layout(push_constant, scalar) uniform Constants { SslrConstants pc; };
 
@@ -112,6 +119,32 @@ float hitTolerance(vec3 worldNormal, ivec2 texel, float depth, float surface) {
     return max(pc.thickness * surface, halfPixel * slope);
 }
 
+// The lit colour at a hit texel as the ray sees it. The G-buffer lit the
+// surface for the camera (glint/brdf.glsl's shadeSurface); of that light
+// only the sun's specular reflection depends on the direction it leaves
+// in, so the camera's is swapped for the ray's, as the ray-traced hits
+// light a surface from the ray's side. The sun's visibility is the
+// G-buffer's (lit.a). `worldNormal` is the G-buffer's at the texel,
+// `hitView` the texel's view-space position, `worldDirection` the ray's.
+vec3 relit(vec4 lit, ivec2 texel, vec3 worldNormal, vec3 hitView, vec3 worldDirection) {
+    if (!(lit.a > 0.0)) return lit.rgb;  // in the sun's shadow: nothing to swap
+    Surface s;
+    s.position = vec3(0.0);  // unused by sunSpecular
+    s.normal = worldNormal;
+    s.albedo = texelFetch(albedoTexture, texel, 0).rgb;
+    const vec3 material = texelFetch(roughnessMetalTexture, texel, 0).xyz;
+    s.roughness = material.x;
+    s.metallic = material.y;
+    s.reflectance = material.z;
+    // The view matrix is a rotation and translation: its inverse rotation
+    // is the transpose.
+    const vec3 toCamera = transpose(mat3(pc.view)) * normalize(-hitView);
+    const vec3 swapped = sunSpecular(lighting, s, -worldDirection) - sunSpecular(lighting, s, toCamera);
+    // The normal's half floats differ from the one the G-buffer shaded
+    // with: a sharp highlight taken away may exceed what it added.
+    return max(lit.rgb + swapped * lit.a, vec3(0.0));
+}
+
 void writeResult(ivec2 pixel, vec3 radiance, float confidence, vec2 hitUv, bool hit, bool cone) {
     imageStore(radianceImage, pixel, vec4(radiance, hit ? (cone ? kSslrHitCone : kSslrHitRay) : 0.0));
     imageStore(confidenceImage, pixel, vec4(confidence));
@@ -181,7 +214,7 @@ void main() {
     // The random start offset (a fraction of one step, new every frame)
     // turns the banding of large steps into noise the temporal filter
     // removes (Far Cry 6 talk).
-    const float jitter = pc.blueNoise != 0u
+    const float jitter = (pc.flags & kSslrFlagBlueNoise) != 0u
                              ? blueNoiseChannel(blueNoise[blueNoiseTexel(pixel, pc.frame)], kBlueNoiseSslrOffset)
                              : scalarNoise(pixel, pc.frame, kNoiseSslrOffset);
     // No more steps than the ray's on-screen length has pixels per
@@ -283,34 +316,44 @@ void main() {
     vec2 hitUv = vec2(0.0);
     if (tHit >= 0.0) {
         hitUv = sslrHitUv(uvec2(hitTexel), pc.size);
-        radiance = texelFetch(litTexture, hitTexel, 0).rgb;
-        if (cone) {
-            // The GGX lobe around the mirror direction falls to half its
-            // peak at tan(theta_h) = alpha sqrt(sqrt(2) - 1) ~ 0.64 alpha
-            // for the half vector, twice that for the reflected ray. Its
-            // diameter where the ray meets the surface, d * 2 tan, in that
-            // depth's pixels, is the footprint; the pyramid level whose
-            // texels span it holds the lobe's mean colour.
-            const float alpha = roughness * roughness;
-            const vec3 hitPosition = viewPosition(vec2(hitTexel) + 0.5, hitDepth);
-            const float distance = length(hitPosition - origin);
-            const float pixelsPerUnit = 0.5 * abs(pc.projection.y) * float(pc.size.y) / max(-hitPosition.z, 1e-6);
-            const float footprint = 2.0 * 1.287 * alpha * distance * pixelsPerUnit;
-            const float mip = clamp(log2(max(footprint, 1.0)), 0.0, float(pc.pyramidMips - 1u));
-            // Trilinear over the chain: the pyramid holds level m as its
-            // mip m - 1; between levels 0 and 1 the lit texel (the hit's
-            // centre: level 0's bilinear there) blends with level 1.
-            if (mip >= 1.0) {
-                radiance = textureLod(pyramidTexture, hitUv, mip - 1.0).rgb;
-            } else if (mip > 0.0) {
-                radiance = mix(radiance, textureLod(pyramidTexture, hitUv, 0.0).rgb, mip);
-            }
-        }
         // Back faces: the hit surface must face the ray (world normals; the
         // view matrix is a rotation and translation, so its inverse
         // rotation is the transpose).
         const vec3 worldDirection = cone ? transpose(mat3(pc.view)) * direction : unpackRayDirection(ray.direction);
         const float facing = dot(hitNormal, worldDirection) < 0.0 ? 1.0 : 0.0;
+        const vec3 hitPosition = viewPosition(vec2(hitTexel) + 0.5, hitDepth);
+        // The cone trace's pyramid level (0: the hit texel alone). The GGX
+        // lobe around the mirror direction falls to half its peak at
+        // tan(theta_h) = alpha sqrt(sqrt(2) - 1) ~ 0.64 alpha for the half
+        // vector, twice that for the reflected ray. Its diameter where the
+        // ray meets the surface, d * 2 tan, in that depth's pixels, is the
+        // footprint; the pyramid level whose texels span it holds the
+        // lobe's mean colour.
+        float mip = 0.0;
+        if (cone) {
+            const float alpha = roughness * roughness;
+            const float distance = length(hitPosition - origin);
+            const float pixelsPerUnit = 0.5 * abs(pc.projection.y) * float(pc.size.y) / max(-hitPosition.z, 1e-6);
+            const float footprint = 2.0 * 1.287 * alpha * distance * pixelsPerUnit;
+            mip = clamp(log2(max(footprint, 1.0)), 0.0, float(pc.pyramidMips - 1u));
+        }
+        // Trilinear over the chain: the pyramid holds level m as its mip
+        // m - 1; between levels 0 and 1 the hit texel (level 0's bilinear
+        // at the hit's centre) blends with level 1. Only the texel is
+        // re-lit for the ray: the pyramid's levels are lit for the camera,
+        // and a footprint of many texels averages highlights that no one
+        // swap would place.
+        if (mip >= 1.0) {
+            radiance = textureLod(pyramidTexture, hitUv, mip - 1.0).rgb;
+        } else {
+            const vec4 lit = texelFetch(litTexture, hitTexel, 0);
+            radiance = (pc.flags & kSslrFlagRelight) != 0u && facing > 0.0
+                           ? relit(lit, hitTexel, hitNormal, hitPosition, worldDirection)
+                           : lit.rgb;
+            if (mip > 0.0) {
+                radiance = mix(radiance, textureLod(pyramidTexture, hitUv, 0.0).rgb, mip);
+            }
+        }
         // Fade near the border, where neighbouring rays start to leave the
         // screen, and as the hit's depth gap approaches the thickness (as
         // FidelityFX SSSR validates its hits).

@@ -67,6 +67,25 @@ vec3 envBrdfApprox(vec3 f0, float roughness, float NoV) {
     return f0 * ab.x + ab.y;
 }
 
+// The sun's specular reflection leaving `s` towards `toViewer` (unit),
+// unshadowed: the one term of shadeSurface that depends on the direction
+// the light leaves in. SSLR swaps the camera's direction for the ray's
+// with it at its hits (shaders/sslr/trace.comp), as the ray-traced hits are
+// lit from the ray's side.
+vec3 sunSpecular(SceneLighting l, Surface s, vec3 toViewer) {
+    const vec3 n = s.normal;
+    const vec3 L = l.sunDirection.xyz;
+    const float NoL = clamp(dot(n, L), 0.0, 1.0);
+    const float NoV = max(dot(n, toViewer), 1e-4);
+    const vec3 H = normalize(L + toViewer);
+    const float NoH = clamp(dot(n, H), 0.0, 1.0);
+    const float VoH = clamp(dot(toViewer, H), 0.0, 1.0);
+    const float roughness = max(s.roughness, kMinRoughness);
+    const float alpha = roughness * roughness;
+    const vec3 F = fresnelSchlick(surfaceF0(s), VoH);
+    return F * (ggxDistribution(NoH, alpha) * smithVisibility(NoV, NoL, alpha)) * l.sunIrradiance.rgb * NoL;
+}
+
 #ifdef GLINT_ENVIRONMENT_BINDING
 // The environment's lookups (the sky, its irradiance, the prefiltered
 // image): shaders that light surfaces bind it.
@@ -77,19 +96,9 @@ vec3 envBrdfApprox(vec3 f0, float roughness, float NoV) {
 // is left to the reflection passes.
 vec3 shadeSurface(SceneLighting l, Surface s, vec3 toViewer, float sunVisibility) {
     const vec3 n = s.normal;
-    const vec3 L = l.sunDirection.xyz;
-    const float NoL = clamp(dot(n, L), 0.0, 1.0);
-    const float NoV = max(dot(n, toViewer), 1e-4);
-    const vec3 H = normalize(L + toViewer);
-    const float NoH = clamp(dot(n, H), 0.0, 1.0);
-    const float VoH = clamp(dot(toViewer, H), 0.0, 1.0);
-    const float roughness = max(s.roughness, kMinRoughness);
-    const float alpha = roughness * roughness;
-
-    const vec3 F = fresnelSchlick(surfaceF0(s), VoH);
-    const vec3 specular = F * (ggxDistribution(NoH, alpha) * smithVisibility(NoV, NoL, alpha));
+    const float NoL = clamp(dot(n, l.sunDirection.xyz), 0.0, 1.0);
     const vec3 diffuse = diffuseColor(s) / kPi;
-    const vec3 sun = (diffuse + specular) * l.sunIrradiance.rgb * (NoL * sunVisibility);
+    const vec3 sun = (diffuse * l.sunIrradiance.rgb * NoL + sunSpecular(l, s, toViewer)) * sunVisibility;
     const vec3 ambient = diffuseColor(s) / kPi * environmentIrradiance(l, n);
     return sun + ambient;
 }

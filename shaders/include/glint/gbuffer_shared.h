@@ -10,7 +10,9 @@
 //                  unjittered: history lookup = pixel + motion
 //   lit            radiance of the opaque scene (sun + diffuse ambient +
 //                  emission, which is neither lit nor shadowed; no
-//                  specular ambient: the reflection passes add that), a = 1;
+//                  specular ambient: the reflection passes add that), a =
+//                  the sun's visibility there (0 shadowed to 1 lit), with
+//                  which SSLR re-lights its hits for the ray's direction;
 //                  the sky's radiance with a = 0 where nothing was drawn.
 //                  The sun term is shadowed by the shadow map below; the
 //                  ambient term never is (the ray-traced hits light the same

@@ -7,7 +7,8 @@
 // whatever the memory held, unless SslrSettings::clearUntraced zeroes them
 // first (for debug views). Readers look at a pixel's leader, and only for
 // SSLR and hybrid pixels:
-//   radiance    lit colour at the hit, rgb; a: 0 no hit, kSslrHitRay (1) a
+//   radiance    lit colour at the hit (re-lit for the ray's direction:
+//               SslrSettings::relightHits), rgb; a: 0 no hit, kSslrHitRay (1) a
 //               hit of the pixel's own (stochastic) ray, kSslrHitCone (2) a
 //               cone trace's hit: the lobe's mean from the lit colour's mip
 //               chain, without the ray's noise
@@ -45,8 +46,12 @@ struct SslrConstants {
     float confidenceThreshold;  // as stored (passes::sslrStoredThreshold); hybrid rays below it go on to RT
     uint pyramidMips;           // levels of the lit colour's mip chain (below); 0: no cone trace
     float minStepPixels;        // SslrSettings::minStepPixels
-    uint blueNoise;             // 1: start offsets from the blue noise (ray generation's choice)
+    uint flags;                 // kSslrFlag* below
 };
+
+// SslrConstants::flags.
+GLINT_CONST uint kSslrFlagBlueNoise = 1u;  // start offsets from the blue noise (ray generation's choice)
+GLINT_CONST uint kSslrFlagRelight = 2u;    // hits re-lit for the ray's direction (SslrSettings::relightHits)
 
 // radiance.a of a hit (above): the pixel's ray, or the cone trace.
 GLINT_CONST float kSslrHitRay = 1.0f;
