@@ -98,6 +98,11 @@ float screenExit(float start, float delta, float size) {
     return ((delta > 0.0 ? size : 0.0) - start) / delta;
 }
 
+const float kMaxSlope = 10.0;  // the slant hitTolerance counts at most
+
+// Half a pixel's width at a view distance, in view units.
+float halfPixelAt(float surface) { return surface / (abs(pc.projection.y) * float(pc.size.y)); }
+
 // How far behind the depth buffer at `texel` a ray's refined crossing may
 // lie and still be a hit: the thickness (a share of the view distance), or
 // where the surface is seen at a slant, what its depth changes over half a
@@ -112,11 +117,17 @@ float hitTolerance(vec3 worldNormal, ivec2 texel, float depth, float surface) {
     const vec3 normal = mat3(pc.view) * worldNormal;
     const vec3 toSurface = normalize(viewPosition(vec2(texel) + 0.5, depth));
     const float facing = abs(dot(normal, toSurface));
-    // tan of the angle between the view ray and the normal, at most 10.
-    const float slope = sqrt(max(1.0 - facing * facing, 0.0)) / max(facing, 0.1);
-    // Half a pixel's width at the surface's distance, in view units.
-    const float halfPixel = surface / (abs(pc.projection.y) * float(pc.size.y));
-    return max(pc.thickness * surface, halfPixel * slope);
+    // tan of the angle between the view ray and the normal, at most
+    // kMaxSlope.
+    const float slope = sqrt(max(1.0 - facing * facing, 0.0)) / max(facing, 1.0 / kMaxSlope);
+    return max(pc.thickness * surface, halfPixelAt(surface) * slope);
+}
+
+// The most hitTolerance can be at a view distance, whatever the normal: a
+// crossing farther behind is no hit, decided without reading the normal
+// (most crossings of a ray passing behind an occluder lie far behind it).
+float largestTolerance(float surface) {
+    return max(pc.thickness * surface, halfPixelAt(surface) * kMaxSlope);
 }
 
 // The lit colour at a hit texel as the ray sees it. The G-buffer lit the
@@ -298,6 +309,10 @@ void main() {
         const float hiGap = rayDistance(m, hi) - hiSurface;
         // Thickness test: the depth buffer holds only front surfaces, so a
         // ray found far behind one passed behind it; keep marching.
+        if (hiGap > largestTolerance(hiSurface)) {
+            tFront = t;
+            continue;
+        }
         const vec3 hiNormal = texelFetch(normalTexture, hiTexel, 0).xyz;
         const float tolerance = hitTolerance(hiNormal, hiTexel, hiDepth, hiSurface);
         if (hiGap <= tolerance) {
