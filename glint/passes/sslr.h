@@ -89,11 +89,15 @@ struct SslrSettings {
     // where more, what the surface's depth changes over half a pixel (seen
     // at a slant, a surface spans that much behind its texel's one depth:
     // shaders/sslr/trace.comp, hitTolerance). Hits fade out from half of
-    // it (confidence). Tuned on the bench's plot: 0.02 until 2026-12-07
+    // it (confidence). Chosen on the bench's plot: 0.02 until 2026-12-07
     // took rays passing just behind thin objects for hits on them, which
     // the plaza's mirrors and glossy street showed in motion
-    // (docs/results/log/09-2026-12-07-fourteenth.md).
-    float thickness = 0.005f;
+    // (docs/results/log/09-2026-12-07-fourteenth.md); thinner costs time,
+    // since rays that stopped there march on and more go to the ray
+    // tracer (0.005 took the city's hybrid from 0.79x rt to 0.85x on an
+    // H100). 0.01 is the cheapest whose plaza in motion is within 1% of
+    // rt's FLIP (docs/results/log/10-2026-12-07-fifteenth.md).
+    float thickness = 0.01f;
     // Length of a ray in view units; a ray that meets nothing within it misses.
     float maxDistance = 1000.0f;
     // Confidence fades to zero over this fraction of the image at each

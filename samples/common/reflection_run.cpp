@@ -76,11 +76,11 @@ const std::array<ParameterSlot, 34> kParameters = {{
     {{"sslr_min_step_pixels", "SslrSettings::minStepPixels", 0.0f, 8.0f, false, {0, 2, 4}, {0, 2}, kScreenSpace},
      [](ReflectionRunOptions& o) { return &o.frame.sslr.minStepPixels; }, nullptr},
     // A hit lies at most this share of its view distance behind the depth
-    // buffer's surface (default 0.005; 0.02 until 2026-12-07), or what a
-    // slanted surface's depth changes over half a pixel: thinner misses
+    // buffer's surface (default 0.01; 0.02 until 2026-12-07, then 0.005),
+    // or what a slanted surface's depth changes over half a pixel: thinner misses
     // more hits and hands them on, thicker takes rays passing behind an
     // object for hits.
-    {{"sslr_thickness", "SslrSettings::thickness", 0.001f, 0.5f, false, {0.002, 0.01, 0.02}, {}, kScreenSpace},
+    {{"sslr_thickness", "SslrSettings::thickness", 0.001f, 0.5f, false, {0.002, 0.005, 0.02}, {}, kScreenSpace},
      [](ReflectionRunOptions& o) { return &o.frame.sslr.thickness; }, nullptr},
     // SSLR's hits re-lit for the ray's direction (default on); 0: the lit
     // colour as the camera sees it.
