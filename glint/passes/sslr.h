@@ -2,11 +2,13 @@
 // Pass 3 of the reflection pipeline: screen-space reflections.
 // One compute pass, dispatched indirectly over ray generation's SSLR ray
 // list (one invocation per ray: no work for an empty list), traces each ray
-// leader of the SSLR and hybrid pixels across the depth buffer: a linear march of large steps with a per-pixel
-// random start offset, then binary refinement where the ray may have met a
-// surface (Far Cry 6 talk section 3; not at every step of a ray passing
-// behind an occluder, shaders/sslr/trace.comp says when). It writes the lit colour at the hit, re-lit for
-// the ray's direction (relightHits), and a confidence in [0, 1], and lists the hybrid rays below the confidence threshold, with
+// leader of the SSLR and hybrid pixels across the depth buffer: a linear
+// march of large steps with a per-pixel random start offset, then binary
+// refinement where the ray may have met a surface (Far Cry 6 talk section
+// 3; not at every step of a ray passing behind an occluder,
+// shaders/sslr/trace.comp says when). It writes the lit colour at the
+// hit, re-lit for the ray's direction (relightHits), and a confidence in
+// [0, 1], and lists the hybrid rays below the confidence threshold, with
 // indirect args, for the ray-traced pass: it appends them to ray
 // generation's RT ray list. The rays ray generation marks for the cone
 // trace sample a box-filtered pyramid of the lit colour, built by two

@@ -151,8 +151,9 @@ vec3 relit(vec4 lit, ivec2 texel, vec3 worldNormal, vec3 hitView, vec3 worldDire
     // is the transpose.
     const vec3 toCamera = transpose(mat3(pc.view)) * normalize(-hitView);
     const vec3 swapped = sunSpecular(lighting, s, -worldDirection) - sunSpecular(lighting, s, toCamera);
-    // The normal's half floats differ from the one the G-buffer shaded
-    // with: a sharp highlight taken away may exceed what it added.
+    // The G-buffer shaded with the material's roughness and normal; they
+    // come back here at 8 and 16 bits: a sharp highlight taken away may
+    // exceed what it added.
     return max(lit.rgb + swapped * lit.a, vec3(0.0));
 }
 
